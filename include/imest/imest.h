@@ -1,0 +1,331 @@
+/**
+ * @file imest.h
+ * @brief imest: online rotor time constant (T_R) and stator resistance (R_S)
+ *        estimator for induction machines (Wang, Chiasson, Bodson, Tolbert,
+ *        IEEE TCST 2007), for inverter firmware.
+ *
+ * Usage (CMSIS-DSP style, every struct is caller-owned, nothing is allocated):
+ *
+ *     imest_config_t cfg;
+ *     imest_config_default(&cfg);             // then set the motor constants:
+ *     cfg.pole_pairs = 2; cfg.ls_h = 0.2908f; cfg.sigma = 0.096f; cfg.fs_hz = 4000.0f;
+ *     static imest_t est;
+ *     if (imest_init(&est, &cfg) != IMEST_OK) { ... }
+ *
+ *     // PWM-synchronous ISR, once per sample:
+ *     if (imest_isr_abc(&est, u_abc_v, i_abc_a, theta_rad)) { wake background task }
+ *
+ *     // background task (any priority below the ISR):
+ *     imest_result_t r;
+ *     while (imest_background(&est, &r) == 1) { use r (r.valid, r.tr_s, r.rs_ohm ...) }
+ *
+ * Algorithm, per sample (ISR path, float32, fixed instruction count):
+ *   3-2 transform (power invariant, MATH.md §1) -> rotation by n_p*theta into the
+ *   rotor frame -> 3rd-order Butterworth (second-order sections, same filter on
+ *   every channel, including the speed) -> time-aligned central differences
+ *   (value, first and second derivative all refer to sample n-1) -> regressor
+ *   W (2x7, columns 1,2,4..8) and y -> accumulation of the 36 independent
+ *   entries of R_W, R_Wy, R_y over a window -> lock-free hand-off.
+ *
+ * Per window (background path, bounded iterations):
+ *   rebuild the 8x8 R_W -> power-of-two scaling -> cost tables e0,e1,e2 ->
+ *   p1, p2 coefficients -> resultant r(K2) (degree 18) -> every positive root by
+ *   a Sturm sequence with bisection -> back-substitution K1 = -a0/a1 ->
+ *   selection (K1 > 0, T_R in [tr_min_s, tr_max_s], least E) -> T_R = 1/K2,
+ *   R_S = sigma*L_S*K1 - (1-sigma)*L_S*K2 -> Hessian, E_I, parametric error
+ *   indices -> validity with a reason.
+ *
+ * Concurrency contract (ISR <-> background):
+ *   - imest_isr_abc()/imest_isr_ab() are called from exactly one context (the
+ *     sampling ISR); imest_background() from exactly one other context of
+ *     lower priority (or the same one, e.g. in a host replay loop). Neither
+ *     blocks nor waits for the other. No locks, no disabling of interrupts.
+ *   - Two window buffers: the ISR fills one while the background owns the
+ *     other. When a window completes, the ISR hands its buffer over only if the
+ *     background has released the previous one; otherwise the finished window
+ *     is dropped, `overruns` is incremented and the sequence number still
+ *     advances, so the gap is visible in the next result (`seq`, `overruns`).
+ *     A window is never torn: the background reads a buffer only after the ISR
+ *     published it, and the ISR writes it again only after the background
+ *     released it.
+ *   - Publication uses one index written only by the ISR and one written only
+ *     by the background, with a compiler barrier (IMEST_BARRIER). On a single
+ *     core Cortex-M that is sufficient; on a multi-core or cached system define
+ *     IMEST_BARRIER to a full memory barrier (e.g. __DMB()).
+ *   - imest_init() must not run concurrently with either call.
+ *
+ * Numerics: the ISR path is float32 only (builds with -Wdouble-promotion
+ * -Werror); products are summed in short float32 blocks folded into the window
+ * sums one entry per sample (no data-dependent loop), and y is centred on the
+ * previous valid estimate (MATH.md §10), which keeps T_R within 0.01 % of an
+ * all-float64 run. The background uses float64 where the precision needs it
+ * (cost tables, E, E_I, Hessian, error indices) and float32 where it does not.
+ *
+ * No malloc, no stdio, no global mutable state; <math.h> is used only outside
+ * the ISR (init and background).
+ */
+#ifndef IMEST_IMEST_H
+#define IMEST_IMEST_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ----------------------------------------------------------------------------
+ * Status and reason codes
+ * ------------------------------------------------------------------------- */
+
+/** Return codes of imest_init() and the error reasons of a result. */
+typedef enum {
+  IMEST_OK = 0,                  /**< valid estimate / success */
+  /* configuration errors (imest_init) */
+  IMEST_ERR_NULL = 1,            /**< a pointer argument was NULL */
+  IMEST_ERR_CONFIG = 2,          /**< a config field is out of range; see imest_config_check() */
+  /* reasons a window is invalid (imest_result_t.status), most fundamental first */
+  IMEST_ST_WARMUP = 10,          /**< filters were still settling (start or after a fault) */
+  IMEST_ST_INPUT_FAULT = 11,     /**< non-finite or absurd sample (NaN, Inf, beyond limits) */
+  IMEST_ST_ADC_SATURATION = 12,  /**< a current or voltage sample reached the ADC limit */
+  IMEST_ST_ENCODER_FAULT = 13,   /**< angle step beyond the speed limit (glitch, jump) */
+  IMEST_ST_NO_CURRENT = 14,      /**< stator current below min_current_a: nothing to identify */
+  IMEST_ST_STANDSTILL = 15,      /**< rotor (nearly) at rest without AC excitation */
+  IMEST_ST_ZERO_SLIP = 16,       /**< rotor currents ~0 (no load, constant speed): T_R unobservable */
+  IMEST_ST_NUMERIC = 17,         /**< non-finite window sums or polynomial */
+  IMEST_ST_NO_ROOT = 18,         /**< no stationary point with K1 > 0 and T_R in [tr_min, tr_max] */
+  IMEST_ST_NOT_MINIMUM = 19,     /**< Hessian at the selected point not positive definite */
+  IMEST_ST_POORLY_DETERMINED = 20, /**< relative parametric error index of K2 too large */
+  IMEST_ST_HIGH_RESIDUAL = 21,   /**< E_I above max_ei: the data do not fit the model */
+  IMEST_ST_RS_OUT_OF_RANGE = 22  /**< R_S outside [rs_min_ohm, rs_max_ohm] */
+} imest_status_t;
+
+/** Short lower-case name of a status code ("ok", "warmup", "zero_slip", ...). */
+const char *imest_status_name(int status);
+
+/** Window flag bits (imest_result_t.flags): everything noticed in the window. */
+#define IMEST_FLAG_WARMUP        0x0001u /**< some samples were warm-up (not accumulated) */
+#define IMEST_FLAG_INPUT_FAULT   0x0002u
+#define IMEST_FLAG_ADC_SAT       0x0004u
+#define IMEST_FLAG_ENCODER_FAULT 0x0008u
+#define IMEST_FLAG_OVERRUN       0x0010u /**< one or more windows before this one were dropped */
+#define IMEST_FLAG_HESSIAN_PD    0x0100u /**< Hessian positive definite at the selected point */
+
+/* ----------------------------------------------------------------------------
+ * Configuration
+ * ------------------------------------------------------------------------- */
+
+/** Configuration. Fill with imest_config_default(), then set the motor. */
+typedef struct {
+  /* Motor constants (known, from the data sheet or a commissioning test). */
+  unsigned int pole_pairs;  /**< n_p */
+  float ls_h;               /**< stator inductance L_S [H] */
+  float sigma;              /**< total leakage factor 1 - M^2/(L_S L_R) */
+
+  /* Sampling. */
+  float fs_hz;              /**< sample rate of the ISR call [Hz] (default 4000) */
+  float window_s;           /**< window length [s] (default 1.0) */
+
+  /* Front end. */
+  float filter_hz;          /**< Butterworth-3 cut-off [Hz] (default 100: works for
+                                 run-up and steady state with 12-bit sensors) */
+  float aa_hz;              /**< if the analog current/voltage channels have a 2nd-order
+                                 anti-alias filter, its cut-off [Hz]; the angle is
+                                 then passed through a digital model of it so all
+                                 channels see the same delay (0 = none, default) */
+  float warmup_s;           /**< samples discarded after start/fault while the filters
+                                 settle [s] (default 0: derived from filter_hz) */
+  int start_at_rest;        /**< nonzero: the first sample follows a zero history
+                                 (drive just enabled, motor at rest, no current),
+                                 so no warm-up is needed at start (default 0) */
+
+  /* Solve and selection. */
+  float tr_nominal_s;       /**< nominal T_R, used for scaling and the first centring
+                                 (default 0.1 s) */
+  float tr_min_s;           /**< admissible T_R band [s] (default 1 ms .. 10 s) */
+  float tr_max_s;
+  float rs_min_ohm;         /**< admissible R_S band [ohm] (default 0 .. 1e3) */
+  float rs_max_ohm;
+
+  /* Validity (see README "When is a window valid"). */
+  float max_pe_k2_rel;      /**< largest relative parametric error index of K2 (default 0.1) */
+  float max_ei;             /**< largest residual error index E_I (default 0.5) */
+  float min_current_a;      /**< least rms stator current (alpha/beta amplitude) [A] (default 0.05) */
+  float min_slip_ratio;     /**< least rms rotor-frame current rate / (rms current / T_R): a
+                                 measure of slip excitation (default 0.05) */
+
+  /* Input plausibility (per sample, ISR). */
+  float i_limit_a;          /**< |phase current| >= this counts as ADC saturation (0 = off) */
+  float u_limit_v;          /**< |phase voltage| >= this counts as ADC saturation (0 = off) */
+  float i_absurd_a;         /**< |current| beyond this (or non-finite) is an input fault (default 1e4) */
+  float u_absurd_v;         /**< |voltage| beyond this (or non-finite) is an input fault (default 1e5) */
+  float speed_limit_rad_s;  /**< |mechanical angle step| * fs beyond this is an encoder fault
+                                 (default 3000 rad/s, about 28 600 rpm) */
+} imest_config_t;
+
+/** Fill a config with defaults (motor constants zero: the caller must set them). */
+void imest_config_default(imest_config_t *cfg);
+
+/** Check a config: IMEST_OK, or IMEST_ERR_CONFIG with *field naming the first bad field. */
+int imest_config_check(const imest_config_t *cfg, const char **field);
+
+/* ----------------------------------------------------------------------------
+ * Result of one window
+ * ------------------------------------------------------------------------- */
+
+#define IMEST_MAX_ROOTS 20
+
+/** Result of one window. Every estimate carries its quality. */
+typedef struct {
+  uint32_t seq;             /**< window sequence number (0, 1, 2, ...; gaps = dropped windows) */
+  uint32_t samples;         /**< samples in the window */
+  uint32_t used_samples;    /**< samples accumulated (not warm-up, not faulty) */
+  uint32_t overruns;        /**< windows dropped since init (background too slow) */
+  int valid;                /**< 1: the estimate can be trusted */
+  int status;               /**< IMEST_OK or the first reason it cannot (imest_status_t) */
+  unsigned int flags;       /**< IMEST_FLAG_* bits */
+  double t_end_s;           /**< time of the window's last sample since init [s] */
+  double tr_s;              /**< rotor time constant T_R [s] (NaN if no candidate) */
+  double rs_ohm;            /**< stator resistance R_S [ohm] */
+  double k1;                /**< K1 = gamma [1/s] */
+  double k2;                /**< K2 = 1/T_R [1/s] */
+  double e;                 /**< E_p^2 at the minimum (units of y^2 * samples) */
+  double e_i;               /**< residual error index sqrt(E/R_y) */
+  double hessian[2][2];     /**< d2E/dK^2 at the minimum, K = (K1, K2) */
+  double pe_k1;             /**< parametric error index of K1 (absolute, 1/s) */
+  double pe_k2;             /**< parametric error index of K2 (absolute, 1/s) */
+  double pe_k1_rel;         /**< pe_k1 / K1 */
+  double pe_k2_rel;         /**< pe_k2 / K2 */
+  double slip_ratio;        /**< excitation measure compared with min_slip_ratio */
+  double i_rms_a;           /**< rms stator current over the window (alpha/beta amplitude) */
+  unsigned int n_roots;     /**< positive roots of the resultant */
+  unsigned int n_admissible;/**< roots with K1 > 0 and T_R in band */
+  double roots_k2[IMEST_MAX_ROOTS]; /**< the positive roots, ascending */
+} imest_result_t;
+
+/* ----------------------------------------------------------------------------
+ * Instance (caller-owned; treat as opaque)
+ * ------------------------------------------------------------------------- */
+
+/** Arithmetic type of the ISR path: float32. Defining IMEST_ISR_DOUBLE builds
+ *  an all-float64 variant, used only by the host tests as the reference that
+ *  the float32 path is measured against. */
+#ifdef IMEST_ISR_DOUBLE
+typedef double imest_real_t;
+#else
+typedef float imest_real_t;
+#endif
+
+/** Number of independent accumulated entries: 28 of R_W (7 columns), 7 of R_Wy, 1 of R_y. */
+#define IMEST_NACC 36
+
+/** One window's sums, as handed from the ISR to the background. */
+typedef struct {
+  imest_real_t sum[IMEST_NACC];   /**< folded block sums */
+  imest_real_t blk[IMEST_NACC];   /**< the current (unfolded) block of each entry */
+  imest_real_t c0[7];             /**< centring vector used for this window (y - W c0 accumulated) */
+  uint32_t seq;
+  uint32_t samples;
+  uint32_t used;
+  uint32_t flags;
+} imest_window_t;
+
+/** Butterworth-3 as a first-order and a second-order section (transposed DF-II). */
+typedef struct {
+  imest_real_t b0, b1, a1;        /**< section 1: (b0 + b1 z^-1) / (1 + a1 z^-1) */
+  imest_real_t c0, c1, c2, d1, d2;/**< section 2: (c0 + c1 z^-1 + c2 z^-2) / (1 + d1 z^-1 + d2 z^-2) */
+} imest_bw3_t;
+
+/** Filter state of one channel: 3 section states and the last two outputs. */
+typedef struct {
+  imest_real_t s1, s2a, s2b;
+  imest_real_t y1, y2;            /**< x_f[n-1], x_f[n-2] */
+} imest_chan_t;
+
+/** 2nd-order analog anti-alias model applied to the speed channel. */
+typedef struct {
+  imest_real_t c0, c1, c2, d1, d2;
+} imest_sos_t;
+
+/** Estimator instance. All fields are private; sizes are what the ISR needs. */
+typedef struct {
+  /* constants derived at init */
+  imest_real_t fs, inv2t, invt2;        /* fs, 1/(2T), 1/T^2 */
+  imest_real_t n, m, inv_s, n1m;        /* n_p, M*beta, 1/(sigma L_S), n_p (1+m) */
+  imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max;
+  uint32_t window_n, warmup_n;
+  imest_bw3_t bw;
+  imest_sos_t aa;
+  /* ISR state */
+  imest_chan_t ch[5];            /* u_x, u_y, i_x, i_y, omega */
+  imest_real_t aa_s1, aa_s2;            /* anti-alias model state (speed) */
+  imest_real_t th_prev;                 /* previous mechanical angle (as given) */
+  uint32_t k;                    /* sample index in the current window */
+  uint32_t warm;                 /* warm-up samples still to discard */
+  uint32_t fold;                 /* next entry to fold */
+  uint32_t seq;                  /* sequence number of the window being filled */
+  uint32_t started;              /* first sample seen */
+  uint32_t fill;                 /* buffer index the ISR fills (0/1) */
+  volatile uint32_t published;   /* ISR -> background: count of buffers handed over */
+  volatile uint32_t released;    /* background -> ISR: count of buffers released */
+  volatile uint32_t overruns;    /* windows dropped */
+  uint32_t dropped_pending;      /* drops not yet reported in a result */
+  imest_real_t c0[7];                   /* centring vector for the next window (background writes
+                                    next_c0, ISR copies it at window start) */
+  volatile imest_real_t next_c0[7];
+  volatile uint32_t next_c0_gen; /* generation counter of next_c0 */
+  uint32_t c0_gen;
+  imest_window_t win[2];
+  /* background-only state */
+  float sigma, ls_h, tr_nominal_s, tr_min_s, tr_max_s, rs_min_ohm, rs_max_ohm;
+  float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
+  double last_k1, last_k2;       /* last valid estimate: centring of later windows */
+  const struct imest_can_port *can; /* telemetry port (NULL: none) */
+  uint32_t can_base_id;
+  uint32_t can_counter;
+  uint32_t can_tx_failed;
+} imest_t;
+
+/* ----------------------------------------------------------------------------
+ * API
+ * ------------------------------------------------------------------------- */
+
+/** Initialise an instance from a config (checked). Returns IMEST_OK,
+ *  IMEST_ERR_NULL or IMEST_ERR_CONFIG. Computes the filter coefficients. */
+int imest_init(imest_t *s, const imest_config_t *cfg);
+
+/**
+ * ISR call with phase quantities. Fixed instruction count.
+ * @param u_abc_v   phase-to-neutral voltages [V]
+ * @param i_abc_a   phase currents [A], positive into the motor
+ * @param theta_rad mechanical rotor angle [rad], any range (wrapped or not; the
+ *                  step between calls must stay below pi), increasing with the
+ *                  a-b-c field. Pass it wrapped (e.g. [0, 2pi)) so float32
+ *                  keeps its resolution.
+ * @return 1 when this sample completed a window that was handed to the
+ *         background (wake it), 0 otherwise.
+ */
+int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], float theta_rad);
+
+/** ISR call with alpha/beta quantities (power-invariant 3-2 transform, MATH.md
+ *  §1: amplitude = line-to-line rms; an amplitude-invariant Clarke transform
+ *  scales u and i alike, which leaves T_R and R_S unchanged but changes E,
+ *  min_current_a and the saturation check, which then apply to alpha/beta). */
+int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a,
+                 float i_beta_a, float theta_rad);
+
+/**
+ * Background call: if a finished window is waiting, solve it, publish it over
+ * the CAN port (if one is attached), fill *out and return 1; else return 0
+ * (-1 if an argument is NULL). Bounded time (no unbounded iteration).
+ * Stack: see README (about 2 KiB). Call it until it returns 0.
+ */
+int imest_background(imest_t *s, imest_result_t *out);
+
+/** Windows dropped because the background had not released the previous one. */
+uint32_t imest_overruns(const imest_t *s);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* IMEST_IMEST_H */

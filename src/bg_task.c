@@ -1,0 +1,100 @@
+/* The background task: once per finished window, take the buffer from the
+ * ISR, solve, judge, publish, and release the buffer with the centring for a
+ * later window. */
+#include <math.h>
+#include <stddef.h>
+
+#include "bg_internal.h"
+
+static void result_clear(imest_result_t *r)
+{
+  unsigned char *raw = (unsigned char *)r;
+  for (size_t b = 0; b < sizeof *r; ++b) raw[b] = 0u;
+}
+
+int imest_background(imest_t *s, imest_result_t *out)
+{
+  if (s == NULL || out == NULL) return -1;
+  if (s->published == s->released) return 0;
+  IMEST_BARRIER(); /* read the window only after seeing it published */
+  imest_window_t *w = &s->win[s->released & 1u];
+
+  result_clear(out);
+  out->seq = w->seq;
+  out->samples = w->samples;
+  out->used_samples = w->used;
+  out->overruns = s->overruns;
+  out->flags = w->flags;
+  out->t_end_s = ((double)w->seq + 1.0) * (double)s->window_n / (double)s->fs -
+                 1.0 / (double)s->fs;
+
+  const double m = (double)s->m;
+  imest_sums_t sums;
+  imest_window_stats_t st;
+  imest_window_sums(w, m, (unsigned int)s->n, &sums, &st);
+
+  imest_solve_out_t so;
+  so.status = IMEST_ST_NUMERIC;
+  so.hessian_pd = 0;
+  so.tr_s = NAN;
+  if (w->used >= 16u) {
+    imest_solve_cfg_t cfg;
+    cfg.sigma = (double)s->sigma;
+    cfg.ls_h = (double)s->ls_h;
+    cfg.tr_nominal_s = (double)s->tr_nominal_s;
+    cfg.tr_min_s = (double)s->tr_min_s;
+    cfg.tr_max_s = (double)s->tr_max_s;
+    (void)imest_solve(&sums, &cfg, &so);
+  }
+
+  if (so.status == IMEST_OK) {
+    out->tr_s = so.tr_s;
+    out->rs_ohm = so.rs_ohm;
+    out->k1 = so.k1;
+    out->k2 = so.k2;
+    out->e = so.e;
+    out->e_i = so.e_i;
+    out->hessian[0][0] = so.hessian[0][0];
+    out->hessian[0][1] = so.hessian[0][1];
+    out->hessian[1][0] = so.hessian[1][0];
+    out->hessian[1][1] = so.hessian[1][1];
+    out->pe_k1 = so.pe_k1;
+    out->pe_k2 = so.pe_k2;
+    out->pe_k1_rel = so.pe_k1 / so.k1;
+    out->pe_k2_rel = so.pe_k2 / so.k2;
+    if (so.hessian_pd) out->flags |= IMEST_FLAG_HESSIAN_PD;
+  } else {
+    out->tr_s = NAN;
+    out->rs_ohm = NAN;
+    out->k1 = NAN;
+    out->k2 = NAN;
+    out->e = NAN;
+    out->e_i = NAN;
+    out->pe_k1 = NAN;
+    out->pe_k2 = NAN;
+    out->pe_k1_rel = NAN;
+    out->pe_k2_rel = NAN;
+  }
+  out->n_roots = so.status == IMEST_ST_NUMERIC ? 0u : so.n_roots;
+  out->n_admissible = so.status == IMEST_ST_NUMERIC ? 0u : so.n_admissible;
+  for (unsigned int k = 0; k < out->n_roots && k < IMEST_MAX_ROOTS; ++k) {
+    out->roots_k2[k] = so.roots_k2[k];
+  }
+  imest_judge(s, &st, &so, out);
+
+  /* centre later windows on the latest trusted estimate */
+  if (out->valid) {
+    s->last_k1 = out->k1;
+    s->last_k2 = out->k2;
+  }
+  if (s->last_k2 > 0.0) imest_centre_from_k(w->c0, s->last_k1, s->last_k2, m);
+  for (unsigned int p = 0; p < IMEST_NACC; ++p) {
+    w->sum[p] = 0;
+    w->blk[p] = 0;
+  }
+  IMEST_BARRIER(); /* buffer cleared before it is released */
+  s->released = s->released + 1u;
+
+  if (s->can != NULL) (void)imest_can_publish(s, out);
+  return 1;
+}

@@ -1,0 +1,56 @@
+/* Background stage 1: take one window's ISR sums to float64 8x8 form.
+ * The ISR accumulated Z = [W1 W2 W4 W5 W6 W7 W8 e] with e = y - W c0; here
+ * R_Wy = R_We + R_W c0 and R_y = R_ee + 2 c0.R_We + c0' R_W c0 (float64), and
+ * row/column 3 = -m x row/column 4 (MATH.md §2). */
+#include <math.h>
+
+#include "bg_internal.h"
+#include "isr_accumulate.h"
+
+/* 7-column index -> 8-column (K) index */
+static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
+
+void imest_window_sums(const imest_window_t *w, double m, unsigned int pole_pairs,
+                       imest_sums_t *out, imest_window_stats_t *st)
+{
+  double z[8][8];
+  for (unsigned int i = 0; i < 8u; ++i) {
+    for (unsigned int j = i; j < 8u; ++j) {
+      const unsigned int p = IMEST_ACC_INDEX(i, j);
+      z[i][j] = (double)w->sum[p] + (double)w->blk[p];
+      z[j][i] = z[i][j];
+    }
+  }
+  double c0[7];
+  for (unsigned int i = 0; i < 7u; ++i) c0[i] = (double)w->c0[i];
+
+  double rwy7[7];
+  double ry = z[7][7];
+  for (unsigned int i = 0; i < 7u; ++i) {
+    double acc = z[i][7];
+    for (unsigned int j = 0; j < 7u; ++j) acc += z[i][j] * c0[j];
+    rwy7[i] = acc;
+    ry += c0[i] * (z[i][7] + acc); /* 2 c0.R_We + c0' R_W c0 = c0.(R_We + R_Wy) */
+  }
+
+  for (unsigned int i = 0; i < 7u; ++i) {
+    out->rwy[k_of_col[i]] = rwy7[i];
+    for (unsigned int j = 0; j < 7u; ++j) out->rw[k_of_col[i]][k_of_col[j]] = z[i][j];
+  }
+  for (unsigned int j = 0; j < 8u; ++j) {
+    out->rw[2][j] = -m * out->rw[3][j];
+  }
+  for (unsigned int i = 0; i < 8u; ++i) {
+    out->rw[i][2] = -m * out->rw[i][3];
+  }
+  out->rw[2][2] = m * m * out->rw[3][3];
+  out->rwy[2] = -m * out->rwy[3];
+  out->ry = ry;
+
+  const double n = w->used > 0u ? (double)w->used : 1.0;
+  const double r44 = out->rw[3][3], r11 = out->rw[0][0], r66 = out->rw[5][5];
+  st->i_rms_a = sqrt(fmax(r44, 0.0) / n);
+  st->di_rms = sqrt(fmax(r11, 0.0) / n);
+  /* |W6|^2 = (n w')^2 + (n w)^4 per |i|^2: a current-weighted speed measure */
+  st->w_rms = (r44 > 0.0) ? sqrt(sqrt(fmax(r66 / r44, 0.0))) / (double)pole_pairs : 0.0;
+}

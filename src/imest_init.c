@@ -1,0 +1,214 @@
+/* Configuration defaults and checks, filter design, instance initialisation.
+ * Runs once, outside the ISR: float64 and <math.h> are fine here. */
+#include <math.h>
+#include <stddef.h>
+
+#include "bg_internal.h"
+
+void imest_config_default(imest_config_t *cfg)
+{
+  if (cfg == NULL) return;
+  cfg->pole_pairs = 0;      /* motor constants: the caller must set them */
+  cfg->ls_h = 0.0f;
+  cfg->sigma = 0.0f;
+  cfg->fs_hz = 4000.0f;
+  cfg->window_s = 1.0f;
+  cfg->filter_hz = 100.0f;
+  cfg->aa_hz = 0.0f;
+  cfg->warmup_s = 0.0f;
+  cfg->start_at_rest = 0;
+  cfg->tr_nominal_s = 0.1f;
+  cfg->tr_min_s = 1.0e-3f;
+  cfg->tr_max_s = 10.0f;
+  cfg->rs_min_ohm = 0.0f;
+  cfg->rs_max_ohm = 1.0e3f;
+  cfg->max_pe_k2_rel = 0.1f;
+  cfg->max_ei = 0.5f;
+  cfg->min_current_a = 0.05f;
+  cfg->min_slip_ratio = 0.05f;
+  cfg->i_limit_a = 0.0f;
+  cfg->u_limit_v = 0.0f;
+  cfg->i_absurd_a = 1.0e4f;
+  cfg->u_absurd_v = 1.0e5f;
+  cfg->speed_limit_rad_s = 3000.0f;
+}
+
+static int finite_pos(float x) { return isfinite(x) && x > 0.0f; }
+
+int imest_config_check(const imest_config_t *cfg, const char **field)
+{
+  const char *bad = NULL;
+  if (cfg == NULL) {
+    if (field) *field = "cfg";
+    return IMEST_ERR_NULL;
+  }
+  const double fs = (double)cfg->fs_hz;
+  if (cfg->pole_pairs < 1u || cfg->pole_pairs > 64u) bad = "pole_pairs";
+  else if (!finite_pos(cfg->ls_h)) bad = "ls_h";
+  else if (!(cfg->sigma > 0.0f && cfg->sigma < 1.0f)) bad = "sigma";
+  else if (!finite_pos(cfg->fs_hz) || cfg->fs_hz > 1.0e6f) bad = "fs_hz";
+  else if (!finite_pos(cfg->window_s) || (double)cfg->window_s * fs < 64.0 ||
+           (double)cfg->window_s * fs > 4.0e8) bad = "window_s";
+  else if (!finite_pos(cfg->filter_hz) || (double)cfg->filter_hz >= 0.4 * fs) bad = "filter_hz";
+  else if (!(cfg->aa_hz == 0.0f || (finite_pos(cfg->aa_hz) && (double)cfg->aa_hz < 0.45 * fs)))
+    bad = "aa_hz";
+  else if (!(isfinite(cfg->warmup_s) && cfg->warmup_s >= 0.0f &&
+             cfg->warmup_s <= cfg->window_s * 100.0f)) bad = "warmup_s";
+  else if (!finite_pos(cfg->tr_nominal_s)) bad = "tr_nominal_s";
+  else if (!finite_pos(cfg->tr_min_s)) bad = "tr_min_s";
+  else if (!(finite_pos(cfg->tr_max_s) && cfg->tr_max_s > cfg->tr_min_s)) bad = "tr_max_s";
+  else if (!(isfinite(cfg->rs_min_ohm) && cfg->rs_min_ohm >= 0.0f)) bad = "rs_min_ohm";
+  else if (!(isfinite(cfg->rs_max_ohm) && cfg->rs_max_ohm > cfg->rs_min_ohm)) bad = "rs_max_ohm";
+  else if (!finite_pos(cfg->max_pe_k2_rel)) bad = "max_pe_k2_rel";
+  else if (!finite_pos(cfg->max_ei)) bad = "max_ei";
+  else if (!(isfinite(cfg->min_current_a) && cfg->min_current_a >= 0.0f)) bad = "min_current_a";
+  else if (!(isfinite(cfg->min_slip_ratio) && cfg->min_slip_ratio >= 0.0f)) bad = "min_slip_ratio";
+  else if (!(isfinite(cfg->i_limit_a) && cfg->i_limit_a >= 0.0f)) bad = "i_limit_a";
+  else if (!(isfinite(cfg->u_limit_v) && cfg->u_limit_v >= 0.0f)) bad = "u_limit_v";
+  else if (!finite_pos(cfg->i_absurd_a)) bad = "i_absurd_a";
+  else if (!finite_pos(cfg->u_absurd_v)) bad = "u_absurd_v";
+  else if (!finite_pos(cfg->speed_limit_rad_s) ||
+           (double)cfg->speed_limit_rad_s >= 3.0 * fs) bad = "speed_limit_rad_s";
+  if (field) *field = bad;
+  return bad ? IMEST_ERR_CONFIG : IMEST_OK;
+}
+
+/* Butterworth-3 by the bilinear transform prewarped at fc: a first-order
+ * section (s + 1) and a second-order section (s^2 + s + 1). */
+static void design_bw3(imest_bw3_t *f, double fc, double fs)
+{
+  const double k = tan(IMEST_PI_D * fc / fs);
+  const double g1 = k / (1.0 + k);
+  f->b0 = (imest_real_t)g1;
+  f->b1 = (imest_real_t)g1;
+  f->a1 = (imest_real_t)((k - 1.0) / (1.0 + k));
+  const double a0 = 1.0 + k + k * k;
+  const double g2 = k * k / a0;
+  f->c0 = (imest_real_t)g2;
+  f->c1 = (imest_real_t)(2.0 * g2);
+  f->c2 = (imest_real_t)g2;
+  f->d1 = (imest_real_t)(2.0 * (k * k - 1.0) / a0);
+  f->d2 = (imest_real_t)((1.0 - k + k * k) / a0);
+}
+
+/* 2nd-order Butterworth (Q = 1/sqrt 2) anti-alias model; fc = 0: identity. */
+static void design_aa(imest_sos_t *f, double fc, double fs)
+{
+  if (fc <= 0.0) {
+    f->c0 = 1;
+    f->c1 = 0;
+    f->c2 = 0;
+    f->d1 = 0;
+    f->d2 = 0;
+    return;
+  }
+  const double k = tan(IMEST_PI_D * fc / fs);
+  const double a0 = 1.0 + IMEST_SQRT2_D * k + k * k;
+  const double g = k * k / a0;
+  f->c0 = (imest_real_t)g;
+  f->c1 = (imest_real_t)(2.0 * g);
+  f->c2 = (imest_real_t)g;
+  f->d1 = (imest_real_t)(2.0 * (k * k - 1.0) / a0);
+  f->d2 = (imest_real_t)((1.0 - IMEST_SQRT2_D * k + k * k) / a0);
+}
+
+/* Centring vector c0 (7-column form) for a given K1, K2 (MATH.md §2, §10). */
+void imest_centre_from_k(imest_real_t c0[7], double k1, double k2, double m)
+{
+  c0[0] = (imest_real_t)k1;
+  c0[1] = (imest_real_t)k2;
+  c0[2] = (imest_real_t)(k1 * k2 - m * k2 * k2); /* K4 - m K3 (column 3 folded into 4) */
+  c0[3] = (imest_real_t)(1.0 / k2);
+  c0[4] = (imest_real_t)(k1 / k2);
+  c0[5] = (imest_real_t)(k1 / (k2 * k2));
+  c0[6] = (imest_real_t)(1.0 / (k2 * k2));
+}
+
+int imest_init(imest_t *s, const imest_config_t *cfg)
+{
+  if (s == NULL || cfg == NULL) return IMEST_ERR_NULL;
+  const int rc = imest_config_check(cfg, NULL);
+  if (rc != IMEST_OK) return rc;
+
+  /* no memset: the core does not depend on <string.h> */
+  unsigned char *raw = (unsigned char *)s;
+  for (size_t b = 0; b < sizeof *s; ++b) raw[b] = 0u;
+
+  const double fs = (double)cfg->fs_hz;
+  const double sigma = (double)cfg->sigma, ls = (double)cfg->ls_h;
+  const double m = (1.0 - sigma) / sigma;
+  s->fs = (imest_real_t)fs;
+  s->inv2t = (imest_real_t)(0.5 * fs);
+  s->invt2 = (imest_real_t)(fs * fs);
+  s->n = (imest_real_t)cfg->pole_pairs;
+  s->m = (imest_real_t)m;
+  s->inv_s = (imest_real_t)(1.0 / (sigma * ls));
+  s->n1m = (imest_real_t)((double)cfg->pole_pairs * (1.0 + m));
+  s->i_lim = (imest_real_t)cfg->i_limit_a;
+  s->u_lim = (imest_real_t)cfg->u_limit_v;
+  s->i_abs = (imest_real_t)cfg->i_absurd_a;
+  s->u_abs = (imest_real_t)cfg->u_absurd_v;
+  s->dth_max = (imest_real_t)cfg->speed_limit_rad_s;
+  s->window_n = (uint32_t)lround((double)cfg->window_s * fs);
+
+  design_bw3(&s->bw, (double)cfg->filter_hz, fs);
+  design_aa(&s->aa, (double)cfg->aa_hz, fs);
+
+  /* warm-up: the slowest Butterworth-3 pole decays as exp(-pi fc t); 3/fc
+   * leaves < 1e-4 of a start-up transient; the anti-alias model adds its own. */
+  double warm_s = (double)cfg->warmup_s;
+  if (warm_s <= 0.0) {
+    warm_s = 3.0 / (double)cfg->filter_hz;
+    if (cfg->aa_hz > 0.0f) warm_s += 2.0 / (double)cfg->aa_hz;
+  }
+  s->warmup_n = cfg->start_at_rest ? 0u : (uint32_t)ceil(warm_s * fs) + 2u;
+  s->warm = s->warmup_n;
+
+  /* background constants */
+  s->sigma = cfg->sigma;
+  s->ls_h = cfg->ls_h;
+  s->tr_nominal_s = cfg->tr_nominal_s;
+  s->tr_min_s = cfg->tr_min_s;
+  s->tr_max_s = cfg->tr_max_s;
+  s->rs_min_ohm = cfg->rs_min_ohm;
+  s->rs_max_ohm = cfg->rs_max_ohm;
+  s->max_pe_k2_rel = cfg->max_pe_k2_rel;
+  s->max_ei = cfg->max_ei;
+  s->min_current_a = cfg->min_current_a;
+  s->min_slip_ratio = cfg->min_slip_ratio;
+
+  /* first centring: nominal T_R, and gamma with R_S = 0 (any c0 is correct;
+   * a close one only improves float32 precision) */
+  const double k2 = 1.0 / (double)cfg->tr_nominal_s;
+  const double k1 = m * k2;
+  imest_centre_from_k(s->win[0].c0, k1, k2, m);
+  imest_centre_from_k(s->win[1].c0, k1, k2, m);
+  s->fill = 0;
+  s->win[0].flags = s->warm ? IMEST_FLAG_WARMUP : 0u;
+  return IMEST_OK;
+}
+
+uint32_t imest_overruns(const imest_t *s) { return s ? s->overruns : 0u; }
+
+const char *imest_status_name(int status)
+{
+  switch (status) {
+  case IMEST_OK: return "ok";
+  case IMEST_ERR_NULL: return "null_argument";
+  case IMEST_ERR_CONFIG: return "bad_config";
+  case IMEST_ST_WARMUP: return "warmup";
+  case IMEST_ST_INPUT_FAULT: return "input_fault";
+  case IMEST_ST_ADC_SATURATION: return "adc_saturation";
+  case IMEST_ST_ENCODER_FAULT: return "encoder_fault";
+  case IMEST_ST_NO_CURRENT: return "no_current";
+  case IMEST_ST_STANDSTILL: return "standstill";
+  case IMEST_ST_ZERO_SLIP: return "zero_slip";
+  case IMEST_ST_NUMERIC: return "numeric";
+  case IMEST_ST_NO_ROOT: return "no_root";
+  case IMEST_ST_NOT_MINIMUM: return "not_minimum";
+  case IMEST_ST_POORLY_DETERMINED: return "poorly_determined";
+  case IMEST_ST_HIGH_RESIDUAL: return "high_residual";
+  case IMEST_ST_RS_OUT_OF_RANGE: return "rs_out_of_range";
+  default: return "unknown";
+  }
+}

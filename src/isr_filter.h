@@ -1,0 +1,62 @@
+/* ISR stage 2: Butterworth-3 low-pass as second-order sections and
+ * time-aligned central differences (MATH.md §8). Every channel passes the same
+ * filter so the delays are identical. */
+#ifndef IMEST_ISR_FILTER_H
+#define IMEST_ISR_FILTER_H
+
+#include "isr_real.h"
+
+/* One sample through the first- and second-order sections (transposed DF-II).
+ * Returns x_f[n]. */
+static inline imest_real_t isr_bw3(const imest_bw3_t *f, imest_chan_t *c, imest_real_t x)
+{
+  const imest_real_t v = f->b0 * x + c->s1;
+  c->s1 = f->b1 * x - f->a1 * v;
+  const imest_real_t w = f->c0 * v + c->s2a;
+  c->s2a = f->c1 * v - f->d1 * w + c->s2b;
+  c->s2b = f->c2 * v - f->d2 * w;
+  return w;
+}
+
+/* Filtered value and its central derivatives, all referred to sample n-1:
+ * x = x_f[n-1], dx = (x_f[n] - x_f[n-2]) / 2T, d2x = (x_f[n] - 2 x_f[n-1] + x_f[n-2]) / T^2. */
+typedef struct {
+  imest_real_t x, dx, d2x;
+} isr_deriv_t;
+
+static inline isr_deriv_t isr_filter_deriv(const imest_t *s, imest_chan_t *c, imest_real_t x)
+{
+  const imest_real_t xf = isr_bw3(&s->bw, c, x);
+  isr_deriv_t d;
+  d.x = c->y1;
+  d.dx = (xf - c->y2) * s->inv2t;
+  d.d2x = ((xf - c->y1) - (c->y1 - c->y2)) * s->invt2;
+  c->y2 = c->y1;
+  c->y1 = xf;
+  return d;
+}
+
+/* The speed channel: the filter runs on the angle increments times fs (a
+ * float32 unwrapped angle would lose resolution). Since differencing commutes
+ * with the filter, omega and domega/dt at n-1 are the mean and the difference
+ * of two consecutive filtered increments. */
+static inline void isr_filter_speed(const imest_t *s, imest_chan_t *c, imest_real_t w_raw,
+                                    imest_real_t *w, imest_real_t *dw)
+{
+  const imest_real_t wf = isr_bw3(&s->bw, c, w_raw);
+  *w = RL(0.5) * (wf + c->y1);
+  *dw = (wf - c->y1) * s->fs;
+  c->y1 = wf;
+}
+
+/* Digital model of a 2nd-order analog anti-alias filter (transposed DF-II). */
+static inline imest_real_t isr_aa(const imest_sos_t *f, imest_real_t *s1, imest_real_t *s2,
+                                  imest_real_t x)
+{
+  const imest_real_t y = f->c0 * x + *s1;
+  *s1 = f->c1 * x - f->d1 * y + *s2;
+  *s2 = f->c2 * x - f->d2 * y;
+  return y;
+}
+
+#endif

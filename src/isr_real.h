@@ -1,0 +1,29 @@
+/* Arithmetic of the ISR path: imest_real_t is float (float64 only in the
+ * host-side reference build, IMEST_ISR_DOUBLE). Literals go through RL() so the
+ * float build never promotes to double (-Wdouble-promotion). */
+#ifndef IMEST_ISR_REAL_H
+#define IMEST_ISR_REAL_H
+
+#include "imest/imest.h"
+
+#define RL(x) ((imest_real_t)(x))
+#define IMEST_PI_R RL(3.14159265358979323846)
+#define IMEST_2PI_R RL(6.28318530717958647692)
+
+/* Compiler barrier for the ISR/background hand-off. Override on multi-core or
+ * cached systems with a real memory barrier (e.g. -DIMEST_BARRIER=__DMB()). */
+#ifndef IMEST_BARRIER
+#if defined(__GNUC__) || defined(__clang__)
+#define IMEST_BARRIER() __asm__ volatile("" ::: "memory")
+#else
+#define IMEST_BARRIER() do { } while (0)
+#endif
+#endif
+
+/* Absolute value without libm (the ISR calls no library function). */
+static inline imest_real_t isr_abs(imest_real_t x) { return x < RL(0) ? -x : x; }
+
+/* 1 if |x| <= lim (false for NaN and +-Inf). */
+static inline int isr_within(imest_real_t x, imest_real_t lim) { return (x <= lim) & (x >= -lim); }
+
+#endif
