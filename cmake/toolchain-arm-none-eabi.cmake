@@ -1,0 +1,39 @@
+# Common part of the arm-none-eabi toolchain files (included by
+# toolchain-arm-cortex-m4f.cmake and toolchain-arm-cortex-m7.cmake, which set
+# IMEST_ARM_CPU_FLAGS first). Bare metal: no OS, no malloc, no stdio.
+#
+# Flags chosen for the core:
+#   -O2                     optimisation used for every figure in fw/README.md
+#   -ffreestanding          no hosted library assumed (implies -fno-builtin)
+#   -fno-math-errno         sqrt() etc. need not set errno
+#   -ffunction-sections -fdata-sections, linked with --gc-sections
+set(CMAKE_SYSTEM_NAME Generic)
+set(CMAKE_SYSTEM_PROCESSOR arm)
+
+set(IMEST_ARM_PREFIX arm-none-eabi- CACHE STRING "prefix of the cross tools")
+set(CMAKE_C_COMPILER   ${IMEST_ARM_PREFIX}gcc)
+set(CMAKE_CXX_COMPILER ${IMEST_ARM_PREFIX}g++)
+set(CMAKE_ASM_COMPILER ${IMEST_ARM_PREFIX}gcc)
+set(CMAKE_AR           ${IMEST_ARM_PREFIX}ar CACHE FILEPATH "")
+set(CMAKE_RANLIB       ${IMEST_ARM_PREFIX}ranlib CACHE FILEPATH "")
+set(CMAKE_SIZE         ${IMEST_ARM_PREFIX}size CACHE FILEPATH "")
+set(CMAKE_OBJDUMP      ${IMEST_ARM_PREFIX}objdump CACHE FILEPATH "")
+
+# Compiler checks link a static library, not an executable (no startup code yet).
+set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
+
+set(CMAKE_C_FLAGS_INIT
+    "${IMEST_ARM_CPU_FLAGS} -ffreestanding -fno-math-errno -ffunction-sections -fdata-sections")
+set(CMAKE_CXX_FLAGS_INIT "${IMEST_ARM_CPU_FLAGS} -ffunction-sections -fdata-sections")
+set(CMAKE_ASM_FLAGS_INIT "${IMEST_ARM_CPU_FLAGS}")
+set(CMAKE_EXE_LINKER_FLAGS_INIT "${IMEST_ARM_CPU_FLAGS} -nostartfiles -Wl,--gc-sections")
+
+# -O2 in every build type that optimises (CMake's Release default would be -O3).
+set(CMAKE_C_FLAGS_RELEASE_INIT "-O2 -DNDEBUG")
+set(CMAKE_C_FLAGS_RELWITHDEBINFO_INIT "-O2 -g -DNDEBUG")
+set(CMAKE_ASM_FLAGS_RELEASE_INIT "")
+
+set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
+set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
+set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
+set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)

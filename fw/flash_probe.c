@@ -1,0 +1,32 @@
+/* Flash probe: links every public function of the core. Built twice, with and
+ * without the library calls (FW_FLASH_BASELINE); the size difference is the
+ * flash a firmware pays for the core, including what it pulls from libm,
+ * libgcc and libc, with --gc-sections. */
+#include <stdint.h>
+#ifndef FW_FLASH_BASELINE
+#include "imest/imest.h"
+static imest_t est;
+static imest_result_t res;
+#endif
+int main(void);
+void fw_mark_b0(void);
+
+int main(void)
+{
+#ifndef FW_FLASH_BASELINE
+  imest_config_t cfg;
+  const char *field = 0;
+  imest_config_default(&cfg);
+  if (imest_config_check(&cfg, &field) != IMEST_OK) return 1;
+  if (imest_init(&est, &cfg) != IMEST_OK) return 1;
+  const float u[3] = {0.0f, 0.0f, 0.0f}, i[3] = {0.0f, 0.0f, 0.0f};
+  (void)imest_isr_abc(&est, u, i, 0.0f);
+  (void)imest_isr_ab(&est, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+  (void)imest_background(&est, &res);
+  (void)imest_status_name(res.status);
+  return (int)imest_overruns(&est);
+#else
+  fw_mark_b0();
+  return 0;
+#endif
+}
