@@ -1,0 +1,166 @@
+// Window timing, the lock-free hand-off, overruns, warm-up and faults.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+extern "C" {
+#include "imest/imest.h"
+}
+
+namespace {
+imest_config_t small_config() {
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  cfg.pole_pairs = 2;
+  cfg.ls_h = 0.2908f;
+  cfg.sigma = 0.096f;
+  cfg.fs_hz = 4000.0f;
+  cfg.window_s = 0.1f;  // 400 samples
+  return cfg;
+}
+// a rotating current/voltage at constant speed (no physics needed here)
+void feed(imest_t *s, int n, int &k, float amp = 1.0f) {
+  for (int j = 0; j < n; ++j, ++k) {
+    const float ph = 2 * (float)M_PI * 30.0f * (float)k / 4000.0f;
+    const float u[3] = {100 * std::cos(ph), 100 * std::cos(ph - 2.0944f), 100 * std::cos(ph + 2.0944f)};
+    const float i[3] = {amp * std::cos(ph - 0.5f), amp * std::cos(ph - 2.6f), amp * std::cos(ph + 1.6f)};
+    imest_isr_abc(s, u, i, std::fmod(0.5f * ph, 6.2831853f));
+  }
+}
+}  // namespace
+
+TEST(Handoff, InitRejectsBadConfigNamingTheField) {
+  imest_config_t cfg = small_config();
+  const char *field = nullptr;
+  EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_OK);
+  cfg.sigma = 1.5f;
+  EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(field, "sigma");
+  static imest_t s;
+  EXPECT_EQ(imest_init(&s, &cfg), IMEST_ERR_CONFIG);
+  EXPECT_EQ(imest_init(nullptr, &cfg), IMEST_ERR_NULL);
+  cfg = small_config();
+  cfg.pole_pairs = 0;
+  EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(field, "pole_pairs");
+  cfg = small_config();
+  cfg.filter_hz = 3000;
+  EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(field, "filter_hz");
+}
+
+TEST(Handoff, IsrSignalsExactlyAtWindowEnds) {
+  imest_config_t cfg = small_config();
+  static imest_t s;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  imest_result_t r;
+  int k = 0, completed = 0;
+  for (int n = 0; n < 1200; ++n, ++k) {
+    const float u[3] = {1, 0, -1}, i[3] = {0.5f, -0.25f, -0.25f};
+    const int done = imest_isr_abc(&s, u, i, 0.0f);
+    if ((n + 1) % 400 == 0) {
+      EXPECT_EQ(done, 1) << n;
+      ASSERT_EQ(imest_background(&s, &r), 1);
+      EXPECT_EQ(r.seq, (uint32_t)completed);
+      EXPECT_EQ(r.samples, 400u);
+      EXPECT_NEAR(r.t_end_s, (n) / 4000.0, 1e-9);
+      ++completed;
+    } else {
+      EXPECT_EQ(done, 0) << n;
+    }
+    EXPECT_EQ(imest_background(&s, &r), 0);
+  }
+  EXPECT_EQ(completed, 3);
+}
+
+TEST(Handoff, OverrunIsCountedAndVisibleNeverTorn) {
+  imest_config_t cfg = small_config();
+  static imest_t s;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  imest_result_t r;
+  int k = 0;
+  feed(&s, 400 * 3, k);  // three windows, background never ran
+  EXPECT_EQ(imest_overruns(&s), 2u);  // window 0 handed over; 1 and 2 dropped
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_EQ(r.seq, 0u);
+  EXPECT_EQ(imest_background(&s, &r), 0);
+  feed(&s, 400, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_EQ(r.seq, 3u);  // the gap shows the dropped windows 1 and 2
+  EXPECT_EQ(r.overruns, 2u);
+  EXPECT_TRUE(r.flags & IMEST_FLAG_OVERRUN);
+  EXPECT_EQ(r.samples, 400u);
+  EXPECT_EQ(r.used_samples, 400u);
+}
+
+TEST(Handoff, WarmupIsMarkedAndStartAtRestSkipsIt) {
+  imest_config_t cfg = small_config();
+  static imest_t s;
+  imest_result_t r;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  int k = 0;
+  feed(&s, 800, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_EQ(r.status, IMEST_ST_WARMUP);
+  EXPECT_FALSE(r.valid);
+  EXPECT_LT(r.used_samples, 400u);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_FALSE(r.flags & IMEST_FLAG_WARMUP);
+  EXPECT_EQ(r.used_samples, 400u);
+
+  cfg.start_at_rest = 1;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  k = 0;
+  feed(&s, 400, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_FALSE(r.flags & IMEST_FLAG_WARMUP);
+  EXPECT_EQ(r.used_samples, 400u);
+}
+
+TEST(Handoff, NonFiniteSampleInvalidatesItsWindowAndRecovers) {
+  imest_config_t cfg = small_config();
+  cfg.start_at_rest = 1;
+  static imest_t s;
+  imest_result_t r;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  int k = 0;
+  feed(&s, 100, k);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float u[3] = {nan, 0, 0}, i[3] = {0, 0, 0};
+  imest_isr_abc(&s, u, i, 0.0f);
+  ++k;
+  feed(&s, 299 + 400, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_EQ(r.status, IMEST_ST_INPUT_FAULT);
+  EXPECT_FALSE(r.valid);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_FALSE(r.flags & (IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_WARMUP));
+  EXPECT_EQ(r.used_samples, 400u);
+  // every reported number is finite or NaN, never Inf with valid set
+  if (r.valid) EXPECT_TRUE(std::isfinite(r.tr_s));
+}
+
+TEST(Handoff, EncoderJumpAndSaturationAreFlagged) {
+  imest_config_t cfg = small_config();
+  cfg.start_at_rest = 1;
+  cfg.i_limit_a = 5.0f;
+  static imest_t s;
+  imest_result_t r;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  int k = 0;
+  feed(&s, 100, k);
+  const float u[3] = {0, 0, 0}, i[3] = {0, 0, 0};
+  imest_isr_abc(&s, u, i, 5.0f);  // angle jumps by ~2.6 rad in one sample
+  ++k;
+  feed(&s, 299, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_EQ(r.status, IMEST_ST_ENCODER_FAULT);
+  feed(&s, 100, k);
+  const float isat[3] = {5.0f, -2.5f, -2.5f};
+  imest_isr_abc(&s, u, isat, 0.0f);
+  ++k;
+  feed(&s, 299, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_EQ(r.status, IMEST_ST_ADC_SATURATION);
+}

@@ -1,0 +1,204 @@
+// ISR stages against float64 references, with stated tolerances.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+extern "C" {
+#include "imest/imest.h"
+#include "isr_accumulate.h"
+#include "isr_regressor.h"
+#include "isr_transform.h"
+}
+
+TEST(IsrTransform, SinCosWithin4e7OverSeveralTurns) {
+  double worst = 0;
+  for (int k = -200000; k <= 200000; ++k) {
+    const float x = (float)(k * 1.0e-4);  // -20 .. 20 rad
+    float s, c;
+    isr_sincos(x, &s, &c);
+    worst = std::max(worst, std::fabs((double)s - std::sin((double)x)));
+    worst = std::max(worst, std::fabs((double)c - std::cos((double)x)));
+  }
+  EXPECT_LT(worst, 4e-7);
+}
+
+TEST(IsrTransform, WrapPiKeepsAngleModulo2Pi) {
+  for (double x : {-100.0, -7.0, -3.2, -0.1, 0.0, 0.1, 3.2, 7.0, 100.0, 1000.0}) {
+    const double w = isr_wrap_pi((float)x);
+    EXPECT_LE(std::fabs(w), M_PI + 1e-5) << x;
+    EXPECT_NEAR(std::remainder(w - x, 2 * M_PI), 0.0, 1e-4) << x;
+  }
+}
+
+TEST(IsrTransform, ClarkeIsPowerInvariant) {
+  // balanced set with line-to-line rms 230 V -> alpha/beta amplitude 230
+  for (int k = 0; k < 50; ++k) {
+    const double ph = k * 0.3, a = std::sqrt(2.0 / 3.0) * 230;
+    const float x[3] = {(float)(a * std::cos(ph)), (float)(a * std::cos(ph - 2 * M_PI / 3)),
+                        (float)(a * std::cos(ph + 2 * M_PI / 3))};
+    float xa, xb;
+    isr_clarke(x, &xa, &xb);
+    EXPECT_NEAR(xa, 230 * std::cos(ph), 1e-3);
+    EXPECT_NEAR(xb, 230 * std::sin(ph), 1e-3);
+  }
+}
+
+// Product of the two sections vs the direct-form coefficients of MATH.md §8.
+static void check_design(double fc, const double b[4], const double a[4]) {
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  cfg.pole_pairs = 2;
+  cfg.ls_h = 0.2908f;
+  cfg.sigma = 0.096f;
+  cfg.filter_hz = (float)fc;
+  static imest_t s;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  const double n1[2] = {s.bw.b0, s.bw.b1}, d1[2] = {1, s.bw.a1};
+  const double n2[3] = {s.bw.c0, s.bw.c1, s.bw.c2}, d2[3] = {1, s.bw.d1, s.bw.d2};
+  double nb[4] = {0}, da[4] = {0};
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 3; ++j) {
+      nb[i + j] += n1[i] * n2[j];
+      da[i + j] += d1[i] * d2[j];
+    }
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_NEAR(nb[k], b[k], 2e-7 * std::fabs(b[k]) + 1e-12) << fc << " b" << k;
+    EXPECT_NEAR(da[k], a[k], 2e-7) << fc << " a" << k;
+  }
+}
+
+TEST(IsrFilter, DesignMatchesMathMdCoefficients) {
+  const double b500[4] = {0.03168934384971104, 0.09506803154913313, 0.09506803154913313, 0.03168934384971104};
+  const double a500[4] = {1, -1.459029062228061, 0.9103690002900687, -0.19782518726431944};
+  const double b100[4] = {4.1654613907575e-4, 1.24963841722724e-3, 1.24963841722724e-3, 4.1654613907575e-4};
+  const double a100[4] = {1, -2.686157396548143, 2.4196551109664717, -0.7301653453057226};
+  const double b25[4] = {7.28117247505e-6, 2.18435174251502e-5, 2.18435174251502e-5, 7.28117247505e-6};
+  const double a25[4] = {1, -2.9214652231948923, 2.8459840557611136, -0.9244605831864209};
+  check_design(500, b500, a500);
+  check_design(100, b100, a100);
+  check_design(25, b25, a25);
+}
+
+// Central differences of the filtered signal against a float64 filter run.
+TEST(IsrFilter, DerivativesAreTimeAlignedCentralDifferences) {
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  cfg.pole_pairs = 2;
+  cfg.ls_h = 0.2908f;
+  cfg.sigma = 0.096f;
+  static imest_t s;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  imest_chan_t c = {};
+  // float64 reference of the same cascade
+  double s1 = 0, s2a = 0, s2b = 0;
+  std::vector<double> xf;
+  const double T = 1.0 / 4000;
+  double worst_x = 0, worst_dx = 0, worst_d2 = 0;
+  for (int n = 0; n < 4000; ++n) {
+    const double x = 2.0 * std::sin(2 * M_PI * 9 * n * T) + 0.5;
+    const double v = (double)s.bw.b0 * x + s1;
+    s1 = (double)s.bw.b1 * x - (double)s.bw.a1 * v;
+    const double w = (double)s.bw.c0 * v + s2a;
+    s2a = (double)s.bw.c1 * v - (double)s.bw.d1 * w + s2b;
+    s2b = (double)s.bw.c2 * v - (double)s.bw.d2 * w;
+    xf.push_back(w);
+    const isr_deriv_t d = isr_filter_deriv(&s, &c, (float)x);
+    if (n >= 2) {
+      const double rx = xf[n - 1], rdx = (xf[n] - xf[n - 2]) / (2 * T),
+                   rd2 = (xf[n] - 2 * xf[n - 1] + xf[n - 2]) / (T * T);
+      worst_x = std::max(worst_x, std::fabs(d.x - rx));
+      worst_dx = std::max(worst_dx, std::fabs(d.dx - rdx));
+      worst_d2 = std::max(worst_d2, std::fabs(d.d2x - rd2));
+    }
+  }
+  // signal: |x| ~ 2.5, |dx| ~ 113 /s, |d2x| ~ 6400 /s^2
+  EXPECT_LT(worst_x, 2e-6);
+  EXPECT_LT(worst_dx, 5e-3);
+  EXPECT_LT(worst_d2, 40.0);  // float32 rounding of x_f times 1/T^2 = 1.6e7
+}
+
+// The 7 regressor columns and y against MATH.md §2 written out in float64.
+TEST(IsrRegressor, MatchesMathMdFormulas) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-1, 1);
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  cfg.pole_pairs = 2;
+  cfg.ls_h = 0.2908f;
+  cfg.sigma = 0.096f;
+  static imest_t s;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  const double n = 2, m = (1 - 0.096) / 0.096, sl = (double)(0.096f * 0.2908f);
+  for (int trial = 0; trial < 200; ++trial) {
+    isr_signals_t g;
+    g.ix = {(float)(2 * U(rng)), (float)(300 * U(rng)), (float)(2e4 * U(rng))};
+    g.iy = {(float)(2 * U(rng)), (float)(300 * U(rng)), (float)(2e4 * U(rng))};
+    g.ux = {(float)(200 * U(rng)), (float)(2e4 * U(rng)), 0};
+    g.uy = {(float)(200 * U(rng)), (float)(2e4 * U(rng)), 0};
+    g.w = (float)(180 * U(rng));
+    g.dw = (float)(1000 * U(rng));
+    const double ix = g.ix.x, iy = g.iy.x, dix = g.ix.dx, diy = g.iy.dx, d2ix = g.ix.d2x, d2iy = g.iy.d2x;
+    const double ux = g.ux.x, uy = g.uy.x, dux = g.ux.dx, duy = g.uy.dx, w = g.w, wp = g.dw;
+    const double vs = 1.0 / (double)s.inv_s;
+    (void)sl;
+    double W[2][8], y[2];
+    y[0] = d2ix - n * w * diy - n * wp * iy - n * n * m * w * w * ix - dux / vs;
+    y[1] = d2iy + n * w * dix + n * wp * ix - n * n * m * w * w * iy - duy / vs;
+    W[0][0] = -dix; W[1][0] = -diy;
+    W[0][1] = -dix + n * (1 + m) * w * iy + ux / vs; W[1][1] = -diy - n * (1 + m) * w * ix + uy / vs;
+    W[0][2] = m * ix; W[1][2] = m * iy;
+    W[0][3] = -ix; W[1][3] = -iy;
+    W[0][4] = n * wp * (diy - uy / vs) + n * n * (w * wp * ix - w * w * dix + w * w * ux / vs) + n * n * n * (1 + m) * w * w * w * iy;
+    W[1][4] = -n * wp * (dix - ux / vs) + n * n * (w * wp * iy - w * w * diy + w * w * uy / vs) - n * n * n * (1 + m) * w * w * w * ix;
+    W[0][5] = n * wp * iy - n * n * w * w * ix; W[1][5] = -n * wp * ix - n * n * w * w * iy;
+    W[0][6] = n * n * (w * wp * ix - w * w * dix); W[1][6] = n * n * (w * wp * iy - w * w * diy);
+    W[0][7] = n * n * (w * wp * dix - w * w * d2ix + (w * w * dux - w * wp * ux) / vs) + n * n * n * w * w * w * diy;
+    W[1][7] = n * n * (w * wp * diy - w * w * d2iy + (w * w * duy - w * wp * uy) / vs) - n * n * n * w * w * w * dix;
+    const float c0[7] = {0, 0, 0, 0, 0, 0, 0};
+    float zx[8], zy[8];
+    isr_regressor(&s, &g, c0, zx, zy);
+    const int k_of[7] = {0, 1, 3, 4, 5, 6, 7};
+    for (int r = 0; r < 2; ++r) {
+      const float *z = r ? zy : zx;
+      for (int j = 0; j < 7; ++j) {
+        const double ref = W[r][k_of[j]];
+        // float32 rounding relative to the column's typical term size
+        static const double scale[7] = {300, 1e4, 2, 1e9, 3e5, 4e7, 3e9};
+        EXPECT_NEAR(z[j], ref, 1e-5 * scale[j]) << "row " << r << " col " << j;
+      }
+      EXPECT_NEAR(z[7], y[r], 1e-5 * 3e6) << "y row " << r;
+      // column 3 is exactly -m x column 4
+      EXPECT_DOUBLE_EQ(W[r][2], -m * W[r][3]);
+    }
+  }
+}
+
+TEST(IsrAccumulate, FoldedBlocksEqualFloat64SumsToFewUlps) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> N(0, 1);
+  imest_window_t w = {};
+  double ref[IMEST_NACC] = {0};
+  uint32_t fold = 0;
+  for (int n = 0; n < 4000; ++n) {
+    float zx[8], zy[8];
+    for (int i = 0; i < 8; ++i) {
+      zx[i] = (float)(N(rng) * (1 + i));
+      zy[i] = (float)(N(rng) + 3.0);
+    }
+    isr_accumulate(&w, zx, zy, fold);
+    fold = (fold + 1 == IMEST_NACC) ? 0 : fold + 1;
+    unsigned p = 0;
+    for (int i = 0; i < 8; ++i)
+      for (int j = i; j < 8; ++j) ref[p++] += (double)zx[i] * zx[j] + (double)zy[i] * zy[j];
+  }
+  for (int i = 0; i < 8; ++i)
+    for (int j = i; j < 8; ++j) {
+      const unsigned p = IMEST_ACC_INDEX((unsigned)i, (unsigned)j);
+      const double got = (double)w.sum[p] + (double)w.blk[p];
+      // scale: sum of |products|, ~ 4000 * (1+i)(1+j) + 4000*10
+      const double scale = 4000.0 * ((1 + i) * (1 + j) + 10.0);
+      EXPECT_NEAR(got, ref[p], 2e-6 * scale) << i << "," << j;
+    }
+}

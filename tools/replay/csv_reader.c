@@ -1,0 +1,150 @@
+#include "csv_reader.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const CSV_NAMES[CSV_NEED] = {"t", "u_a", "u_b", "u_c", "i_a", "i_b", "i_c", "theta"};
+
+/* Read one line (any length); strips \n and \r. Returns length or -1 at EOF. */
+static long read_line(csv_reader_t *r)
+{
+  size_t n = 0;
+  int c;
+  while ((c = fgetc(r->f)) != EOF && c != '\n') {
+    if (n + 2 > r->cap) {
+      size_t cap = r->cap ? 2 * r->cap : 256;
+      char *nb = realloc(r->buf, cap);
+      if (nb == NULL) return -1;
+      r->buf = nb;
+      r->cap = cap;
+    }
+    r->buf[n++] = (char)c;
+  }
+  if (c == EOF && n == 0) return -1;
+  if (r->buf == NULL) {
+    r->buf = malloc(256);
+    r->cap = 256;
+  }
+  if (n > 0 && r->buf[n - 1] == '\r') n--;
+  r->buf[n] = '\0';
+  r->line++;
+  return (long)n;
+}
+
+static char *trim(char *s)
+{
+  while (isspace((unsigned char)*s)) s++;
+  char *e = s + strlen(s);
+  while (e > s && isspace((unsigned char)e[-1])) *--e = '\0';
+  if (*s == '"' && e > s + 1 && e[-1] == '"') {
+    e[-1] = '\0';
+    s++;
+  }
+  return s;
+}
+
+int csv_open(csv_reader_t *r, const char *path)
+{
+  memset(r, 0, sizeof *r);
+  r->name = path;
+  r->f = fopen(path, "rb");
+  if (r->f == NULL) {
+    snprintf(r->err, sizeof r->err, "%s: cannot open: %s", path, strerror(errno));
+    return -1;
+  }
+  for (int k = 0; k < CSV_NEED; ++k) r->col[k] = -1;
+  long len = read_line(r);
+  if (len < 0) {
+    snprintf(r->err, sizeof r->err, "%s: empty file (no header row)", path);
+    return -1;
+  }
+  /* strip a UTF-8 byte order mark */
+  char *p = r->buf;
+  if ((unsigned char)p[0] == 0xEF && (unsigned char)p[1] == 0xBB && (unsigned char)p[2] == 0xBF) p += 3;
+  int idx = 0;
+  for (char *tok = p;; ++idx) {
+    char *comma = strchr(tok, ',');
+    if (comma) *comma = '\0';
+    const char *name = trim(tok);
+    for (int k = 0; k < CSV_NEED; ++k) {
+      if (strcmp(name, CSV_NAMES[k]) == 0) {
+        if (r->col[k] >= 0) {
+          snprintf(r->err, sizeof r->err, "%s:1: column '%s' appears twice", path, name);
+          return -1;
+        }
+        r->col[k] = idx;
+      }
+    }
+    if (!comma) break;
+    tok = comma + 1;
+  }
+  r->ncols = idx + 1;
+  for (int k = 0; k < CSV_NEED; ++k) {
+    if (r->col[k] < 0) {
+      snprintf(r->err, sizeof r->err,
+               "%s:1: missing column '%s' (the header needs t,u_a,u_b,u_c,i_a,i_b,i_c,theta in any order)",
+               path, CSV_NAMES[k]);
+      return -1;
+    }
+  }
+  return 0;
+}
+
+int csv_next(csv_reader_t *r, double v[CSV_NEED])
+{
+  long len;
+  do {
+    len = read_line(r);
+    if (len < 0) return 0;
+  } while (len == 0); /* blank lines are ignored */
+  int idx = 0, got = 0;
+  char *tok = r->buf;
+  for (;; ++idx) {
+    char *comma = strchr(tok, ',');
+    if (comma) *comma = '\0';
+    for (int k = 0; k < CSV_NEED; ++k) {
+      if (r->col[k] != idx) continue;
+      char *s = trim(tok), *end = NULL;
+      errno = 0;
+      double x = strtod(s, &end);
+      if (*s == '\0' || end == s || *trim(end) != '\0') {
+        snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': '%.40s' is not a number", r->name,
+                 r->line, CSV_NAMES[k], s);
+        return -1;
+      }
+      if (!isfinite(x)) {
+        snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': non-finite value '%.40s'", r->name,
+                 r->line, CSV_NAMES[k], s);
+        return -1;
+      }
+      v[k] = x;
+      got++;
+    }
+    if (!comma) break;
+    tok = comma + 1;
+  }
+  if (idx + 1 != r->ncols || got != CSV_NEED) {
+    snprintf(r->err, sizeof r->err, "%s:%ld: %d fields, the header has %d", r->name, r->line,
+             idx + 1, r->ncols);
+    return -1;
+  }
+  return 1;
+}
+
+int csv_rewind(csv_reader_t *r)
+{
+  if (fseek(r->f, 0, SEEK_SET) != 0) return -1;
+  r->line = 0;
+  return read_line(r) < 0 ? -1 : 0;
+}
+
+void csv_close(csv_reader_t *r)
+{
+  if (r->f) fclose(r->f);
+  free(r->buf);
+  r->f = NULL;
+  r->buf = NULL;
+}
