@@ -7,6 +7,10 @@
 
 #include "imest/imest.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* One window's sums, full 8x8 (structure already fixed: row/column 3 = -m x
  * row/column 4, (R_Wy)_3 = -m (R_Wy)_4), float64, not scaled. */
 typedef struct {
@@ -37,10 +41,17 @@ typedef struct {
   double pe_k1, pe_k2;        /* parametric error indices (absolute), MATH.md §7 */
   double pe_quad[2];          /* quadratic approximations sqrt(0.5 E (H^-1)_ii) */
   double scale_s, scale_g, scale_c; /* the power-of-two scalings used */
+  unsigned int pe_flags;      /* IMEST_PE_FLAG_* (bg_poly.h): how the PE indices were obtained */
+  unsigned int work;          /* iterations used (Sturm evaluations + bisection + polish +
+                                 quality evaluations); bounded, see bg_solve.c */
 } imest_solve_out_t;
 
 /* Solve one window. Always terminates within fixed iteration bounds; never
  * returns a non-finite value with status IMEST_OK. */
 int imest_solve(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_solve_out_t *out);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* IMEST_BG_SOLVE_H */

@@ -1,0 +1,131 @@
+/* Internal interface of the background-solve stages (MATH.md §3..§7), one
+ * function group per source file, so that tests can call each stage alone.
+ * Not part of the public API. No stage allocates, none keeps state. */
+#ifndef IMEST_BG_POLY_H
+#define IMEST_BG_POLY_H
+
+#include "bg_solve.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Largest polynomial degree the root finder accepts (generic resultant: 20). */
+#define IMEST_POLY_MAXDEG 20
+
+/* ---------------------------------------------------------------- bg_tables.c
+ * Power-of-two scalings (MATH.md §5) and the scaled cost tables (§3) and
+ * p1/p2 coefficients (§4), all float64, in the scaled unknowns (k, kappa):
+ * K1 = g k, K2 = s kappa, E = c E~. */
+typedef struct {
+  int sexp, gexp, cexp;       /* s = 2^sexp, g = 2^gexp, c = 2^cexp */
+  double s, g, c;
+  double e2[7], e1[8], e0[9]; /* E~ = kappa^-4 sum_m (e2[m] k^2 + e1[m] k + e0[m]) kappa^m */
+  double a1[7], a0[8];        /* p1 = a1(kappa) k + a0(kappa) */
+  double b2[7], b1[8], b0[9]; /* p2 = b2 k^2 + b1 k + b0 */
+} imest_tables_t;
+
+/* round(log2(x)) for finite x > 0, computed exactly with frexp. */
+int imest_round_log2(double x);
+
+/* Tables for given exponents (no data-driven choice): R~ = D R D / c with
+ * D = diag(g, s, s^2, g s, 1/s, g/s, g/s^2, 1/s^2), each entry scaled by one
+ * ldexp (exact unless it under/overflows). Also fills a*, b*. */
+void imest_tables_scaled(const imest_sums_t *in, int sexp, int gexp, int cexp, imest_tables_t *t);
+
+/* Choose s from tr_nominal_s, c from R_y and g from the data (MATH.md §5) and
+ * build the tables. Returns IMEST_OK, or IMEST_ST_NUMERIC for non-finite sums,
+ * R_y <= 0 or non-finite tables. */
+int imest_tables_build(const imest_sums_t *in, double tr_nominal_s, imest_tables_t *t);
+
+/* Values of e2(kappa), e1(kappa), e0(kappa) (polynomials in kappa) and their
+ * first and second kappa-derivatives. */
+typedef struct {
+  double e2, e1, e0;
+  double d2, d1, d0;    /* first derivatives */
+  double dd2, dd1, dd0; /* second derivatives */
+} imest_tabval_t;
+void imest_tables_eval(const imest_tables_t *t, double kappa, imest_tabval_t *v);
+
+/* ------------------------------------------------------------- bg_resultant.c
+ * r = a0^2 b2 - a0 a1 b1 + a1^2 b0, 21 coefficients ascending (MATH.md §4).
+ * generic = 0: this regressor (deg 18): r[19] = r[20] = 0 are set.
+ * generic = 1: keep all 21 coefficients (degree 20, arbitrary symmetric R_W). */
+void imest_resultant(const imest_tables_t *t, double r[21], int generic);
+
+/* ----------------------------------------------------------------- bg_roots.c
+ * All distinct positive roots of sum_k c[k] x^k (deg <= IMEST_POLY_MAXDEG) by
+ * Sturm sequences and bisection, (0,1] on p and (1,inf) on the reversed
+ * polynomial, each root polished in float64 (see bg_roots.c for the design).
+ * The Sturm chain is float32 unless IMEST_ROOTS_DOUBLE is defined.
+ * Returns the number of roots written to roots[] (ascending, at most max), or
+ * -1 for a non-finite or all-zero polynomial or a bad deg. */
+typedef struct {
+  unsigned int sturm_evals;   /* evaluations of the sign-change count V(x) */
+  unsigned int bisect_steps;  /* sign or count bisection steps (chain precision) */
+  unsigned int polish_evals;  /* float64 polynomial evaluations in the polish */
+  unsigned int chain_len;     /* longest Sturm chain built (number of polynomials) */
+  unsigned int unresolved;    /* clusters that could not be separated (reported once) */
+  unsigned int rejected;      /* isolated intervals whose float64 check failed */
+  unsigned int merged;        /* duplicates merged (a root found from both sides of 1) */
+} imest_roots_stats_t;
+
+/* Bounds (per polynomial domain; two domains per call). */
+#define IMEST_ROOTS_MAX_DEPTH 48   /* isolation: interval halvings from (0,1] */
+#define IMEST_ROOTS_MAX_BISECT 48  /* refinement bisections in chain precision */
+#define IMEST_ROOTS_MAX_POLISH 40  /* safeguarded Newton/bisection steps in float64 */
+#define IMEST_ROOTS_MAX_EXPAND 8   /* bracket expansions when float64 sees no sign change */
+
+int imest_poly_positive_roots(const double *c, int deg, double *roots, int max);
+int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int max,
+                                 imest_roots_stats_t *st);
+
+/* Horner evaluation of sum_k c[k] x^k (float64). */
+double imest_poly_eval(const double *c, int deg, double x);
+
+/* ---------------------------------------------------------------- bg_select.c */
+typedef struct {
+  double kappa, k;   /* scaled root and back-substituted k = -a0/a1 */
+  double k1, k2;     /* K1 = g k, K2 = s kappa */
+  double e;          /* E_p^2 (unscaled; may be slightly negative from cancellation) */
+  double tr_s, rs_ohm;
+  int admissible;    /* K1 > 0, T_R in band, all finite, E above -1e-9 R_y */
+} imest_cand_t;
+
+/* Evaluate every root as a candidate and pick the admissible one with least E.
+ * Returns the index of the selected candidate, or -1 if none is admissible. */
+int imest_select(const imest_tables_t *t, const double *kappa, int n, const imest_solve_cfg_t *cfg,
+                 double ry, imest_cand_t *cand, unsigned int *n_admissible);
+
+/* --------------------------------------------------------------- bg_quality.c */
+#define IMEST_PE_UNBOUNDED 1e30 /* PE reported when it has no finite meaning (H not PD) */
+#define IMEST_PE_FLAG_K2_LO_EDGE 0x1u /* no crossing below K2*: distance to the band edge reported */
+#define IMEST_PE_FLAG_K2_HI_EDGE 0x2u /* no crossing above K2*: distance to the band edge reported */
+#define IMEST_PE_FLAG_DEGENERATE 0x4u /* E* <= 0: indices are 0 */
+#define IMEST_PE_FLAG_NOT_PD     0x8u /* quadratic indices set to IMEST_PE_UNBOUNDED */
+
+#define IMEST_PE_MAX_PROBE 80  /* step-out probes per side */
+#define IMEST_PE_MAX_ROOT 40   /* Illinois iterations per crossing */
+#define IMEST_PE_MAX_MIN 60    /* Brent minimisation iterations per K1 extreme */
+
+/* Hessian, positive definiteness, quadratic and exact PE indices at the
+ * selected candidate; writes hessian, hessian_pd, pe_k1, pe_k2, pe_quad,
+ * pe_flags of out. Returns the number of profile evaluations used. */
+unsigned int imest_quality(const imest_tables_t *t, const imest_solve_cfg_t *cfg,
+                           const imest_cand_t *best, imest_solve_out_t *out);
+
+/* ----------------------------------------------------------------- bg_solve.c */
+typedef struct {
+  imest_roots_stats_t roots;
+  unsigned int quality_evals;
+} imest_solve_stats_t;
+
+/* imest_solve with optional instrumentation (stats may be NULL). */
+int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_solve_out_t *out,
+                   imest_solve_stats_t *stats);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* IMEST_BG_POLY_H */

@@ -1,0 +1,441 @@
+/* Stage 3 of the background solve: every distinct positive root of a real
+ * polynomial of degree <= 20 by Sturm sequences and bisection (MATH.md §6).
+ * No companion matrix, no eigenvalues, no allocation, no static mutable data.
+ *
+ * Design
+ *  - Normalise: strip exact-zero leading and trailing coefficients (a root at 0
+ *    is not positive), scale by a power of two so that max|c| is in [0.5, 1).
+ *  - Two domains: p(x) = sum c_k x^k on (0,1] gives the roots kappa = x <= 1;
+ *    the reversed q(x) = x^n p(1/x) on (0,1] gives kappa = 1/x >= 1. Every
+ *    evaluation is on [0,1]: nothing overflows in float32. A root at (or
+ *    within 2^-36 relative of) 1 may be found in both domains; duplicates
+ *    closer than 2^-36 relative are merged (so distinct roots that close are
+ *    reported once).
+ *  - Chain precision (sreal_t): float32 by default, float64 with
+ *    -DIMEST_ROOTS_DOUBLE. The chain P0 = p, P1 = p', P_{k+1} = -rem(P_{k-1},P_k)
+ *    keeps each P_k normalised to max|c| = 1, drops leading coefficients
+ *    <= TOL (TOL = 16 eps_f, or 64 eps_d), and stops when max|rem| <=
+ *    TOL*len(P_{k-1}) (a gcd: multiple roots; the chain then counts distinct
+ *    roots) or at degree 0. V(x) = sign changes of the chain (zeros ignored);
+ *    distinct roots in (a,b] = V(a) - V(b).
+ *  - Isolation: depth-first halving of (0,1] while the count is >= 2, at most
+ *    IMEST_ROOTS_MAX_DEPTH halvings deep and IMEST_ROOTS_MAX_SPLITS halvings per
+ *    domain; an interval that cannot be split further (depth, split budget, or
+ *    its midpoint not representable) is refined as one root ("unresolved").
+ *  - Refinement in chain precision down to a relative width of 2^-20: sign
+ *    bisection when p changes sign on the interval, else (even multiplicity, or
+ *    float32 sign noise) bisection on the Sturm count; <= IMEST_ROOTS_MAX_BISECT.
+ *  - Polish in float64 on the full (untruncated) polynomial: find a float64
+ *    sign change on the refined bracket, widening it by 4x up to
+ *    IMEST_ROOTS_MAX_EXPAND times (limited to the isolating interval plus 1/16
+ *    of its width), then safeguarded Newton (a Newton step that leaves the
+ *    bracket becomes a bisection), <= IMEST_ROOTS_MAX_POLISH evaluations, until
+ *    a Newton step is <= 2^-30 |x| (then the error is ~ |x p''/(2p')| 2^-60 |x|:
+ *    full double accuracy for simple roots) or the bracket is 4 ulp wide. If
+ *    float64 sees no sign change (even multiplicity), the same is done on p'
+ *    (odd multiplicity there), and the point is kept only if
+ *    |p(x)| <= 32 (n+1) eps_d sum|c_k x^k|; otherwise the interval is rejected
+ *    (counted in stats.rejected).
+ *
+ * Bounds, per call (two domains, n <= 20): V(x) evaluations <= 2 x (2 +
+ * MAX_SPLITS + 20 MAX_BISECT), chain-precision bisection steps <= 2 x 20 x
+ * MAX_BISECT, float64 polish evaluations <= 2 x 20 x (2 + 2 MAX_EXPAND + 2
+ * MAX_POLISH + 1). Typical (testvector, n = 18): see test/solve (about 30
+ * V evaluations, 60 bisection steps and 20 float64 evaluations).
+ *
+ * Stack: chain 21 x 21 sreal_t (1764 B float32, 3528 B float64) + isolation
+ * stack 50 intervals (<= 1 KB) + two coefficient copies (2 x 168 B) + roots
+ * (2 x 20 doubles): about 3.5 KB (float32 chain) or 5.3 KB (float64 chain).
+ */
+#include <float.h>
+#include <math.h>
+
+#include "bg_poly.h"
+
+#ifdef IMEST_ROOTS_DOUBLE
+typedef double sreal_t;
+#define SR_TOL (64.0 * DBL_EPSILON)
+#define SR_ABS(x) fabs(x)
+#else
+typedef float sreal_t;
+#define SR_TOL (16.0f * FLT_EPSILON)
+#define SR_ABS(x) fabsf(x)
+#endif
+
+#define NMAX IMEST_POLY_MAXDEG
+#define IMEST_ROOTS_MAX_SPLITS 1024
+#define REFINE_REL ((sreal_t)9.5367431640625e-07) /* 2^-20 */
+#define NEWTON_STOP 9.313225746154785e-10          /* 2^-30 */
+#define MERGE_REL 1.4551915228366852e-11           /* 2^-36 */
+
+typedef struct {
+  sreal_t c[NMAX + 1][NMAX + 1]; /* chain polynomials, ascending coefficients */
+  int deg[NMAX + 1];
+  int len;
+} chain_t;
+
+typedef struct {
+  sreal_t a, b;
+  int va, vb, depth;
+} ival_t;
+
+static int sgn_s(sreal_t v) { return (v > 0) - (v < 0); }
+static int sgn_d(double v) { return (v > 0.0) - (v < 0.0); }
+
+static sreal_t horner_s(const sreal_t *c, int n, sreal_t x) {
+  sreal_t p = c[n];
+  for (int k = n - 1; k >= 0; --k) p = p * x + c[k];
+  return p;
+}
+
+double imest_poly_eval(const double *c, int deg, double x) {
+  double p = c[deg];
+  for (int k = deg - 1; k >= 0; --k) p = p * x + c[k];
+  return p;
+}
+
+/* f = p^(order)(x), df = p^(order+1)(x), order 0 or 1. */
+static void eval_d(const double *c, int n, int order, double x, double *f, double *df) {
+  double p = 0.0, p1 = 0.0, p2 = 0.0;
+  for (int k = n; k >= 0; --k) {
+    p2 = p2 * x + 2.0 * p1;
+    p1 = p1 * x + p;
+    p = p * x + c[k];
+  }
+  if (order == 0) {
+    *f = p;
+    *df = p1;
+  } else {
+    *f = p1;
+    *df = p2;
+  }
+}
+
+static double abs_sum_d(const double *c, int n, double x) {
+  double p = 0.0;
+  for (int k = n; k >= 0; --k) p = p * fabs(x) + fabs(c[k]);
+  return p;
+}
+
+/* Normalise P_k to max|c| = 1 (optionally negated) and drop small leading terms. */
+static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
+  sreal_t mx = 0;
+  for (int i = 0; i <= ch->deg[k]; ++i)
+    if (SR_ABS(ch->c[k][i]) > mx) mx = SR_ABS(ch->c[k][i]);
+  if (mx > 0) {
+    const sreal_t f = sign / mx;
+    for (int i = 0; i <= ch->deg[k]; ++i) ch->c[k][i] *= f;
+  }
+  while (ch->deg[k] > 0 && SR_ABS(ch->c[k][ch->deg[k]]) <= SR_TOL) --ch->deg[k];
+}
+
+static void chain_build(chain_t *ch, const double *pd, int n) {
+  for (int i = 0; i <= n; ++i) ch->c[0][i] = (sreal_t)pd[i];
+  ch->deg[0] = n;
+  chain_normalise(ch, 0, 1);
+  ch->len = 1;
+  if (ch->deg[0] == 0) return;
+  ch->deg[1] = ch->deg[0] - 1;
+  for (int i = 0; i < ch->deg[0]; ++i) ch->c[1][i] = (sreal_t)(i + 1) * ch->c[0][i + 1];
+  chain_normalise(ch, 1, 1);
+  ch->len = 2;
+  while (ch->deg[ch->len - 1] > 0 && ch->len <= NMAX) {
+    const sreal_t *a = ch->c[ch->len - 2];
+    const sreal_t *b = ch->c[ch->len - 1];
+    const int da = ch->deg[ch->len - 2], db = ch->deg[ch->len - 1];
+    sreal_t *r = ch->c[ch->len];
+    for (int i = 0; i <= da; ++i) r[i] = a[i];
+    for (int i = da; i >= db; --i) {
+      const sreal_t q = r[i] / b[db];
+      for (int j = 0; j < db; ++j) r[i - db + j] -= q * b[j];
+      r[i] = 0;
+    }
+    sreal_t mx = 0;
+    for (int i = 0; i < db; ++i)
+      if (SR_ABS(r[i]) > mx) mx = SR_ABS(r[i]);
+    if (!(mx > SR_TOL * (sreal_t)(da + 1))) break; /* gcd reached (or NaN) */
+    ch->deg[ch->len] = db - 1;
+    chain_normalise(ch, ch->len, -1);
+    ++ch->len;
+  }
+}
+
+static int sign_changes(const chain_t *ch, sreal_t x, imest_roots_stats_t *st) {
+  int v = 0, last = 0;
+  ++st->sturm_evals;
+  for (int k = 0; k < ch->len; ++k) {
+    const int s = sgn_s(horner_s(ch->c[k], ch->deg[k], x));
+    if (s != 0) {
+      if (last != 0 && s != last) ++v;
+      last = s;
+    }
+  }
+  return v;
+}
+
+/* Safeguarded Newton on p^(order) in [a,b], where the signs at a and b differ
+ * (fa is the value at a). */
+static double newton_bracketed(const double *c, int n, int order, double a, double b, double fa,
+                               imest_roots_stats_t *st) {
+  double x = 0.5 * (a + b);
+  for (int it = 0; it < IMEST_ROOTS_MAX_POLISH; ++it) {
+    double f, df;
+    eval_d(c, n, order, x, &f, &df);
+    ++st->polish_evals;
+    if (f == 0.0) return x;
+    if (sgn_d(f) == sgn_d(fa))
+      a = x;
+    else
+      b = x;
+    double xn = x - f / df;
+    const int newton = (xn > a && xn < b); /* false for NaN/Inf too */
+    if (!newton) xn = 0.5 * (a + b);
+    if (newton && fabs(xn - x) <= NEWTON_STOP * fabs(xn)) return xn;
+    if (b - a <= 4.0 * DBL_EPSILON * fabs(b)) return xn;
+    x = xn;
+  }
+  return x;
+}
+
+/* Find a float64 sign change of p^(order) on [a,b] or a widening of it within
+ * [lo,hi]; then polish. Returns 1 and *root on success. */
+static int polish_order(const double *c, int n, int order, double a, double b, double lo, double hi,
+                        double *root, imest_roots_stats_t *st) {
+  double fa, fb, dummy;
+  eval_d(c, n, order, a, &fa, &dummy);
+  eval_d(c, n, order, b, &fb, &dummy);
+  st->polish_evals += 2;
+  if (fa == 0.0) {
+    *root = a;
+    return 1;
+  }
+  if (fb == 0.0) {
+    *root = b;
+    return 1;
+  }
+  double w = b - a;
+  if (!(w > 0.0)) w = fabs(b) * 1e-6 + DBL_MIN;
+  for (int j = 0; sgn_d(fa) == sgn_d(fb) && j < IMEST_ROOTS_MAX_EXPAND; ++j) {
+    w *= 4.0;
+    const double a2 = fmax(lo, a - w), b2 = fmin(hi, b + w);
+    double fa2 = fa, fb2 = fb;
+    if (a2 < a) {
+      eval_d(c, n, order, a2, &fa2, &dummy);
+      ++st->polish_evals;
+    }
+    if (sgn_d(fa2) != sgn_d(fa)) { /* sign change on [a2, a] */
+      b = a;
+      fb = fa;
+      a = a2;
+      fa = fa2;
+      break;
+    }
+    if (b2 > b) {
+      eval_d(c, n, order, b2, &fb2, &dummy);
+      ++st->polish_evals;
+    }
+    if (sgn_d(fb2) != sgn_d(fb)) { /* sign change on [b, b2] */
+      a = b;
+      fa = fb;
+      b = b2;
+      fb = fb2;
+      break;
+    }
+    a = a2;
+    b = b2;
+    if (a2 <= lo && b2 >= hi) break;
+  }
+  if (sgn_d(fa) == sgn_d(fb) || sgn_d(fa) == 0 || sgn_d(fb) == 0) {
+    if (fa == 0.0) {
+      *root = a;
+      return 1;
+    }
+    if (fb == 0.0) {
+      *root = b;
+      return 1;
+    }
+    return 0;
+  }
+  *root = newton_bracketed(c, n, order, a, b, fa, st);
+  return 1;
+}
+
+static int polish(const double *c, int n, double a, double b, double lo, double hi, double *root,
+                  imest_roots_stats_t *st) {
+  const double ext = (hi - lo) * 0.0625;
+  lo = fmax(0.0, lo - ext);
+  hi = hi + ext;
+  if (polish_order(c, n, 0, a, b, lo, hi, root, st)) return 1;
+  /* no float64 sign change: even multiplicity? polish the root of p' */
+  double x;
+  if (!polish_order(c, n, 1, a, b, lo, hi, &x, st)) return 0;
+  const double px = imest_poly_eval(c, n, x);
+  ++st->polish_evals;
+  if (fabs(px) <= 32.0 * (double)(n + 1) * DBL_EPSILON * abs_sum_d(c, n, x)) {
+    *root = x;
+    return 1;
+  }
+  return 0;
+}
+
+/* Refine one interval (count >= 1) in chain precision and polish it in float64. */
+static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root, imest_roots_stats_t *st) {
+  const double lo = (double)iv.a, hi = (double)iv.b;
+  sreal_t a = iv.a, b = iv.b;
+  const sreal_t *p0 = ch->c[0];
+  const int d0 = ch->deg[0];
+  sreal_t fa = horner_s(p0, d0, a), fb = horner_s(p0, d0, b);
+  if (sgn_s(fa) * sgn_s(fb) < 0) {
+    for (int it = 0; it < IMEST_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
+      const sreal_t m = a + (b - a) * (sreal_t)0.5;
+      if (!(m > a && m < b)) break;
+      ++st->bisect_steps;
+      const sreal_t fm = horner_s(p0, d0, m);
+      if (fm == 0) {
+        a = m;
+        b = m;
+        break;
+      }
+      if (sgn_s(fm) == sgn_s(fa)) {
+        a = m;
+        fa = fm;
+      } else {
+        b = m;
+      }
+    }
+  } else if (fb != 0) {
+    int va = iv.va;
+    for (int it = 0; it < IMEST_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
+      const sreal_t m = a + (b - a) * (sreal_t)0.5;
+      if (!(m > a && m < b)) break;
+      ++st->bisect_steps;
+      const int vm = sign_changes(ch, m, st);
+      if (va - vm >= 1) {
+        b = m;
+      } else {
+        a = m;
+        va = vm;
+      }
+    }
+  } else {
+    a = b; /* exact zero at b in chain precision */
+  }
+  return polish(pd, n, (double)a, (double)b, lo, hi, root, st);
+}
+
+/* Roots of pd (float64, normalised, degree n >= 1, pd[0] != 0) in (0,1]. */
+static int domain_roots(chain_t *ch, const double *pd, int n, double *out, imest_roots_stats_t *st) {
+  ival_t stack[IMEST_ROOTS_MAX_DEPTH + 2];
+  int top = 0, nout = 0, splits = 0;
+  chain_build(ch, pd, n);
+  if ((unsigned int)ch->len > st->chain_len) st->chain_len = (unsigned int)ch->len;
+  if (ch->deg[0] == 0) return 0;
+  stack[top].a = 0;
+  stack[top].b = 1;
+  stack[top].va = sign_changes(ch, 0, st);
+  stack[top].vb = sign_changes(ch, 1, st);
+  stack[top].depth = 0;
+  ++top;
+  while (top > 0) {
+    const ival_t iv = stack[--top];
+    const int cnt = iv.va - iv.vb;
+    if (cnt <= 0) continue;
+    if (cnt >= 2) {
+      const sreal_t m = iv.a + (iv.b - iv.a) * (sreal_t)0.5;
+      if (iv.depth < IMEST_ROOTS_MAX_DEPTH && splits < IMEST_ROOTS_MAX_SPLITS && m > iv.a && m < iv.b &&
+          top + 2 <= IMEST_ROOTS_MAX_DEPTH + 2) {
+        const int vm = sign_changes(ch, m, st);
+        ++splits;
+        /* right half first so that the left half is processed first */
+        stack[top].a = m;
+        stack[top].b = iv.b;
+        stack[top].va = vm;
+        stack[top].vb = iv.vb;
+        stack[top].depth = iv.depth + 1;
+        ++top;
+        stack[top].a = iv.a;
+        stack[top].b = m;
+        stack[top].va = iv.va;
+        stack[top].vb = vm;
+        stack[top].depth = iv.depth + 1;
+        ++top;
+        continue;
+      }
+      ++st->unresolved;
+    }
+    double x;
+    if (nout < NMAX && refine(ch, pd, n, iv, &x, st)) {
+      out[nout++] = x;
+    } else {
+      ++st->rejected;
+    }
+  }
+  return nout;
+}
+
+int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int max, imest_roots_stats_t *st) {
+  imest_roots_stats_t dummy;
+  if (st == 0) st = &dummy;
+  st->sturm_evals = st->bisect_steps = st->polish_evals = st->chain_len = 0;
+  st->unresolved = st->rejected = st->merged = 0;
+  if (c == 0 || deg < 0 || deg > NMAX || (max > 0 && roots == 0)) return -1;
+  int hi = -1, lo = -1;
+  double mx = 0.0;
+  for (int k = 0; k <= deg; ++k) {
+    if (!isfinite(c[k])) return -1;
+    if (c[k] != 0.0) {
+      if (lo < 0) lo = k;
+      hi = k;
+      if (fabs(c[k]) > mx) mx = fabs(c[k]);
+    }
+  }
+  if (hi < 0) return -1; /* all zero */
+  const int n = hi - lo;
+  if (n == 0) return 0;
+  int e;
+  (void)frexp(mx, &e);
+  double p[NMAX + 1], q[NMAX + 1];
+  for (int k = 0; k <= n; ++k) {
+    p[k] = ldexp(c[lo + k], -e);
+    q[n - k] = p[k];
+  }
+
+  chain_t ch;
+  double found[2 * NMAX];
+  int nf = domain_roots(&ch, p, n, found, st);
+  double xq[NMAX];
+  const int nq = domain_roots(&ch, q, n, xq, st);
+  for (int i = 0; i < nq; ++i) found[nf++] = 1.0 / xq[i];
+
+  /* sort ascending (insertion; nf <= 40) and merge near-duplicates */
+  for (int i = 1; i < nf; ++i) {
+    const double v = found[i];
+    int j = i - 1;
+    while (j >= 0 && found[j] > v) {
+      found[j + 1] = found[j];
+      --j;
+    }
+    found[j + 1] = v;
+  }
+  int nr = 0;
+  for (int i = 0; i < nf; ++i) {
+    if (!(found[i] > 0.0) || !isfinite(found[i])) {
+      ++st->rejected;
+      continue;
+    }
+    if (nr > 0 && found[i] - roots[nr - 1] <= MERGE_REL * found[i]) {
+      ++st->merged;
+      continue;
+    }
+    if (nr < max) {
+      roots[nr++] = found[i];
+    } else {
+      break;
+    }
+  }
+  return nr;
+}
+
+int imest_poly_positive_roots(const double *c, int deg, double *roots, int max) {
+  return imest_poly_positive_roots_ex(c, deg, roots, max, 0);
+}

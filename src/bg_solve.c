@@ -1,0 +1,92 @@
+/* Stage 6: the background solve of one window (MATH.md §3..§7), orchestrating
+ * bg_tables.c -> bg_resultant.c -> bg_roots.c -> bg_select.c -> bg_quality.c.
+ *
+ * Bounded: every loop has a compile-time bound (bg_poly.h):
+ *   roots:   <= 2 x (2 + 1024 + 20 x 48) Sturm evaluations, <= 2 x 20 x 48
+ *            bisection steps, <= 2 x 20 x 99 float64 polish evaluations;
+ *   quality: <= 2 x 80 x 41 + 2 x 61 profile evaluations.
+ * Typical (testvector): ~30 Sturm evaluations, ~60 bisection steps, ~20 polish
+ * and ~45 quality evaluations (out->work holds the sum).
+ *
+ * Stack (worst case, measured with -fstack-usage for Cortex-M4F, -O2, float32
+ * chain): imest_solve ~0.9 KB (tables, r, roots, candidates) + the root finder
+ * ~2.6 KB (Sturm chain 1.8 KB, isolation stack 0.6 KB) = about 3.5 KB; the
+ * quality stage (~0.3 KB) runs after the root finder has returned. No static
+ * mutable data, no allocation. */
+#include <math.h>
+
+#include "bg_poly.h"
+
+static int cfg_ok(const imest_solve_cfg_t *cfg) {
+  return isfinite(cfg->sigma) && cfg->sigma > 0.0 && cfg->sigma < 1.0 && isfinite(cfg->ls_h) && cfg->ls_h > 0.0 &&
+         isfinite(cfg->tr_min_s) && isfinite(cfg->tr_max_s) && cfg->tr_min_s > 0.0 && cfg->tr_max_s > cfg->tr_min_s;
+}
+
+int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_solve_out_t *out,
+                   imest_solve_stats_t *stats) {
+  imest_solve_stats_t local;
+  if (stats == 0) stats = &local;
+  stats->quality_evals = 0;
+  if (out == 0) return IMEST_ERR_NULL;
+  const double nan = (double)NAN;
+  out->n_roots = out->n_admissible = 0;
+  for (int i = 0; i < IMEST_MAX_ROOTS; ++i) out->roots_k2[i] = 0.0;
+  out->k1 = out->k2 = out->tr_s = out->rs_ohm = nan;
+  out->e = out->e_i = nan;
+  out->hessian[0][0] = out->hessian[0][1] = out->hessian[1][0] = out->hessian[1][1] = nan;
+  out->hessian_pd = 0;
+  out->pe_k1 = out->pe_k2 = nan;
+  out->pe_quad[0] = out->pe_quad[1] = nan;
+  out->scale_s = out->scale_g = out->scale_c = nan;
+  out->pe_flags = 0;
+  out->work = 0;
+  if (in == 0 || cfg == 0) return out->status = IMEST_ERR_NULL;
+  if (!cfg_ok(cfg)) return out->status = IMEST_ERR_CONFIG;
+
+  imest_tables_t t;
+  if (imest_tables_build(in, cfg->tr_nominal_s, &t) != IMEST_OK) {
+    stats->roots.sturm_evals = stats->roots.bisect_steps = stats->roots.polish_evals = 0;
+    return out->status = IMEST_ST_NUMERIC;
+  }
+  out->scale_s = t.s;
+  out->scale_g = t.g;
+  out->scale_c = t.c;
+
+  double r[21];
+  imest_resultant(&t, r, 0);
+  double kappa[IMEST_MAX_ROOTS];
+  const int nr = imest_poly_positive_roots_ex(r, 18, kappa, IMEST_MAX_ROOTS, &stats->roots);
+  out->work = stats->roots.sturm_evals + stats->roots.bisect_steps + stats->roots.polish_evals;
+  if (nr < 0) return out->status = IMEST_ST_NUMERIC; /* non-finite or all-zero resultant */
+  out->n_roots = (unsigned int)nr;
+  for (int i = 0; i < nr; ++i) out->roots_k2[i] = ldexp(kappa[i], t.sexp);
+
+  imest_cand_t cand[IMEST_MAX_ROOTS];
+  unsigned int nad = 0;
+  const int b = imest_select(&t, kappa, nr, cfg, in->ry, cand, &nad);
+  out->n_admissible = nad;
+  if (b < 0) return out->status = IMEST_ST_NO_ROOT;
+
+  const imest_cand_t *c = &cand[b];
+  out->k1 = c->k1;
+  out->k2 = c->k2;
+  out->tr_s = c->tr_s;
+  out->rs_ohm = c->rs_ohm;
+  out->e = (c->e > 0.0) ? c->e : 0.0;
+  out->e_i = sqrt(out->e / in->ry);
+  stats->quality_evals = imest_quality(&t, cfg, c, out);
+  out->work += stats->quality_evals;
+
+  const int finite = isfinite(out->e_i) && isfinite(out->hessian[0][0]) && isfinite(out->hessian[0][1]) &&
+                     isfinite(out->hessian[1][1]) && isfinite(out->pe_k1) && isfinite(out->pe_k2) &&
+                     isfinite(out->pe_quad[0]) && isfinite(out->pe_quad[1]);
+  if (!finite) {
+    out->hessian_pd = 0;
+    return out->status = IMEST_ST_NUMERIC;
+  }
+  return out->status = IMEST_OK;
+}
+
+int imest_solve(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_solve_out_t *out) {
+  return imest_solve_ex(in, cfg, out, 0);
+}
