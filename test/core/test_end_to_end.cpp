@@ -11,13 +11,13 @@ extern "C" {
 }
 
 namespace {
-struct Run {
+struct RunOut {
   std::vector<imest_result_t> res;
   std::vector<double> tr_true, rs_true;
 };
 
 // Runs the motor for `seconds`, feeding exact samples at fs from t_start on.
-Run run(MotorRef &mot, double seconds, double t_start, bool at_rest, float window_s = 1.0f) {
+RunOut run(MotorRef &mot, double seconds, double t_start, bool at_rest, float window_s = 1.0f) {
   const double fs = 4000.0;
   const int sub = 16;
   imest_config_t cfg;
@@ -30,7 +30,7 @@ Run run(MotorRef &mot, double seconds, double t_start, bool at_rest, float windo
   cfg.start_at_rest = at_rest ? 1 : 0;
   static imest_t s;
   EXPECT_EQ(imest_init(&s, &cfg), IMEST_OK);
-  Run out;
+  RunOut out;
   while (mot.t < t_start - 1e-12)
     for (int k = 0; k < sub; ++k) mot.step(1.0 / fs / sub);
   const long n = (long)std::lround(seconds * fs);
@@ -57,7 +57,7 @@ TEST(EndToEnd, LoadedSteadyStateRecoversTrAndRs) {
   mot.vll = 115;
   mot.f = 30;
   mot.load = 2.064;
-  Run r = run(mot, 4.0, 1.5, false);
+  RunOut r = run(mot, 4.0, 1.5, false);
   ASSERT_EQ(r.res.size(), 4u);
   EXPECT_EQ(r.res[0].status, IMEST_ST_WARMUP);
   for (size_t k = 1; k < r.res.size(); ++k) {
@@ -74,7 +74,7 @@ TEST(EndToEnd, LoadedSteadyStateRecoversTrAndRs) {
 // valid; once at no-load speed the slip is ~0 and T_R is unobservable.
 TEST(EndToEnd, RunUpValidThenZeroSlipInvalid) {
   MotorRef mot;
-  Run r = run(mot, 3.0, 0.0, true);
+  RunOut r = run(mot, 3.0, 0.0, true);
   ASSERT_EQ(r.res.size(), 3u);
   EXPECT_TRUE(r.res[0].valid) << imest_status_name(r.res[0].status);
   EXPECT_NEAR(r.res[0].tr_s, 0.12, 0.12 * 1e-2);
@@ -89,7 +89,7 @@ TEST(EndToEnd, RunUpValidThenZeroSlipInvalid) {
 TEST(EndToEnd, NoCurrentIsInvalidWithReason) {
   MotorRef mot;
   mot.vll = 0;
-  Run r = run(mot, 2.0, 0.0, true);
+  RunOut r = run(mot, 2.0, 0.0, true);
   ASSERT_EQ(r.res.size(), 2u);
   for (const auto &w : r.res) {
     EXPECT_FALSE(w.valid);

@@ -100,11 +100,12 @@ TEST(Handoff, WarmupIsMarkedAndStartAtRestSkipsIt) {
   imest_result_t r;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   int k = 0;
-  feed(&s, 800, k);
+  feed(&s, 400, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_EQ(r.status, IMEST_ST_WARMUP);
   EXPECT_FALSE(r.valid);
   EXPECT_LT(r.used_samples, 400u);
+  feed(&s, 400, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_FALSE(r.flags & IMEST_FLAG_WARMUP);
   EXPECT_EQ(r.used_samples, 400u);
@@ -130,10 +131,11 @@ TEST(Handoff, NonFiniteSampleInvalidatesItsWindowAndRecovers) {
   const float u[3] = {nan, 0, 0}, i[3] = {0, 0, 0};
   imest_isr_abc(&s, u, i, 0.0f);
   ++k;
-  feed(&s, 299 + 400, k);
+  feed(&s, 299, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_EQ(r.status, IMEST_ST_INPUT_FAULT);
   EXPECT_FALSE(r.valid);
+  feed(&s, 400, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_FALSE(r.flags & (IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_WARMUP));
   EXPECT_EQ(r.used_samples, 400u);

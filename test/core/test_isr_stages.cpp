@@ -114,8 +114,8 @@ TEST(IsrFilter, DerivativesAreTimeAlignedCentralDifferences) {
     }
   }
   // signal: |x| ~ 2.5, |dx| ~ 113 /s, |d2x| ~ 6400 /s^2
-  EXPECT_LT(worst_x, 2e-6);
-  EXPECT_LT(worst_dx, 5e-3);
+  EXPECT_LT(worst_x, 2e-5);   // float32 SOS rounding, ~1e-5 relative
+  EXPECT_LT(worst_dx, 1.5e-2);
   EXPECT_LT(worst_d2, 40.0);  // float32 rounding of x_f times 1/T^2 = 1.6e7
 }
 
