@@ -1,0 +1,34 @@
+/* Firmware CAN port: forwards each frame to the HAL transmit hook. */
+#include "imest_can_callback.h"
+
+#include <stddef.h>
+
+static int cb_send(void *ctx, const struct imest_can_frame *f) {
+  struct imest_can_callback *cb = (struct imest_can_callback *)ctx;
+  int ext;
+  uint32_t id;
+  if (cb == NULL || f == NULL || cb->tx == NULL || f->dlc > 8u) {
+    return -1;
+  }
+  ext = (f->id & IMEST_CAN_ID_EXT) ? 1 : 0;
+  id = f->id & (ext ? IMEST_CAN_EFF_MASK : IMEST_CAN_SFF_MASK);
+  if (cb->tx(cb->hal, id, ext, f->data, f->dlc) != 0) {
+    cb->failed++;
+    return -1;
+  }
+  cb->sent++;
+  return 0;
+}
+
+int imest_can_callback_init(struct imest_can_callback *cb, imest_can_hal_tx_fn tx, void *hal) {
+  if (cb == NULL || tx == NULL) {
+    return -1;
+  }
+  cb->port.send = cb_send;
+  cb->port.ctx = cb;
+  cb->tx = tx;
+  cb->hal = hal;
+  cb->sent = 0u;
+  cb->failed = 0u;
+  return 0;
+}

@@ -1,0 +1,48 @@
+/**
+ * @file imest_can_callback.h
+ * @brief Firmware CAN port: adapts imest's frames to a HAL transmit function.
+ *
+ * The firmware supplies one non-blocking function that puts a frame into a
+ * free transmit mailbox / FIFO slot of its CAN controller and returns 0, or
+ * returns nonzero at once when none is free (or the controller is bus-off).
+ * See example/example_stm32.c for an STM32-HAL-style implementation.
+ *
+ *     static struct imest_can_callback cb;
+ *     imest_can_callback_init(&cb, my_can_tx, &hcan1);
+ *     imest_attach_can(&est, &cb.port, 0x6A0u);
+ *
+ * C11, no stdio, no malloc; octets in `unsigned char`, one per element.
+ */
+#ifndef IMEST_CAN_CALLBACK_H
+#define IMEST_CAN_CALLBACK_H
+
+#include <stdint.h>
+
+#include "imest/imest_can.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** HAL transmit hook. id: 11-bit or 29-bit identifier (without flag);
+ *  extended: 1 for a 29-bit identifier; data: dlc octets. Must not block.
+ *  @return 0 when queued, nonzero when not. */
+typedef int (*imest_can_hal_tx_fn)(void *hal, uint32_t id, int extended,
+                                   const unsigned char *data, unsigned int dlc);
+
+struct imest_can_callback {
+  struct imest_can_port port;   /**< pass &cb.port to imest_attach_can() */
+  imest_can_hal_tx_fn tx;
+  void *hal;                    /**< the HAL handle given to tx (e.g. &hcan1) */
+  uint32_t sent;                /**< frames the HAL accepted */
+  uint32_t failed;              /**< frames it refused */
+};
+
+/** Fill cb. @return 0, or -1 if cb or tx is NULL. */
+int imest_can_callback_init(struct imest_can_callback *cb, imest_can_hal_tx_fn tx, void *hal);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* IMEST_CAN_CALLBACK_H */

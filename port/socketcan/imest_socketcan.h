@@ -1,0 +1,59 @@
+/**
+ * @file imest_socketcan.h
+ * @brief Host library (Linux): a CAN port on a SocketCAN CAN_RAW socket.
+ *
+ *     struct imest_socketcan sc;
+ *     if (imest_socketcan_open(&sc, "vcan0") != 0) { puts(sc.err); ... }
+ *     imest_attach_can(&est, &sc.port, IMEST_CAN_DEFAULT_BASE_ID);
+ *     ...
+ *     imest_socketcan_close(&sc);
+ *
+ * Sending never blocks (MSG_DONTWAIT): a full queue (ENOBUFS/EAGAIN) or a
+ * down interface is a failed send, counted by the publisher.
+ */
+#ifndef IMEST_SOCKETCAN_H
+#define IMEST_SOCKETCAN_H
+
+#include <stdint.h>
+
+#include "imest/imest_can.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct imest_socketcan {
+  struct imest_can_port port;  /**< pass &sc.port to imest_attach_can() */
+  int fd;                      /**< CAN_RAW socket, -1 when closed */
+  int ifindex;
+  char ifname[16];
+  int last_errno;              /**< errno of the last failure (open, send, recv) */
+  char err[256];               /**< human-readable message of the last failure */
+  unsigned long sent;
+  unsigned long failed;
+};
+
+/**
+ * Open a CAN_RAW socket bound to interface `ifname` (e.g. "can0", "vcan0").
+ * @return 0, or -errno with sc->err explaining, e.g.
+ *   -EAFNOSUPPORT: the kernel has no CAN support (modules can, can-raw),
+ *   -ENODEV: no such interface, or it is not a CAN interface,
+ *   -ENETDOWN: the interface is down.
+ */
+int imest_socketcan_open(struct imest_socketcan *sc, const char *ifname);
+
+/** Receive one frame, waiting at most timeout_ms (< 0: forever). Remote,
+ *  error and CAN FD frames are skipped. t_s (optional): receive time
+ *  (CLOCK_REALTIME, seconds). @return 1 frame, 0 timeout / interrupted,
+ *  -errno on error (sc->err set). */
+int imest_socketcan_recv(struct imest_socketcan *sc, struct imest_can_frame *f, int timeout_ms,
+                         double *t_s);
+
+/** Close the socket (safe to call twice). */
+void imest_socketcan_close(struct imest_socketcan *sc);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* IMEST_SOCKETCAN_H */
