@@ -143,7 +143,6 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   s->n = (imest_real_t)cfg->pole_pairs;
   s->m = (imest_real_t)m;
   s->inv_s = (imest_real_t)(1.0 / (sigma * ls));
-  s->n1m = (imest_real_t)((double)cfg->pole_pairs * (1.0 + m));
   s->i_lim = (imest_real_t)cfg->i_limit_a;
   s->u_lim = (imest_real_t)cfg->u_limit_v;
   s->i_abs = (imest_real_t)cfg->i_absurd_a;

@@ -250,7 +250,7 @@ typedef struct {
 typedef struct {
   /* constants derived at init */
   imest_real_t fs, inv2t, invt2;        /* fs, 1/(2T), 1/T^2 */
-  imest_real_t n, m, inv_s, n1m;        /* n_p, M*beta, 1/(sigma L_S), n_p (1+m) */
+  imest_real_t n, m, inv_s;             /* n_p, M*beta, 1/(sigma L_S) */
   imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max;
   uint32_t window_n, warmup_n;
   imest_bw3_t bw;
@@ -268,12 +268,6 @@ typedef struct {
   volatile uint32_t published;   /* ISR -> background: count of buffers handed over */
   volatile uint32_t released;    /* background -> ISR: count of buffers released */
   volatile uint32_t overruns;    /* windows dropped */
-  uint32_t dropped_pending;      /* drops not yet reported in a result */
-  imest_real_t c0[7];                   /* centring vector for the next window (background writes
-                                    next_c0, ISR copies it at window start) */
-  volatile imest_real_t next_c0[7];
-  volatile uint32_t next_c0_gen; /* generation counter of next_c0 */
-  uint32_t c0_gen;
   imest_window_t win[2];
   /* background-only state */
   float sigma, ls_h, tr_nominal_s, tr_min_s, tr_max_s, rs_min_ohm, rs_max_ohm;
