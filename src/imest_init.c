@@ -23,7 +23,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->rs_min_ohm = 0.0f;
   cfg->rs_max_ohm = 1.0e3f;
   cfg->max_pe_k2_rel = 0.1f;
-  cfg->max_ei = 1.0f;
+  cfg->max_ei = 3.0f;
   cfg->min_current_a = 0.05f;
   cfg->min_slip_ratio = 0.05f;
   cfg->i_limit_a = 0.0f;

@@ -148,7 +148,8 @@ typedef struct {
 
   /* Validity (see README "When is a window valid"). */
   float max_pe_k2_rel;      /**< largest relative parametric error index of K2 (default 0.1) */
-  float max_ei;             /**< largest residual error index E_I (default 1.0) */
+  float max_ei;             /**< largest residual error index E_I (default 3.0: a sanity bound; the
+                                 PE index is the evidence of trust, README) */
   float min_current_a;      /**< least rms stator current (alpha/beta amplitude) [A] (default 0.05) */
   float min_slip_ratio;     /**< least rms rotor-frame current rate / (rms current / T_R): a
                                  measure of slip excitation (default 0.05) */

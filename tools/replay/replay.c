@@ -316,14 +316,17 @@ int main(int argc, char **argv)
 
   FILE *canlog = NULL;
 #ifdef IMEST_HAVE_CANDUMP
-  imest_candump_port_t cport;
+  struct imest_candump_port cport;
   if (candump_path) {
     canlog = strcmp(candump_path, "-") ? fopen(candump_path, "w") : stdout;
     if (canlog == NULL) {
       fprintf(stderr, "imest-replay: %s: %s\n", candump_path, strerror(errno));
       return 1;
     }
-    imest_candump_port_init(&cport, canlog, can_iface);
+    if (imest_candump_port_open(&cport, canlog, can_iface) != 0) {
+      fprintf(stderr, "imest-replay: --can-iface '%s' is not a valid interface name\n", can_iface);
+      return 2;
+    }
     if (imest_attach_can(&est, &cport.port, (uint32_t)can_id) != 0) {
       fprintf(stderr, "imest-replay: --can-id 0x%lx is not a valid CAN identifier\n", can_id);
       return 2;
@@ -355,10 +358,10 @@ int main(int argc, char **argv)
     double th = fmod(v[7], TWO_PI); /* firmware sees a wrapped encoder angle */
     if (th < 0) th += TWO_PI;
     if (imest_isr_abc(&est, u, i, (float)th)) {
-      while (imest_background(&est, &res) == 1) {
 #ifdef IMEST_HAVE_CANDUMP
-        (void)0;
+      if (canlog) imest_candump_port_set_time(&cport, v[0]); /* log time = window end */
 #endif
+      while (imest_background(&est, &res) == 1) {
         printf("%.6f,%.9g,%.9g,%.6g,%d,%s,%u,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%u,%u,%.4g,%.6g,%u,0x%x\n",
                t0 + res.t_end_s, res.tr_s, res.rs_ohm, res.e_i, res.valid,
                imest_status_name(res.status), res.seq, res.k1, res.k2, res.pe_k1_rel, res.pe_k2_rel,
