@@ -43,7 +43,10 @@ uint32_t harness_stack_used(void)
 __attribute__((noreturn, used)) void harness_c_start(void);
 __attribute__((noreturn, used)) void harness_c_start(void)
 {
-  uint32_t *src = &__data_load, *dst = &__data_start;
+  /* volatile: keep these loops loops (not memcpy/memset calls), so that the
+   * flash probe's baseline does not already contain memcpy/memset. */
+  const volatile uint32_t *src = &__data_load;
+  volatile uint32_t *dst = &__data_start;
   while (dst < &__data_end) *dst++ = *src++;
   for (dst = &__bss_start; dst < &__bss_end;) *dst++ = 0u;
   /* Full access to CP10 and CP11 (the FPU). */
