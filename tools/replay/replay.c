@@ -219,7 +219,7 @@ int main(int argc, char **argv)
   clip_t clip_i[3], clip_u[3];
   memset(clip_i, 0, sizeof clip_i);
   memset(clip_u, 0, sizeof clip_u);
-  double i_first = 0, th_first = 0, th_span8 = 0, imax = 0;
+  double i_first = 0, th_first = 0, th_step1 = 0, imax = 0;
   while ((rc = csv_next(&r, v)) == 1) {
     if (n == 0) {
       t0 = v[0];
@@ -236,7 +236,7 @@ int main(int argc, char **argv)
       if (dt < dtmin) { dtmin = dt; line_dtmin = r.line; }
       if (dt > dtmax) { dtmax = dt; line_dtmax = r.line; }
     }
-    if (n < 8) th_span8 = fmax(th_span8, fabs(v[7] - th_first));
+    if (n == 1) th_step1 = fabs(v[7] - th_first);
     for (int k = 0; k < 3; ++k) {
       clip_feed(&clip_u[k], v[1 + k]);
       clip_feed(&clip_i[k], v[4 + k]);
@@ -300,8 +300,9 @@ int main(int argc, char **argv)
 
   if (from_rest < 0) {
     /* At rest: no current and a still rotor imply a zero history for every
-     * filter (no current means no flux and no voltage either). */
-    from_rest = (i_first <= 0.01 * imax && th_span8 * fs / 8.0 < 1.0) ? 1 : 0;
+     * filter (no current means no flux and no voltage either). The rotor
+     * test uses the first step only: a DOL start accelerates within ms. */
+    from_rest = (i_first <= 0.01 * imax && th_step1 * fs < 2.0) ? 1 : 0;
   }
   cfg.start_at_rest = from_rest;
 
