@@ -38,10 +38,10 @@ set(CMAKE_CXX_FLAGS_INIT "${IMEST_ARM_CPU_FLAGS} -ffunction-sections -fdata-sect
 set(CMAKE_ASM_FLAGS_INIT "${IMEST_ARM_CPU_FLAGS}")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "${IMEST_ARM_CPU_FLAGS} -nostartfiles -Wl,--gc-sections")
 
-# -O2 in every build type that optimises (CMake's Release default would be -O3).
-set(CMAKE_C_FLAGS_RELEASE_INIT "-O2 -DNDEBUG")
-set(CMAKE_C_FLAGS_RELWITHDEBINFO_INIT "-O2 -g -DNDEBUG")
-set(CMAKE_ASM_FLAGS_RELEASE_INIT "")
+# -O2 in every build type that optimises. As cache entries, because CMake
+# appends its own defaults (-O3 for Release) to the *_INIT values.
+set(CMAKE_C_FLAGS_RELEASE "-O2 -DNDEBUG" CACHE STRING "C flags for Release (imest firmware: -O2)")
+set(CMAKE_C_FLAGS_RELWITHDEBINFO "-O2 -g -DNDEBUG" CACHE STRING "C flags for RelWithDebInfo")
 
 set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
 set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
