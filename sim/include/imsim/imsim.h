@@ -1,0 +1,221 @@
+/*
+ * imsim: host-side induction-motor simulator for the imest project.
+ *
+ * Model: eq. (1) of Wang, Chiasson, Bodson, Tolbert (IEEE TCST 2007) in the stationary
+ * (a, b) frame, power-invariant 3-2 transform (MATH.md section 1). Supplies: ideal sine,
+ * ideal V/f, sine-triangle PWM inverter (event-exact), indirect field-oriented control (IFOC).
+ * Sensors: ADCs (bits, range, clipping, seeded white noise), optional 2nd-order analog
+ * anti-alias filter, incremental encoder. Thermal drift of R_S and R_R.
+ *
+ * Host only: never linked into the firmware. No malloc: the caller owns every struct.
+ *
+ * Usage:
+ *   imsim_config c; imsim_config_preset(&c, "exp2"); c.supply = IMSIM_SUPPLY_PWM;
+ *   imsim sim; imsim_sample s;
+ *   if (imsim_init(&sim, &c, &s) != 0) { puts(imsim_error(&sim)); }
+ *   ... s holds t = 0 ...
+ *   for (;;) { imsim_step(&sim, &s); ... s holds t = T, 2T, ... }
+ *
+ * Units: SI (V, A, rad, s, N m, Wb, ohm, H, kg m^2). Phase quantities are phase-to-neutral,
+ * currents positive into the motor, theta = mechanical angle (rad, unwrapped, increasing with
+ * the a-b-c field).
+ */
+#ifndef IMSIM_IMSIM_H
+#define IMSIM_IMSIM_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+  IMSIM_SUPPLY_SINE = 0, /* ideal balanced sine, fixed vll/freq from t = 0 (DOL start)     */
+  IMSIM_SUPPLY_VF = 1,   /* ideal sine following a V/f ramp over vf_ramp_s                */
+  IMSIM_SUPPLY_PWM = 2,  /* sine-triangle PWM inverter, reference = the V/f ramp (or step)  */
+  IMSIM_SUPPLY_IFOC = 3  /* IFOC current control driving the PWM inverter (or ideal stage)  */
+} imsim_supply;
+
+typedef enum {
+  IMSIM_VMEAS_AUTO = 0, /* AVG with PWM stages, INST with ideal supplies                      */
+  IMSIM_VMEAS_AVG = 1,  /* phase-to-neutral volt-seconds of the carrier period that just ended,
+                           from commanded duties and Vdc (what a drive knows); delay 1/(2 f_c) */
+  IMSIM_VMEAS_AA = 2,   /* measured phase-to-neutral voltage through the AA filter            */
+  IMSIM_VMEAS_INST = 3  /* raw instantaneous sample (PWM: zero vector, i.e. 0 V)              */
+} imsim_vmeas;
+
+typedef enum { IMSIM_START_REST = 0, IMSIM_START_STEADY = 1 } imsim_start;
+typedef enum { IMSIM_IFOC_SPEED = 0, IMSIM_IFOC_TORQUE = 1 } imsim_ifoc_mode;
+typedef enum {
+  IMSIM_INTEGRATOR_FAST = 0, /* exact Taylor-Horner propagation of the linear electrical part
+                                (event-exact PWM), speed frozen at a predicted mid-step value,
+                                trapezoidal/Hermite mechanics                                  */
+  IMSIM_INTEGRATOR_RK4 = 1   /* reference: classic RK4 of the full nonlinear model, split at
+                                every switching instant, rk4_substeps per piece (slow)        */
+} imsim_integrator;
+
+typedef struct {
+  /* Motor (paper's notation). M = sqrt((1 - sigma) L_S L_R), R_R = L_R / T_R (cold values). */
+  int pole_pairs;
+  double ls_h, lr_h, sigma;
+  double rs_ohm; /* stator resistance at t_amb_c (cold)   */
+  double tr_s;   /* rotor time constant at t_amb_c (cold) */
+  double j_kgm2, b_nms;
+
+  /* Thermal model (copper): R(T) = R_cold (1 + alpha (T - t_amb_c)); each body first order,
+     tau dT/dt = (t_amb + rth * P_cu) - T, P_cu = copper loss of that body (I^2 R). */
+  bool thermal;
+  double t_amb_c, alpha_per_k;
+  double rth_stator_k_per_w, tau_stator_s;
+  double rth_rotor_k_per_w, tau_rotor_s;
+  double thermal_speedup; /* multiplies both thermal rates (1 = physical), for short tests */
+
+  /* Load torque (opposes positive rotation): 0 before load_on_s, linear ramp over
+     load_ramp_s, then load_nm. imsim_set_load() overrides it at run time. */
+  double load_nm, load_on_s, load_ramp_s;
+
+  /* Supply. vll_v = line-to-line rms, freq_hz = electrical frequency. The V/f ramp (VF, PWM)
+     raises frequency and voltage linearly from 0 over vf_ramp_s (0 = apply at once);
+     V_ll(f) = vf_boost_v + (vll_v - vf_boost_v) f / freq_hz. */
+  imsim_supply supply;
+  double vll_v, freq_hz, vf_ramp_s, vf_boost_v;
+
+  /* PWM inverter: regular-sampled sine-triangle, reference sampled once per half carrier
+     period (at its centre, i.e. delay-compensated); dead time with current-sign logic. */
+  double carrier_hz, vdc_v, dead_time_s;
+  bool pwm_moments; /* fast integrator: integrate each half carrier period in one step, the
+                       PWM input entering through its exact moments (~3e-5 relative error from
+                       the torque ripple within the step; default false = integrate piecewise
+                       between switching instants, ~1e-8; see README) */
+
+  /* IFOC (indirect field orientation, slip from the controller's T_R). */
+  imsim_ifoc_mode ifoc_mode;
+  bool ifoc_ideal_stage;   /* true: ideal voltage source (ZOH per sample) instead of PWM   */
+  double ifoc_tr_s;        /* controller's T_R (<= 0: use the motor's cold tr_s)            */
+  double ifoc_flux_wb;     /* rotor flux reference (<= 0: rated flux of the preset)          */
+  double speed_ref_rpm;    /* speed mode: reference, reached by a linear ramp over speed_ramp_s */
+  double speed_ramp_s;
+  double torque_ref_nm;    /* torque mode: reference (applied after flux build-up, see README) */
+  double torque_limit_nm;
+  double current_bw_hz, speed_bw_hz, speed_filter_hz;
+
+  /* Sampling and sensors. fs_hz must divide 2 * carrier_hz for PWM stages. */
+  double fs_hz;
+  int steps_per_sample; /* integration steps per sample; 0 = auto (PWM: 2 f_c / fs; else 5) */
+  bool ideal_sensors;   /* exact samples: no quantisation, noise, clipping, AA or encoder   */
+  int adc_bits;
+  double i_range_a, u_range_v; /* symmetric ranges: +-range (clipping)                    */
+  double noise_lsb;            /* white Gaussian noise, rms in LSB, added before the ADC    */
+  int encoder_counts;          /* counts per mechanical revolution, floor quantisation      */
+  double aa_hz;                /* 2nd-order Butterworth analog AA filter cut-off; 0 = none  */
+  imsim_vmeas vmeas;
+  uint64_t seed;
+
+  imsim_start start;
+  imsim_integrator integrator;
+  int rk4_substeps; /* RK4 steps per constant-input piece */
+
+  double duration_s; /* used by the CLI and the benchmark only */
+} imsim_config;
+
+typedef struct {
+  uint64_t n; /* sample index; t = n / fs */
+  double t;
+
+  /* Measured (what the drive sees). */
+  double u_abc[3]; /* V, phase-to-neutral (see vmeas)            */
+  double i_abc[3]; /* A                                          */
+  double theta;    /* rad, unwrapped, encoder-quantised          */
+
+  /* Truth. */
+  double tr_s, rs_ohm;         /* present (temperature-dependent) values        */
+  double speed_rad_s;          /* mechanical                                    */
+  double torque_nm, load_nm;   /* electromagnetic torque, load torque           */
+  double psi_r_wb;             /* rotor-flux magnitude |psi_R| (alpha-beta)     */
+  double temp_stator_c, temp_rotor_c;
+  double i_abc_true[3], theta_true;
+  double u_abc_true[3];        /* ideal supplies: instantaneous; PWM: actual applied
+                                  (dead-time inclusive) average over the last carrier period */
+  double i_ab_true[2], psi_ab[2], u_ab_true[2]; /* alpha-beta state (power invariant)   */
+  double accel_rad_s2;         /* d omega / dt from the model at t               */
+  double p_cu_stator_w, p_cu_rotor_w;
+  /* IFOC (NaN when not IFOC). */
+  double ifoc_torque_ref_nm, ifoc_flux_ref_wb, ifoc_tr_s, ifoc_speed_ref_rad_s;
+} imsim_sample;
+
+/* Steady state of the model under a balanced sinusoidal supply (phasor solution of eq. (1)). */
+typedef struct {
+  double speed_rad_s, speed_rpm, slip;
+  double i_rms_phase, torque_nm, psi_r_wb;
+  double i_ab[2], psi_ab[2]; /* alpha-beta state at supply phase 0 (u = vll + j0) */
+} imsim_steady;
+
+/* Private state. Declared here only so that the caller can own the storage (no malloc). */
+typedef struct { double re, im; } imsim_cpx_;
+typedef struct {
+  imsim_config c;
+  char err[160];
+  /* derived constants */
+  double m_h, rr0_ohm, ts_s, h_s;
+  int k_steps;
+  /* present parameters */
+  double rs, rr, tr, gamma, beta;
+  /* state: 0 i, 1 psi, 2-3 AA(i), 4-5 AA(u), 6 source voltage */
+  imsim_cpx_ x[7];
+  double w, th, t;
+  uint64_t n;
+  double te, acc; /* torque and acceleration at t */
+  double temp_s, temp_r;
+  double load_override; bool load_overridden;
+  /* supply bookkeeping */
+  double u_hp_cmd[2][2], u_hp_act[2][2]; /* last two half-period averages (re, im) */
+  int hp_count;
+  double u_inst[2]; /* instantaneous applied voltage at t (alpha-beta) */
+  /* IFOC */
+  double ifoc_tr, ifoc_flux, speed_ref;
+  double w_meas, th_meas_prev, slip_angle, integ_d, integ_q, integ_w;
+  double v_dq[2], rho, we_ctrl, t_ctrl, te_ref, id_ref, iq_ref;
+  double u_zoh[2];
+  /* sensors */
+  uint64_t rng[4];
+  double gauss_spare; bool has_spare;
+  double i_meas_ab[2]; double th_meas;
+  /* Taylor coefficients h^k/k! */
+  double hk[32];
+} imsim;
+
+/* Fills c with the paper's motor and the exp1 experiment (same as preset "exp1"). */
+void imsim_config_default(imsim_config *c);
+/* name: "exp1" or "exp2". Returns 0, or -1 for an unknown name (c then holds exp1). */
+int imsim_config_preset(imsim_config *c, const char *name);
+
+/* Validates c, sets up sim, and fills *first (may be NULL) with the t = 0 sample.
+   Returns 0, or -1 with a message in imsim_error(sim). */
+int imsim_init(imsim *sim, const imsim_config *c, imsim_sample *first);
+const char *imsim_error(const imsim *sim);
+
+/* Advances exactly one sample period 1/fs and fills *out with the sample at the new time. */
+void imsim_step(imsim *sim, imsim_sample *out);
+
+/* Run-time controls. */
+void imsim_set_ifoc_tr(imsim *sim, double tr_s);   /* controller's T_R, takes effect at the next step */
+void imsim_set_speed_ref(imsim *sim, double rpm);  /* IFOC speed reference (no ramp)          */
+void imsim_set_torque_ref(imsim *sim, double nm);  /* IFOC torque-mode reference              */
+void imsim_set_load(imsim *sim, double load_nm);   /* overrides the load profile              */
+
+/* Phasor steady state of the configured motor (cold parameters) at the given supply and load
+   (load opposes rotation; viscous friction included). Returns 0, or -1 if the load exceeds
+   the breakdown torque. */
+int imsim_steady_state(const imsim_config *c, double vll_v, double freq_hz, double load_nm,
+                       imsim_steady *out);
+
+/* Power-invariant transforms (MATH.md section 1). */
+void imsim_abc_to_ab(const double abc[3], double ab[2]);
+void imsim_ab_to_abc(const double ab[2], double abc[3]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* IMSIM_IMSIM_H */

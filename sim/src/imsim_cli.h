@@ -1,0 +1,38 @@
+/* imest-sim command line (internal to sim/ and test/sim/). */
+#ifndef IMSIM_CLI_H
+#define IMSIM_CLI_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "imsim/imsim.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct {
+  const char *out;   /* "-" = stdout */
+  long decimate;     /* write every n-th sample (1 = all) */
+  int progress;      /* -1 auto (isatty(stderr)), 0 off, 1 on */
+  int help;
+} imsim_cli_opts;
+
+/* The CSV header line (no newline). */
+const char *imsim_cli_header(void);
+
+/* Parses argv into c (preset applied first, then the other flags in order) and o.
+   Returns 0, or -1 with a message in err. */
+int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, char *err, size_t errlen);
+
+/* Writes one CSV row (with newline). */
+void imsim_cli_write_row(FILE *f, const imsim_sample *s);
+
+/* The whole program; returns the process exit status. */
+int imsim_cli_main(int argc, char **argv);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
