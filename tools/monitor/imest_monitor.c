@@ -184,6 +184,17 @@ static void finish(monitor_t *m) {
           m->malformed, m->have_tx_failed ? "" : "n/a ", (unsigned long)m->last_tx_failed);
 }
 
+static void print_header(const monitor_t *m) {
+  if (m->csv) {
+    puts("t_s,seq,T_R_s,R_S_ohm,E_I,valid,status,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,flags,sat,"
+         "tx_failed,counter,frames");
+  } else {
+    printf("%17s %8s %13s %13s %7s %8s %8s %5s %-17s %5s %6s %5s\n", "t [s]", "seq", "T_R [s]",
+           "R_S [ohm]", "E_I", "PE_K1", "PE_K2", "valid", "status", "adm/r", "flags", "txf");
+  }
+  fflush(stdout);
+}
+
 static int run_log(monitor_t *m, const char *path) {
   FILE *fp = strcmp(path, "-") == 0 ? stdin : fopen(path, "r");
   const char *label = strcmp(path, "-") == 0 ? "<stdin>" : path;
@@ -195,6 +206,7 @@ static int run_log(monitor_t *m, const char *path) {
     fprintf(stderr, "imest-monitor: cannot open log '%s': %s\n", path, strerror(errno));
     return 2;
   }
+  print_header(m);
   while (!g_stop && (n = getline(&line, &cap, fp)) >= 0) {
     struct imest_can_frame f;
     double t = 0.0;
@@ -234,6 +246,7 @@ static int run_iface(monitor_t *m, const char *ifname, double timeout_s) {
     fprintf(stderr, "imest-monitor: %s\n", sc.err);
     return 2;
   }
+  print_header(m);
   fprintf(stderr, "imest-monitor: listening on %s (base id 0x%lX%s)\n", ifname,
           (unsigned long)(m->base_id & IMEST_CAN_EFF_MASK), (m->base_id & IMEST_CAN_ID_EXT) ? ", extended" : "");
   while (!g_stop) {
@@ -336,14 +349,6 @@ int main(int argc, char **argv) {
   imest_can_rx_init(&m.rx, m.base_id);
   signal(SIGINT, on_signal);
   signal(SIGTERM, on_signal);
-  if (m.csv) {
-    puts("t_s,seq,T_R_s,R_S_ohm,E_I,valid,status,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,flags,sat,"
-         "tx_failed,counter,frames");
-  } else {
-    printf("%17s %8s %13s %13s %7s %8s %8s %5s %-17s %5s %6s %5s\n", "t [s]", "seq", "T_R [s]",
-           "R_S [ohm]", "E_I", "PE_K1", "PE_K2", "valid", "status", "adm/r", "flags", "txf");
-  }
-  fflush(stdout);
   if (log != NULL) return run_log(&m, log);
 #ifdef IMEST_MONITOR_SOCKETCAN
   return run_iface(&m, iface, timeout_s);
