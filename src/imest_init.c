@@ -73,11 +73,27 @@ int imest_config_check(const imest_config_t *cfg, const char **field)
   return bad ? IMEST_ERR_CONFIG : IMEST_OK;
 }
 
+/* tan(x) for 0 < x < 1.3 by its sin and cos series (fixed 14 terms, relative
+ * error < 1e-15): libm's tan() alone would cost ~4.5 KB of flash on a
+ * Cortex-M4 (argument reduction tables). */
+static double tan_small(double x)
+{
+  const double x2 = x * x;
+  double s = x, c = 1.0, ts = x, tc = 1.0;
+  for (int k = 1; k <= 14; ++k) {
+    ts *= -x2 / (double)((2 * k) * (2 * k + 1));
+    tc *= -x2 / (double)((2 * k - 1) * (2 * k));
+    s += ts;
+    c += tc;
+  }
+  return s / c;
+}
+
 /* Butterworth-3 by the bilinear transform prewarped at fc: a first-order
  * section (s + 1) and a second-order section (s^2 + s + 1). */
 static void design_bw3(imest_bw3_t *f, double fc, double fs)
 {
-  const double k = tan(IMEST_PI_D * fc / fs);
+  const double k = tan_small(IMEST_PI_D * fc / fs);
   const double g1 = k / (1.0 + k);
   f->b0 = (imest_real_t)g1;
   f->b1 = (imest_real_t)g1;
@@ -102,7 +118,7 @@ static void design_aa(imest_sos_t *f, double fc, double fs)
     f->d2 = 0;
     return;
   }
-  const double k = tan(IMEST_PI_D * fc / fs);
+  const double k = tan_small(IMEST_PI_D * fc / fs);
   const double a0 = 1.0 + IMEST_SQRT2_D * k + k * k;
   const double g = k * k / a0;
   f->c0 = (imest_real_t)g;
@@ -148,7 +164,7 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   s->i_abs = (imest_real_t)cfg->i_absurd_a;
   s->u_abs = (imest_real_t)cfg->u_absurd_v;
   s->dth_max = (imest_real_t)cfg->speed_limit_rad_s;
-  s->window_n = (uint32_t)lround((double)cfg->window_s * fs);
+  s->window_n = (uint32_t)((double)cfg->window_s * fs + 0.5);
 
   design_bw3(&s->bw, (double)cfg->filter_hz, fs);
   design_aa(&s->aa, (double)cfg->aa_hz, fs);
@@ -160,7 +176,7 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
     warm_s = 3.0 / (double)cfg->filter_hz;
     if (cfg->aa_hz > 0.0f) warm_s += 2.0 / (double)cfg->aa_hz;
   }
-  s->warmup_n = cfg->start_at_rest ? 0u : (uint32_t)ceil(warm_s * fs) + 2u;
+  s->warmup_n = cfg->start_at_rest ? 0u : (uint32_t)(warm_s * fs) + 3u; /* rounded up, +2 */
   s->warm = s->warmup_n;
 
   /* background constants */
