@@ -63,8 +63,8 @@ void imsim_config_default(imsim_config *c) {
   c->alpha_per_k = 0.00393;
   c->tau_stator_s = 900.0;
   c->tau_rotor_s = 1200.0;
-  c->rth_stator_k_per_w = 0.8955;
-  c->rth_rotor_k_per_w = 5.208;
+  c->rth_stator_k_per_w = 0.9027;
+  c->rth_rotor_k_per_w = 6.22;
   c->thermal_speedup = 1.0;
 
   c->load_nm = 0.0;
@@ -484,9 +484,13 @@ static void fast_piece(imsim *s, double h, const double *hkv, const step_input *
   fast_step(s, hkv, w_mean, (double)c->pole_pairs * (acc0 + 0.5 * h * w2), in);
   if (in->src) u1 = s->x[6];
   const double te1 = torque_of(s, s->x[0], s->x[1]);
-  if (rip != NULL) { /* psi at mid-step for the torque-ripple integral */
+  if (rip != NULL) {
+    /* int T_rip ds with psi(s) linear over the step: psi_mid r1 + psi' int (s - h/2) r ds,
+       int (s - h/2) r ds = h/2 r1 - r2 */
     const cpx pm = cscale(cadd(psi0, s->x[1]), 0.5);
-    tr1 = kt * (rip[0].im * pm.re - rip[0].re * pm.im);
+    const cpx dp = cscale(cadd(s->x[1], cscale(psi0, -1.0)), 1.0 / h);
+    const cpx q = cadd(cscale(rip[0], 0.5 * h), cscale(rip[1], -1.0));
+    tr1 = kt * (rip[0].im * pm.re - rip[0].re * pm.im + q.im * dp.re - q.re * dp.im);
   }
   /* omega: Hermite (corrected trapezoid) quadrature of the torque; theta likewise. dTe/dt at
      the end needs omega at the end: take it from the plain trapezoid first. */

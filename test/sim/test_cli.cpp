@@ -1,0 +1,110 @@
+// imest-sim command line: flag parsing, errors, CSV header and first row.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "imsim_cli.h"
+
+namespace {
+int parse(std::vector<std::string> args, imsim_config &c, imsim_cli_opts &o, std::string *err = nullptr) {
+  args.insert(args.begin(), "imest-sim");
+  std::vector<char *> argv;
+  for (auto &a : args) argv.push_back(a.data());
+  char e[256];
+  const int r = imsim_cli_parse(int(argv.size()), argv.data(), &c, &o, e, sizeof e);
+  if (err) *err = e;
+  return r;
+}
+}  // namespace
+
+TEST(SimCli, RequiredFlagsSetTheConfig) {
+  imsim_config c;
+  imsim_cli_opts o;
+  ASSERT_EQ(parse({"--duration", "3.5", "--fs", "8000", "--out", "x.csv", "--pole-pairs", "3", "--ls", "0.3",
+                   "--lr", "0.31", "--sigma", "0.1", "--rs", "4.5", "--tr", "0.11", "--j", "0.002", "--b", "0.0002",
+                   "--supply", "pwm", "--vll", "220", "--freq", "50", "--load-nm", "1.5", "--ideal-sensors"},
+                  c, o),
+            0);
+  EXPECT_EQ(c.duration_s, 3.5);
+  EXPECT_EQ(c.fs_hz, 8000);
+  EXPECT_STREQ(o.out, "x.csv");
+  EXPECT_EQ(c.pole_pairs, 3);
+  EXPECT_EQ(c.ls_h, 0.3);
+  EXPECT_EQ(c.lr_h, 0.31);
+  EXPECT_EQ(c.sigma, 0.1);
+  EXPECT_EQ(c.rs_ohm, 4.5);
+  EXPECT_EQ(c.tr_s, 0.11);
+  EXPECT_EQ(c.j_kgm2, 0.002);
+  EXPECT_EQ(c.b_nms, 0.0002);
+  EXPECT_EQ(c.supply, IMSIM_SUPPLY_PWM);
+  EXPECT_EQ(c.vll_v, 220);
+  EXPECT_EQ(c.freq_hz, 50);
+  EXPECT_EQ(c.load_nm, 1.5);
+  EXPECT_TRUE(c.ideal_sensors);
+}
+
+TEST(SimCli, PresetAppliesFirstWhateverItsPosition) {
+  imsim_config c;
+  imsim_cli_opts o;
+  ASSERT_EQ(parse({"--vll", "100", "--preset", "exp2", "--seed=7", "--supply=ifoc", "--ifoc-tr", "0.1"}, c, o), 0);
+  EXPECT_EQ(c.vll_v, 100);    // explicit flag wins over the preset
+  EXPECT_EQ(c.freq_hz, 30);   // from exp2
+  EXPECT_EQ(c.load_nm, 2.064);
+  EXPECT_EQ(c.duration_s, 3600);
+  EXPECT_EQ(c.seed, 7u);
+  EXPECT_EQ(c.supply, IMSIM_SUPPLY_IFOC);
+  EXPECT_EQ(c.ifoc_tr_s, 0.1);
+  ASSERT_EQ(parse({"--preset", "exp1"}, c, o), 0);
+  EXPECT_EQ(c.freq_hz, 60);
+  EXPECT_EQ(c.vll_v, 230);
+  EXPECT_EQ(c.duration_s, 2);
+}
+
+TEST(SimCli, BadFlagsAreRejectedWithAMessage) {
+  imsim_config c;
+  imsim_cli_opts o;
+  std::string e;
+  const std::vector<std::vector<std::string>> bad = {
+      {"--bogus"},          {"--fs"},          {"--fs", "abc"},      {"--fs", "-5"},   {"--sigma", "1.2"},
+      {"--supply", "dc"},   {"--preset", "x"}, {"--duration", "1x"}, {"positional"},   {"--pole-pairs", "2.5"},
+      {"--ideal-sensors=1"}, {"--tr", "nan"}, {"--adc-bits", "40"}};
+  for (const auto &b : bad) {
+    EXPECT_NE(parse(b, c, o, &e), 0) << b[0];
+    EXPECT_FALSE(e.empty()) << b[0];
+  }
+}
+
+TEST(SimCli, HeaderStartsWithTheContractColumns) {
+  const std::string h = imsim_cli_header();
+  EXPECT_EQ(h.rfind("t,u_a,u_b,u_c,i_a,i_b,i_c,theta,T_R_true_s,R_S_true_ohm,speed_rad_s,torque_nm", 0), 0u);
+}
+
+#ifdef IMEST_SIM_EXE
+TEST(SimCli, ExecutableWritesCsvAndFailsOnBadFlags) {
+  const std::string out = ::testing::TempDir() + "imsim_cli_test.csv";
+  const std::string cmd = std::string(IMEST_SIM_EXE) + " --preset exp1 --duration 0.01 --ideal-sensors --out " + out;
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  std::ifstream f(out);
+  std::string header, row;
+  std::getline(f, header);
+  std::getline(f, row);
+  EXPECT_EQ(header, imsim_cli_header());
+  double t, ua;
+  ASSERT_EQ(std::sscanf(row.c_str(), "%lf,%lf", &t, &ua), 2);
+  EXPECT_EQ(t, 0.0);
+  EXPECT_NEAR(ua, std::sqrt(2.0 / 3.0) * 230, 1e-6);
+  int rows = 1;
+  while (std::getline(f, row)) ++rows;
+  EXPECT_EQ(rows, 41);  // t = 0 .. 0.01 at 4 kHz
+  const std::string badcmd = std::string(IMEST_SIM_EXE) + " --fs nope > /dev/null 2>&1";
+  EXPECT_NE(std::system(badcmd.c_str()), 0);
+  const std::string badcfg = std::string(IMEST_SIM_EXE) + " --supply pwm --carrier-hz 9999 --duration 0.01 > /dev/null 2>&1";
+  EXPECT_NE(std::system(badcfg.c_str()), 0);
+  std::remove(out.c_str());
+}
+#endif
