@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# CTest smoke test of the main job (label demo): 60 s of motor time through the
+# whole chain into a temporary folder; checks that the files exist, that every
+# window went over the CAN log and that summary.md parses.
+# Usage: smoke-test.sh WORKDIR  (IMEST_DEMO_BIN and IMEST_MONITOR_BIN set by CTest)
+set -euo pipefail
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+work=${1:?usage: smoke-test.sh WORKDIR}
+rm -rf "$work"
+mkdir -p "$work"
+out="$work/results"
+
+"$here/tools/demo-run" --no-setup --no-build --quiet --out "$out" --duration 60 >"$work/stdout.txt"
+
+fail() { echo "demo smoke test: $*" >&2; exit 1; }
+for f in windows.csv exp1_windows.csv ifoc_fixed_windows.csv ifoc_adaptive_windows.csv \
+         exp2_avg30.csv exp2_avg120.csv summary.md \
+         fig02_exp1_voltages.png fig03_exp1_current.png fig04_exp1_speed.png \
+         fig05_tr_1s.png fig06_tr_30s.png fig07_tr_120s.png \
+         fig08_rs_1s.png fig09_rs_30s.png fig10_rs_120s.png fig11_ifoc_closed_loop.png \
+         raw/exp2.candump.log raw/exp2_monitor.csv; do
+  [ -s "$out/$f" ] || fail "missing or empty: $f"
+done
+
+/usr/bin/python3 - "$out" <<'EOF'
+import csv, re, sys
+out = sys.argv[1]
+need = ["t_end_s", "T_R_s", "R_S_ohm", "valid", "status", "T_R_true_s", "R_S_true_ohm"]
+rows = list(csv.DictReader(open(f"{out}/windows.csv")))
+assert len(rows) == 60, f"windows.csv: {len(rows)} rows, expected 60"
+for k in need:
+    assert k in rows[0], f"windows.csv: no column {k}"
+assert all(r["via_can"] == "1" for r in rows), "a window did not come through the CAN log"
+for r in rows:
+    assert abs(float(r["R_S_true_ohm"]) - 5.04) < 0.2, r
+    assert abs(float(r["T_R_true_s"]) - 0.12) < 0.01, r
+md = open(f"{out}/summary.md").read()
+# error table: one row per experiment and averaging level, numbers in every cell
+rows = re.findall(r"^\| (exp1|exp2|ifoc_fixed|ifoc_adaptive) \| (1 s|30 s avg|120 s avg) \|(.*)\|$", md, re.M)
+assert ("exp2", "1 s") in [(a, b) for a, b, _ in rows], "summary: no exp2 1-s row"
+for a, b, rest in rows:
+    cells = [c.strip() for c in rest.split("|")]
+    int(cells[0])
+    for c in cells[1:]:
+        float(c)
+tel = re.search(r"^\| exp2 \| (\d+) \| (\d+) \| [^|]* \| (\d+) \| (\d+) \|", md, re.M)
+assert tel, "summary: no exp2 telemetry row"
+assert int(tel.group(1)) == 60 and int(tel.group(3)) == 60, tel.group(0)
+assert int(tel.group(4)) == 0, "lost frames in a local log"
+assert re.search(r"^\| total \| [0-9.]+ \|$", md, re.M), "summary: no total wall time"
+print("demo smoke test: ok")
+EOF
