@@ -758,3 +758,55 @@ TEST(SocketCan, ErrorsAreClear) {
   imest_socketcan_close(&sc);
   imest_socketcan_close(&sc);
 }
+
+// ---------------------------------------------------------------- wiring
+
+// imest_background() publishes each result it returns, through the attached
+// port, and what arrives decodes to that result.
+TEST(CanPublish, BackgroundPublishesEveryResult) {
+  static imest_t s;
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  cfg.pole_pairs = 2;
+  cfg.ls_h = 0.2908f;
+  cfg.sigma = 0.096f;
+  cfg.window_s = 0.25f;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  FakePort p;
+  imest_can_port port = p.port();
+  ASSERT_EQ(imest_attach_can(&s, &port, IMEST_CAN_DEFAULT_BASE_ID), IMEST_OK);
+  imest_can_rx_t rx;
+  imest_can_rx_init(&rx, IMEST_CAN_DEFAULT_BASE_ID);
+  std::vector<imest_result_t> results;
+  size_t fed = 0;
+  std::vector<imest_can_window_t> windows;
+  for (int n = 0; n < 4000; n++) {
+    const float t = static_cast<float>(n) / 4000.0f;
+    const float w = 2.0f * 3.14159265f * 20.0f;
+    if (imest_isr_ab(&s, 100.0f * std::cos(w * t), 100.0f * std::sin(w * t), 5.0f * std::cos(w * t - 0.5f),
+                     5.0f * std::sin(w * t - 0.5f), std::fmod(0.9f * w * t / 2.0f, 6.2831853f))) {
+      imest_result_t r;
+      while (imest_background(&s, &r) == 1) results.push_back(r);
+      for (; fed < p.frames.size(); fed++) {
+        imest_can_window_t win;
+        if (imest_can_rx_feed(&rx, &p.frames[fed], &win, nullptr) & IMEST_CAN_EV_WINDOW) windows.push_back(win);
+      }
+    }
+  }
+  ASSERT_GE(results.size(), 3u);
+  ASSERT_EQ(p.frames.size(), 4u * results.size());
+  ASSERT_EQ(windows.size(), results.size());
+  for (size_t k = 0; k < results.size(); k++) {
+    EXPECT_EQ(windows[k].have, 0xFu);
+    EXPECT_EQ(windows[k].seq, results[k].seq);
+    EXPECT_EQ(windows[k].status, results[k].status);
+    EXPECT_EQ(windows[k].valid, results[k].valid ? 1 : 0);
+    if (std::isnan(results[k].tr_s)) {
+      EXPECT_TRUE(std::isnan(windows[k].tr_s));
+    } else {
+      EXPECT_EQ(windows[k].tr_s, static_cast<double>(static_cast<float>(results[k].tr_s)));
+    }
+  }
+  EXPECT_EQ(s.can_counter, results.size());
+  EXPECT_EQ(rx.st.lost + rx.st.corrupt + rx.st.repeated, 0u);
+}
