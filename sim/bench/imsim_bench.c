@@ -42,6 +42,9 @@ int main(int argc, char **argv) {
   imsim_config_preset(&c, "exp2");
   c.supply = IMSIM_SUPPLY_PWM;
   run("exp2 pwm 10kHz, 12-bit + 1 LSB noise, 4 kHz", &c, motor_s);
+  c.pwm_moments = false;
+  run("  same, --pwm-segments (reference accuracy)", &c, motor_s);
+  c.pwm_moments = true;
   c.aa_hz = 800.0;
   run("exp2 pwm 10kHz, 12-bit, AA 800 Hz", &c, motor_s);
   c.aa_hz = 0.0;

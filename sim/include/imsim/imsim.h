@@ -84,10 +84,12 @@ typedef struct {
   /* PWM inverter: regular-sampled sine-triangle, reference sampled once per half carrier
      period (at its centre, i.e. delay-compensated); dead time with current-sign logic. */
   double carrier_hz, vdc_v, dead_time_s;
-  bool pwm_moments; /* fast integrator: integrate each half carrier period in one step, the
-                       PWM input entering through its exact moments (~3e-5 relative error from
-                       the torque ripple within the step; default false = integrate piecewise
-                       between switching instants, ~1e-8; see README) */
+  bool pwm_moments; /* fast integrator with PWM. true (default, fast): one step per half carrier
+                       period, the PWM input entering through its exact moments; the electrical
+                       part is exact for the step's speed, the torque ripple inside the step is
+                       resolved only approximately (speed/angle ~3e-5 relative vs reference).
+                       false: integrate piecewise between switching instants (~1e-8, ~2.3x
+                       slower). See README. */
 
   /* IFOC (indirect field orientation, slip from the controller's T_R). */
   imsim_ifoc_mode ifoc_mode;
