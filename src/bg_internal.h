@@ -26,7 +26,5 @@ void imest_window_sums(const imest_window_t *w, double m, unsigned int pole_pair
 void imest_judge(const imest_t *s, const imest_window_stats_t *st, const imest_solve_out_t *so,
                  imest_result_t *r);
 
-/* Publish a result over the attached CAN port (can_publish.c). */
-int imest_can_publish(imest_t *s, const imest_result_t *r);
 
 #endif

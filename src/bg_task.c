@@ -5,6 +5,7 @@
 #include <stddef.h>
 
 #include "bg_internal.h"
+#include "imest/imest_can.h"
 
 static void result_clear(imest_result_t *r)
 {

@@ -10,8 +10,8 @@
 
 #include "csv_reader.h"
 #include "imest/imest.h"
-#ifdef IMEST_HAVE_CANDUMP
 #include "imest/imest_can.h"
+#ifdef IMEST_HAVE_CANDUMP
 #include "imest_candump.h"
 #endif
 
@@ -43,7 +43,7 @@ static void usage(FILE *o)
           "                      auto = current ~0 and rotor still at the first samples\n"
           "  --candump FILE      also write the published CAN frames (candump -L format)\n"
           "  --can-iface NAME    interface name in that log (default vcan0)\n"
-          "  --can-id ID         base CAN identifier (default 0x640)\n"
+          "  --can-id ID         base CAN identifier (default 0x6A0)\n"
           "  --quiet             no summary on stderr\n");
 }
 
@@ -95,7 +95,7 @@ int main(int argc, char **argv)
   int have_np = 0, have_ls = 0, have_sigma = 0, quiet = 0;
   double i_limit = -1.0, u_limit = -1.0; /* -1 = auto */
   int from_rest = -1;                     /* -1 = auto */
-  unsigned long can_id = 0x640;
+  unsigned long can_id = IMEST_CAN_DEFAULT_BASE_ID;
 
   for (int a = 1; a < argc; ++a) {
     const char *o = argv[a];
