@@ -33,6 +33,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -647,6 +648,12 @@ int main(int argc, char **argv)
     if (j->live) printf(" live_sent=%lu live_failed=%lu", j->live_sent, j->live_failed);
     printf("\n");
   }
-  printf("simulate_wall_s=%.2f\n", now_s() - t0);
+  struct rusage ru;
+  double cpu = NAN;
+  if (getrusage(RUSAGE_SELF, &ru) == 0)
+    cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+          (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+  const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+  printf("simulate_wall_s=%.2f simulate_cpu_s=%.2f cpus=%ld\n", now_s() - t0, cpu, ncpu);
   return fail;
 }
