@@ -68,6 +68,9 @@ typedef struct {
   unsigned int unresolved;    /* clusters that could not be separated (reported once) */
   unsigned int rejected;      /* isolated intervals whose float64 check failed */
   unsigned int merged;        /* duplicates merged (a root found from both sides of 1) */
+  unsigned int rescues;       /* domains where the float64 parity check triggered the grid rescue */
+  double max_chain_rel;       /* largest |polished - chain-precision estimate| / root, in the
+                                 domain variable: what the chain precision alone would give */
 } imest_roots_stats_t;
 
 /* Bounds (per polynomial domain; two domains per call). */

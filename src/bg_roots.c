@@ -6,11 +6,14 @@
  *  - Normalise: strip exact-zero leading and trailing coefficients (a root at 0
  *    is not positive), scale by a power of two so that max|c| is in [0.5, 1).
  *  - Two domains: p(x) = sum c_k x^k on (0,1] gives the roots kappa = x <= 1;
- *    the reversed q(x) = x^n p(1/x) on (0,1] gives kappa = 1/x >= 1. Every
- *    evaluation is on [0,1]: nothing overflows in float32. A root at (or
- *    within 2^-36 relative of) 1 may be found in both domains; duplicates
- *    closer than 2^-36 relative are merged (so distinct roots that close are
- *    reported once).
+ *    the reversed q(x) = x^n p(1/x) on (0,1] gives kappa = 1/x >= 1. Both
+ *    domains are searched up to 1 + 2^-8, so that a root at or next to 1 (where
+ *    the sign of p(1) is round-off) lies inside at least one of them. Every
+ *    evaluation is on [0, 1.004]: nothing overflows in float32. Roots closer
+ *    than 2^-36 relative are reported once (a root found from both sides, or
+ *    two distinct roots that close). An ill-conditioned multiple root within
+ *    1 + 2^-8 of 1 can be reported twice, as two float64 roots further apart
+ *    than 2^-36 (each a root to round-off level).
  *  - Chain precision (sreal_t): float32 by default, float64 with
  *    -DIMEST_ROOTS_DOUBLE. The chain P0 = p, P1 = p', P_{k+1} = -rem(P_{k-1},P_k)
  *    keeps each P_k normalised to max|c| = 1, drops leading coefficients
@@ -36,11 +39,17 @@
  *    (odd multiplicity there), and the point is kept only if
  *    |p(x)| <= 32 (n+1) eps_d sum|c_k x^k|; otherwise the interval is rejected
  *    (counted in stats.rejected).
+ *  - Safety net in float64 (parity_rescue): if the odd-multiplicity roots
+ *    found in a domain do not match the parity of the float64 sign change of p
+ *    over the domain, p is sampled on a fixed 19-point grid and cells with a
+ *    sign change but no root are solved in float64 (stats.rescues). Every
+ *    reported root is a float64 root (sign change or |p| at round-off level):
+ *    a chain that lost accuracy can miss roots but never invent one.
  *
  * Bounds, per call (two domains, n <= 20): V(x) evaluations <= 2 x (2 +
  * MAX_SPLITS + 20 MAX_BISECT), chain-precision bisection steps <= 2 x 20 x
  * MAX_BISECT, float64 polish evaluations <= 2 x 20 x (2 + 2 MAX_EXPAND + 2
- * MAX_POLISH + 1). Typical (testvector, n = 18): see test/solve (about 30
+ * MAX_POLISH + 1) + 2 x (19 + 20 MAX_POLISH) (rescue). Typical (testvector, n = 18): see test/solve (about 30
  * V evaluations, 60 bisection steps and 20 float64 evaluations).
  *
  * Stack: chain 21 x 21 sreal_t (1764 B float32, 3528 B float64) + isolation
@@ -66,6 +75,7 @@ typedef float sreal_t;
 #define IMEST_ROOTS_MAX_SPLITS 1024
 #define REFINE_REL ((sreal_t)9.5367431640625e-07) /* 2^-20 */
 #define NEWTON_STOP 9.313225746154785e-10          /* 2^-30 */
+#define DOMAIN_TOP ((sreal_t)1.00390625)           /* 1 + 2^-8: the domains overlap */
 #define MERGE_REL 1.4551915228366852e-11           /* 2^-36 */
 
 typedef struct {
@@ -178,6 +188,7 @@ static int sign_changes(const chain_t *ch, sreal_t x, imest_roots_stats_t *st) {
 static double newton_bracketed(const double *c, int n, int order, double a, double b, double fa,
                                imest_roots_stats_t *st) {
   double x = 0.5 * (a + b);
+  int prev_newton = 0;
   for (int it = 0; it < IMEST_ROOTS_MAX_POLISH; ++it) {
     double f, df;
     eval_d(c, n, order, x, &f, &df);
@@ -187,10 +198,14 @@ static double newton_bracketed(const double *c, int n, int order, double a, doub
       a = x;
     else
       b = x;
-    double xn = x - f / df;
+    const double step = f / df;
+    if (fabs(step) <= 4.0 * DBL_EPSILON * fabs(x)) return x - step; /* converged to ulp level */
+    double xn = x - step;
     const int newton = (xn > a && xn < b); /* false for NaN/Inf too */
     if (!newton) xn = 0.5 * (a + b);
-    if (newton && fabs(xn - x) <= NEWTON_STOP * fabs(xn)) return xn;
+    /* two Newton steps in a row: in the convergent regime */
+    if (newton && prev_newton && fabs(xn - x) <= NEWTON_STOP * fabs(xn)) return xn;
+    prev_newton = newton;
     if (b - a <= 4.0 * DBL_EPSILON * fabs(b)) return xn;
     x = xn;
   }
@@ -273,12 +288,13 @@ static int polish(const double *c, int n, double a, double b, double lo, double 
   ++st->polish_evals;
   if (fabs(px) <= 32.0 * (double)(n + 1) * DBL_EPSILON * abs_sum_d(c, n, x)) {
     *root = x;
-    return 1;
+    return 2;
   }
   return 0;
 }
 
-/* Refine one interval (count >= 1) in chain precision and polish it in float64. */
+/* Refine one interval (count >= 1) in chain precision and polish it in float64.
+ * Returns 0 (rejected), 1 (float64 sign change: odd multiplicity) or 2 (even). */
 static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root, imest_roots_stats_t *st) {
   const double lo = (double)iv.a, hi = (double)iv.b;
   sreal_t a = iv.a, b = iv.b;
@@ -320,20 +336,58 @@ static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double 
   } else {
     a = b; /* exact zero at b in chain precision */
   }
-  return polish(pd, n, (double)a, (double)b, lo, hi, root, st);
+  const int kind = polish(pd, n, (double)a, (double)b, lo, hi, root, st);
+  if (kind == 0) return 0;
+  const double est = 0.5 * ((double)a + (double)b);
+  const double dev = fabs(*root - est) / fabs(*root);
+  if (dev > st->max_chain_rel) st->max_chain_rel = dev;
+  return kind;
 }
 
-/* Roots of pd (float64, normalised, degree n >= 1, pd[0] != 0) in (0,1]. */
+/* float64 safety net for a chain that lost accuracy: the number of odd-
+ * multiplicity roots in (0, TOP] must have the parity of the sign change of p
+ * between 0+ and TOP. If not, p is sampled in float64 at a fixed grid
+ * (0, 2^-16 .. 2^-1, 0.75, TOP; 19 points) and every grid cell with a sign
+ * change and no root yet is solved by the bracketed float64 Newton. */
+static int parity_rescue(const double *pd, int n, double *out, int *odd, int nout, imest_roots_stats_t *st) {
+  const double top = (double)DOMAIN_TOP;
+  const double ftop = imest_poly_eval(pd, n, top);
+  ++st->polish_evals;
+  int nodd = 0;
+  for (int i = 0; i < nout; ++i) nodd += odd[i];
+  if (sgn_d(ftop) == 0 || ((sgn_d(pd[0]) != sgn_d(ftop)) == ((nodd & 1) == 1))) return nout;
+  ++st->rescues;
+  double glo = 0.0, flo = pd[0];
+  for (int k = 1; k <= 18; ++k) {
+    const double ghi = (k <= 16) ? ldexp(1.0, k - 17) : (k == 17) ? 0.75 : top;
+    const double fhi = imest_poly_eval(pd, n, ghi);
+    ++st->polish_evals;
+    if (sgn_d(flo) * sgn_d(fhi) < 0) {
+      int inside = 0;
+      for (int i = 0; i < nout; ++i) inside += (out[i] > glo && out[i] <= ghi);
+      if (inside == 0 && nout < NMAX) {
+        out[nout] = newton_bracketed(pd, n, 0, glo, ghi, flo, st);
+        odd[nout++] = 1;
+      }
+    }
+    glo = ghi;
+    flo = fhi;
+  }
+  return nout;
+}
+
+/* Roots of pd (float64, normalised, degree n >= 1, pd[0] != 0) in (0, 1 + 2^-8]. */
 static int domain_roots(chain_t *ch, const double *pd, int n, double *out, imest_roots_stats_t *st) {
   ival_t stack[IMEST_ROOTS_MAX_DEPTH + 2];
+  int odd[NMAX];
   int top = 0, nout = 0, splits = 0;
   chain_build(ch, pd, n);
   if ((unsigned int)ch->len > st->chain_len) st->chain_len = (unsigned int)ch->len;
   if (ch->deg[0] == 0) return 0;
   stack[top].a = 0;
-  stack[top].b = 1;
+  stack[top].b = DOMAIN_TOP;
   stack[top].va = sign_changes(ch, 0, st);
-  stack[top].vb = sign_changes(ch, 1, st);
+  stack[top].vb = sign_changes(ch, DOMAIN_TOP, st);
   stack[top].depth = 0;
   ++top;
   while (top > 0) {
@@ -364,20 +418,23 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double *out, imest
       ++st->unresolved;
     }
     double x;
-    if (nout < NMAX && refine(ch, pd, n, iv, &x, st)) {
+    const int kind = (nout < NMAX) ? refine(ch, pd, n, iv, &x, st) : 0;
+    if (kind != 0) {
+      odd[nout] = (kind == 1);
       out[nout++] = x;
     } else {
       ++st->rejected;
     }
   }
-  return nout;
+  return parity_rescue(pd, n, out, odd, nout, st);
 }
 
 int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int max, imest_roots_stats_t *st) {
   imest_roots_stats_t dummy;
   if (st == 0) st = &dummy;
   st->sturm_evals = st->bisect_steps = st->polish_evals = st->chain_len = 0;
-  st->unresolved = st->rejected = st->merged = 0;
+  st->unresolved = st->rejected = st->merged = st->rescues = 0;
+  st->max_chain_rel = 0.0;
   if (c == 0 || deg < 0 || deg > NMAX || (max > 0 && roots == 0)) return -1;
   int hi = -1, lo = -1;
   double mx = 0.0;
@@ -402,10 +459,10 @@ int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int ma
 
   chain_t ch;
   double found[2 * NMAX];
+  double xd[NMAX];
   int nf = domain_roots(&ch, p, n, found, st);
-  double xq[NMAX];
-  const int nq = domain_roots(&ch, q, n, xq, st);
-  for (int i = 0; i < nq; ++i) found[nf++] = 1.0 / xq[i];
+  const int nq = domain_roots(&ch, q, n, xd, st);
+  for (int i = 0; i < nq; ++i) found[nf++] = 1.0 / xd[i];
 
   /* sort ascending (insertion; nf <= 40) and merge near-duplicates */
   for (int i = 1; i < nf; ++i) {
