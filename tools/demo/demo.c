@@ -408,8 +408,8 @@ static int run_job(job_t *j)
             j->id_seq = (int)r.seq;
             j->id_status = r.status;
           }
-        } else if (j->id == EXP1 && have_id == 0 && r.tr_s > 0 && r.rs_ohm > 0) {
-          have_id = 1; /* no valid window yet: the first with an estimate */
+        } else if (j->id == EXP1 && have_id == 0 && r.seq == 0 && r.tr_s > 0 && r.rs_ohm > 0) {
+          have_id = 1; /* no valid window yet: the run-up window's estimate, flagged invalid */
           j->id_tr = r.tr_s;
           j->id_rs = r.rs_ohm;
           j->id_seq = (int)r.seq;
@@ -447,8 +447,8 @@ static int run_job(job_t *j)
     fprintf(f, "seq,valid,status,T_R_s,R_S_ohm,source\n%d,%d,%s,%.9g,%.9g,%s\n", j->id_seq,
             have_id == 2, have_id ? imest_status_name(j->id_status) : "none", j->id_tr, j->id_rs,
             have_id == 2   ? "first valid window"
-            : have_id == 1 ? "first window with an estimate (none valid)"
-                           : "nominal (no estimate)");
+            : have_id == 1 ? "run-up window 0, NOT valid (no valid window)"
+                           : "nominal parameters (no usable estimate)");
     if (fclose(f) != 0) return -1;
     if (exp1_wave(j, dir, j->id_tr, j->id_rs) != 0) return -1;
   }

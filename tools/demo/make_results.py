@@ -248,8 +248,12 @@ def stats_note(n, mean, p95, mx, bias):
 def fig_exp1(out, wave, ident, exp1rows):
     t = wave["t_s"]
     tr_id, rs_id = ident["T_R_s"], ident["R_S_ohm"]
-    how = (f"identified in window {ident['seq']} ({ident['status']}): T_R = {tr_id:.4f} s, "
-           f"R_S = {rs_id:.3f} Ω")
+    if str(ident["valid"]) == "1":
+        how = (f"identified in window {ident['seq']} (valid): T_R = {tr_id:.4f} s, "
+               f"R_S = {rs_id:.3f} Ω")
+    else:
+        how = (f"{ident['source']}, status {ident['status']}: T_R = {tr_id:.4f} s, "
+               f"R_S = {rs_id:.3f} Ω")
     files = []
     # Fig. 2: voltages
     fig, axs = plt.subplots(2, 1, figsize=(10, 6.0))
