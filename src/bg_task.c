@@ -85,10 +85,10 @@ int imest_background(imest_t *s, imest_result_t *out)
 
   /* centre later windows on the latest trusted estimate */
   if (out->valid) {
-    s->last_k1 = out->k1;
-    s->last_k2 = out->k2;
+    s->last_k1 = (float)out->k1;
+    s->last_k2 = (float)out->k2;
   }
-  if (s->last_k2 > 0.0) imest_centre_from_k(w->c0, s->last_k1, s->last_k2, m);
+  if (s->last_k2 > 0.0f) imest_centre_from_k(w->c0, (double)s->last_k1, (double)s->last_k2, m);
   for (unsigned int p = 0; p < IMEST_NACC; ++p) {
     w->sum[p] = 0;
     w->blk[p] = 0;

@@ -48,9 +48,10 @@ void imest_window_sums(const imest_window_t *w, double m, unsigned int pole_pair
   out->ry = ry;
 
   const double n = w->used > 0u ? (double)w->used : 1.0;
-  const double r44 = out->rw[3][3], r11 = out->rw[0][0], r66 = out->rw[5][5];
+  const double r44 = out->rw[3][3], r66 = out->rw[5][5];
   st->i_rms_a = sqrt(fmax(r44, 0.0) / n);
-  st->di_rms = sqrt(fmax(r11, 0.0) / n);
   /* |W6|^2 = (n w')^2 + (n w)^4 per |i|^2: a current-weighted speed measure */
+  const double cross = (double)w->sum[36] + (double)w->blk[36];
+  st->slip_rate = (r44 > 0.0) ? cross / r44 : 0.0;
   st->w_rms = (r44 > 0.0) ? sqrt(sqrt(fmax(r66 / r44, 0.0))) / (double)pole_pairs : 0.0;
 }

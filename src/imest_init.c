@@ -15,6 +15,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->window_s = 1.0f;
   cfg->filter_hz = 100.0f;
   cfg->aa_hz = 0.0f;
+  cfg->u_delay_s = 0.0f;
   cfg->warmup_s = 0.0f;
   cfg->start_at_rest = 0;
   cfg->tr_nominal_s = 0.1f;
@@ -25,7 +26,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->max_pe_k2_rel = 0.1f;
   cfg->max_ei = 3.0f;
   cfg->min_current_a = 0.05f;
-  cfg->min_slip_ratio = 0.05f;
+  cfg->min_slip_ratio = 0.02f;
   cfg->i_limit_a = 0.0f;
   cfg->u_limit_v = 0.0f;
   cfg->i_absurd_a = 1.0e4f;
@@ -52,6 +53,8 @@ int imest_config_check(const imest_config_t *cfg, const char **field)
   else if (!finite_pos(cfg->filter_hz) || (double)cfg->filter_hz >= 0.4 * fs) bad = "filter_hz";
   else if (!(cfg->aa_hz == 0.0f || (finite_pos(cfg->aa_hz) && (double)cfg->aa_hz < 0.45 * fs)))
     bad = "aa_hz";
+  else if (!(isfinite(cfg->u_delay_s) && cfg->u_delay_s >= 0.0f &&
+             (double)cfg->u_delay_s * fs <= 1.0 + 1e-6)) bad = "u_delay_s";
   else if (!(isfinite(cfg->warmup_s) && cfg->warmup_s >= 0.0f &&
              cfg->warmup_s <= cfg->window_s * 100.0f)) bad = "warmup_s";
   else if (!finite_pos(cfg->tr_nominal_s)) bad = "tr_nominal_s";
@@ -164,6 +167,7 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   s->i_abs = (imest_real_t)cfg->i_absurd_a;
   s->u_abs = (imest_real_t)cfg->u_absurd_v;
   s->dth_max = (imest_real_t)cfg->speed_limit_rad_s;
+  s->dly = (imest_real_t)((double)cfg->u_delay_s * fs);
   s->window_n = (uint32_t)((double)cfg->window_s * fs + 0.5);
 
   design_bw3(&s->bw, (double)cfg->filter_hz, fs);

@@ -1,17 +1,18 @@
 /* ISR stage 4: accumulation of the 36 independent entries of
  * [W e]^T [W e] (upper triangle of an 8x8, row-major: R_W 7x7, R_We, R_ee) and
- * the lock-free hand-off of a finished window.
+ * the rotation of the rotor-frame current i x di/dt (entry 36). The hand-off
+ * itself is in isr_sample.c.
  *
  * Precision: each entry is summed into a short float32 block; every sample
  * folds ONE entry's block into its window sum (round robin), so each block
- * holds at most 36 products and no sample pays for more than one fold. */
+ * holds at most 37 products and no sample pays for more than one fold. */
 #ifndef IMEST_ISR_ACCUMULATE_H
 #define IMEST_ISR_ACCUMULATE_H
 
 #include "isr_real.h"
 
 static inline void isr_accumulate(imest_window_t *w, const imest_real_t zx[8],
-                                  const imest_real_t zy[8], uint32_t fold)
+                                  const imest_real_t zy[8], imest_real_t cross, uint32_t fold)
 {
   imest_real_t *b = w->blk;
   /* Written out (no loop): a compiler need not unroll a triangular loop, and
@@ -27,6 +28,7 @@ static inline void isr_accumulate(imest_window_t *w, const imest_real_t zx[8],
   ACC(33, 6, 6); ACC(34, 6, 7);
   ACC(35, 7, 7);
 #undef ACC
+  b[36] += cross;
   w->sum[fold] += b[fold];
   b[fold] = RL(0);
 }

@@ -84,19 +84,27 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
     w->flags |= fault | IMEST_FLAG_WARMUP;
     isr_restart_filters(s);
   } else {
+    /* align currents and angle with lagging voltage samples (dly = 0: no-op) */
+    const imest_real_t a = s->dly;
+    const imest_real_t ia_d = ia - a * (ia - s->ia_prev), ib_d = ib - a * (ib - s->ib_prev);
+    const imest_real_t w_now = dth * s->fs, w_d = w_now - a * (w_now - s->wr_prev);
+    s->ia_prev = ia;
+    s->ib_prev = ib;
+    s->wr_prev = w_now;
+
     /* rotation into the rotor frame by n_p * theta */
     imest_real_t sn, cs;
-    isr_sincos(isr_wrap_pi(s->n * th), &sn, &cs);
+    isr_sincos(isr_wrap_pi(s->n * (th - a * dth)), &sn, &cs);
     imest_real_t ux, uy, ix, iy;
     isr_rotate(sn, cs, ua, ub, &ux, &uy);
-    isr_rotate(sn, cs, ia, ib, &ix, &iy);
+    isr_rotate(sn, cs, ia_d, ib_d, &ix, &iy);
 
     isr_signals_t g;
     g.ux = isr_filter_deriv(s, &s->ch[0], ux);
     g.uy = isr_filter_deriv(s, &s->ch[1], uy);
     g.ix = isr_filter_deriv(s, &s->ch[2], ix);
     g.iy = isr_filter_deriv(s, &s->ch[3], iy);
-    const imest_real_t w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, dth * s->fs);
+    const imest_real_t w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, w_d);
     isr_filter_speed(s, &s->ch[4], w_raw, &g.w, &g.dw);
 
     if (s->warm) {
@@ -105,7 +113,9 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
     } else {
       imest_real_t zx[8], zy[8];
       isr_regressor(s, &g, w->c0, zx, zy);
-      isr_accumulate(w, zx, zy, s->fold);
+      /* i x di/dt: in steady state |i|^2 times the slip frequency */
+      const imest_real_t cross = g.ix.x * g.iy.dx - g.iy.x * g.ix.dx;
+      isr_accumulate(w, zx, zy, cross, s->fold);
       s->fold = (s->fold + 1u == IMEST_NACC) ? 0u : s->fold + 1u;
       w->used++;
     }

@@ -132,6 +132,13 @@ typedef struct {
                                  anti-alias filter, its cut-off [Hz]; the angle is
                                  then passed through a digital model of it so all
                                  channels see the same delay (0 = none, default) */
+  float u_delay_s;          /**< how much the voltage samples lag the current samples [s],
+                                 0 .. 1/fs_hz (default 0). E.g. a phase voltage
+                                 reconstructed from the duty cycles of the PWM period that
+                                 just ended lags by half a carrier period (50 us at 10 kHz):
+                                 uncompensated, that biases R_S by about +5 % at 30 Hz. The
+                                 currents and the angle are delayed to match (linear
+                                 interpolation). */
   float warmup_s;           /**< samples discarded after start/fault while the filters
                                  settle [s] (default 0: derived from filter_hz) */
   int start_at_rest;        /**< nonzero: the first sample follows a zero history
@@ -151,8 +158,9 @@ typedef struct {
   float max_ei;             /**< largest residual error index E_I (default 3.0: a sanity bound; the
                                  PE index is the evidence of trust, README) */
   float min_current_a;      /**< least rms stator current (alpha/beta amplitude) [A] (default 0.05) */
-  float min_slip_ratio;     /**< least rms rotor-frame current rate / (rms current / T_R): a
-                                 measure of slip excitation (default 0.05) */
+  float min_slip_ratio;     /**< least slip excitation: mean rotation rate of the rotor-frame
+                                 current x tr_nominal_s, i.e. slip frequency x T_R in steady
+                                 state (default 0.02; rated load is about 1) */
 
   /* Input plausibility (per sample, ISR). */
   float i_limit_a;          /**< |phase current| >= this counts as ADC saturation (0 = off) */
@@ -196,7 +204,7 @@ typedef struct {
   double pe_k2;             /**< parametric error index of K2 (absolute, 1/s) */
   double pe_k1_rel;         /**< pe_k1 / K1 */
   double pe_k2_rel;         /**< pe_k2 / K2 */
-  double slip_ratio;        /**< excitation measure compared with min_slip_ratio */
+  double slip_ratio;        /**< slip excitation (slip frequency x tr_nominal_s), see min_slip_ratio */
   double i_rms_a;           /**< rms stator current over the window (alpha/beta amplitude) */
   unsigned int n_roots;     /**< positive roots of the resultant */
   unsigned int n_admissible;/**< roots with K1 > 0 and T_R in band */
@@ -216,8 +224,9 @@ typedef double imest_real_t;
 typedef float imest_real_t;
 #endif
 
-/** Number of independent accumulated entries: 28 of R_W (7 columns), 7 of R_Wy, 1 of R_y. */
-#define IMEST_NACC 36
+/** Number of accumulated entries: 28 of R_W (7 columns), 7 of R_Wy, 1 of R_y,
+ *  and the rotation of the rotor-frame current (sum of i x di/dt: slip excitation). */
+#define IMEST_NACC 37
 
 /** One window's sums, as handed from the ISR to the background. */
 typedef struct {
@@ -259,6 +268,8 @@ typedef struct {
   /* ISR state */
   imest_chan_t ch[5];            /* u_x, u_y, i_x, i_y, omega */
   imest_real_t aa_s1, aa_s2;            /* anti-alias model state (speed) */
+  imest_real_t dly;                     /* u_delay_s * fs: currents/angle delay (fraction) */
+  imest_real_t ia_prev, ib_prev, wr_prev; /* previous alpha/beta current, raw speed */
   imest_real_t th_prev;                 /* previous mechanical angle (as given) */
   uint32_t k;                    /* sample index in the current window */
   uint32_t warm;                 /* warm-up samples still to discard */
@@ -273,7 +284,7 @@ typedef struct {
   /* background-only state */
   float sigma, ls_h, tr_nominal_s, tr_min_s, tr_max_s, rs_min_ohm, rs_max_ohm;
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
-  double last_k1, last_k2;       /* last valid estimate: centring of later windows */
+  float last_k1, last_k2;        /* last valid estimate: centring of later windows */
   const struct imest_can_port *can; /* telemetry port (NULL: none) */
   uint32_t can_base_id;
   uint32_t can_counter;

@@ -96,15 +96,31 @@ TEST(Handoff, OverrunIsCountedAndVisibleNeverTorn) {
 
 TEST(Handoff, WarmupIsMarkedAndStartAtRestSkipsIt) {
   imest_config_t cfg = small_config();
+  cfg.window_s = 0.05f;  // 200 samples: the 123-sample warm-up is most of it
   static imest_t s;
   imest_result_t r;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   int k = 0;
-  feed(&s, 400, k);
+  feed(&s, 200, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_EQ(r.status, IMEST_ST_WARMUP);
   EXPECT_FALSE(r.valid);
-  EXPECT_LT(r.used_samples, 400u);
+  EXPECT_TRUE(r.flags & IMEST_FLAG_WARMUP);
+  EXPECT_EQ(r.used_samples, 200u - 123u);
+  feed(&s, 200, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_FALSE(r.flags & IMEST_FLAG_WARMUP);
+  EXPECT_EQ(r.used_samples, 200u);
+
+  // a longer window keeps its flag but is judged on the samples it used
+  cfg = small_config();
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  k = 0;
+  feed(&s, 400, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_TRUE(r.flags & IMEST_FLAG_WARMUP);
+  EXPECT_NE(r.status, IMEST_ST_WARMUP);
+  EXPECT_EQ(r.used_samples, 400u - 123u);
   feed(&s, 400, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_FALSE(r.flags & IMEST_FLAG_WARMUP);

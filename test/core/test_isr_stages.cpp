@@ -187,7 +187,7 @@ TEST(IsrAccumulate, FoldedBlocksEqualFloat64SumsToFewUlps) {
       zx[i] = (float)(N(rng) * (1 + i));
       zy[i] = (float)(N(rng) + 3.0);
     }
-    isr_accumulate(&w, zx, zy, fold);
+    isr_accumulate(&w, zx, zy, 0.5f, fold);
     fold = (fold + 1 == IMEST_NACC) ? 0 : fold + 1;
     unsigned p = 0;
     for (int i = 0; i < 8; ++i)
@@ -201,4 +201,5 @@ TEST(IsrAccumulate, FoldedBlocksEqualFloat64SumsToFewUlps) {
       const double scale = 4000.0 * ((1 + i) * (1 + j) + 10.0);
       EXPECT_NEAR(got, ref[p], 2e-6 * scale) << i << "," << j;
     }
+  EXPECT_NEAR((double)w.sum[36] + (double)w.blk[36], 2000.0, 1e-3);
 }

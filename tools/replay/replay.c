@@ -33,6 +33,8 @@ static void usage(FILE *o)
           "  --filter-hz HZ      front-end Butterworth-3 cut-off (default 100)\n"
           "  --aa-hz HZ          cut-off of a 2nd-order analog anti-alias filter on the\n"
           "                      electrical channels, modelled on the angle (default none)\n"
+          "  --u-delay S         the voltage samples lag the currents by S seconds (e.g. 50e-6\n"
+          "                      for volt-seconds of the PWM period that just ended at 10 kHz)\n"
           "  --tr-nominal S      nominal T_R for scaling (default 0.1)\n"
           "  --tr-min S --tr-max S   admissible T_R band (default 0.001 .. 10)\n"
           "  --max-pe-k2 X       validity threshold on the relative PE index of K2 (0.1)\n"
@@ -141,6 +143,10 @@ int main(int argc, char **argv)
       NEED_VALUE;
       if (parse_num(o, v, &d)) return 2;
       cfg.aa_hz = (float)d;
+    } else if (!strcmp(o, "--u-delay")) {
+      NEED_VALUE;
+      if (parse_num(o, v, &d)) return 2;
+      cfg.u_delay_s = (float)d;
     } else if (!strcmp(o, "--tr-nominal")) {
       NEED_VALUE;
       if (parse_num(o, v, &d)) return 2;
