@@ -143,19 +143,32 @@ TEST(RobustInput, PlausibleSpikeInvalidatesOnlyItsWindow) {
 }
 
 // A fault in the last samples of a window: the filter restart (warm-up) spills
-// into the next window, which is then invalid as warmup; the one after is valid.
+// into the next window (flagged warmup, fewer samples used). With the default
+// warm-up (30 ms) that window may still be valid; with a warm-up longer than
+// half a window (here 0.3 s of 0.5 s) it is invalid as warmup, and the one
+// after is valid.
 TEST(RobustInput, FaultAtWindowEndSpillsWarmupIntoNextWindow) {
-  Rig r;
-  r.start();
-  r.run(3);
-  const double pre = mean_tr(r, 1, 2);
-  r.run(6, [&](Sample &s) {
-    if (s.window == 3 && s.pos == (int)r.window_n - 5) s.i[0] = kNaN;
-  });
-  ASSERT_NE(r.window(4), nullptr);
-  EXPECT_EQ(r.window(4)->status, IMEST_ST_WARMUP) << r.dump();
-  EXPECT_TRUE(r.window(4)->flags & IMEST_FLAG_WARMUP);
-  EXPECT_EQ(check_fault(r, "NaN 5 samples before window end", 3, 3, IMEST_ST_INPUT_FAULT, pre), 2);
+  for (float warmup_s : {0.0f, 0.3f}) {
+    SCOPED_TRACE(warmup_s);
+    Rig r;
+    r.cfg.warmup_s = warmup_s;
+    r.start();
+    r.run(3);
+    const double pre = mean_tr(r, 1, 2);
+    r.run(6, [&](Sample &s) {
+      if (s.window == 3 && s.pos == (int)r.window_n - 5) s.i[0] = kNaN;
+    });
+    const imest_result_t *w4 = r.window(4);
+    ASSERT_NE(w4, nullptr);
+    EXPECT_TRUE(w4->flags & IMEST_FLAG_WARMUP) << r.dump();
+    EXPECT_LT(w4->used_samples, r.window_n);
+    const int rec = check_fault(r, warmup_s > 0 ? "NaN at window end, warm-up 0.3 s" : "NaN at window end, default warm-up",
+                                3, 3, IMEST_ST_INPUT_FAULT, pre);
+    if (warmup_s > 0) {
+      EXPECT_EQ(w4->status, IMEST_ST_WARMUP) << r.dump();
+      EXPECT_EQ(rec, 2);
+    }
+  }
 }
 
 // A fault lasting longer than a window: every window it touches is invalid.
