@@ -56,7 +56,8 @@ void imest_resultant(const imest_tables_t *t, double r[21], int generic);
 /* ----------------------------------------------------------------- bg_roots.c
  * All distinct positive roots of sum_k c[k] x^k (deg <= IMEST_POLY_MAXDEG) by
  * Sturm sequences and bisection, (0,1] on p and (1,inf) on the reversed
- * polynomial, each root polished in float64 (see bg_roots.c for the design).
+ * polynomial in four scaled domains, each root polished in float64 (see
+ * bg_roots.c for the design).
  * The Sturm chain is float32 unless IMEST_ROOTS_DOUBLE is defined.
  * Returns the number of roots written to roots[] (ascending, at most max), or
  * -1 for a non-finite or all-zero polynomial or a bad deg. */
@@ -73,11 +74,19 @@ typedef struct {
                                  domain variable: what the chain precision alone would give */
 } imest_roots_stats_t;
 
-/* Bounds (per polynomial domain; two domains per call). */
+/* Bounds (per polynomial domain; IMEST_ROOTS_DOMAINS domains per call). */
 #define IMEST_ROOTS_MAX_DEPTH 48   /* isolation: interval halvings from (0,1] */
 #define IMEST_ROOTS_MAX_BISECT 48  /* refinement bisections in chain precision */
 #define IMEST_ROOTS_MAX_POLISH 40  /* safeguarded Newton/bisection steps in float64 */
 #define IMEST_ROOTS_MAX_EXPAND 8   /* bracket expansions when float64 sees no sign change */
+#define IMEST_ROOTS_MAX_SPLITS 1024 /* isolation halvings per domain */
+#define IMEST_ROOTS_DOMAINS 4u    /* kappa in (0,1], (1,16], (16,256], (256,inf) */
+/* Hard bounds per call (4 domains, <= 20 roots each), asserted by the tests. */
+#define IMEST_ROOTS_BOUND_STURM (IMEST_ROOTS_DOMAINS * (2u + IMEST_ROOTS_MAX_SPLITS + IMEST_POLY_MAXDEG * IMEST_ROOTS_MAX_BISECT))
+#define IMEST_ROOTS_BOUND_BISECT (IMEST_ROOTS_DOMAINS * IMEST_POLY_MAXDEG * IMEST_ROOTS_MAX_BISECT)
+#define IMEST_ROOTS_BOUND_POLISH                                                                      \
+  (IMEST_ROOTS_DOMAINS * (IMEST_POLY_MAXDEG * (2u * (2u + 2u * IMEST_ROOTS_MAX_EXPAND + IMEST_ROOTS_MAX_POLISH) + 1u) + \
+                          20u + 18u * IMEST_ROOTS_MAX_POLISH))
 
 int imest_poly_positive_roots(const double *c, int deg, double *roots, int max);
 int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int max,
@@ -110,6 +119,9 @@ int imest_select(const imest_tables_t *t, const double *kappa, int n, const imes
 #define IMEST_PE_MAX_PROBE 80  /* step-out probes per side */
 #define IMEST_PE_MAX_ROOT 40   /* Illinois iterations per crossing */
 #define IMEST_PE_MAX_MIN 60    /* Brent minimisation iterations per K1 extreme */
+#define IMEST_QUALITY_BOUND (2u * (IMEST_PE_MAX_PROBE + IMEST_PE_MAX_ROOT) + 2u * (1u + IMEST_PE_MAX_MIN))
+#define IMEST_SOLVE_WORK_BOUND \
+  (IMEST_ROOTS_BOUND_STURM + IMEST_ROOTS_BOUND_BISECT + IMEST_ROOTS_BOUND_POLISH + IMEST_QUALITY_BOUND)
 
 /* Hessian, positive definiteness, quadratic and exact PE indices at the
  * selected candidate; writes hessian, hessian_pd, pe_k1, pe_k2, pe_quad,

@@ -5,15 +5,20 @@
  * Design
  *  - Normalise: strip exact-zero leading and trailing coefficients (a root at 0
  *    is not positive), scale by a power of two so that max|c| is in [0.5, 1).
- *  - Two domains: p(x) = sum c_k x^k on (0,1] gives the roots kappa = x <= 1;
- *    the reversed q(x) = x^n p(1/x) on (0,1] gives kappa = 1/x >= 1. Both
- *    domains are searched up to 1 + 2^-8, so that a root at or next to 1 (where
- *    the sign of p(1) is round-off) lies inside at least one of them. Every
- *    evaluation is on [0, 1.004]: nothing overflows in float32. Roots closer
- *    than 2^-36 relative are reported once (a root found from both sides, or
- *    two distinct roots that close). An ill-conditioned multiple root within
- *    1 + 2^-8 of 1 can be reported twice, as two float64 roots further apart
- *    than 2^-36 (each a root to round-off level).
+ *  - Four domains, each searched on (lo, 1 + 2^-8] so that neighbouring
+ *    domains overlap (a root at a domain boundary, where the sign of p is
+ *    round-off, lies inside one of them): kappa in (0,1] on p(y); (1,16] on
+ *    p(16y) and (16,256] on p(256y), y > 1/16 - 2^-12; (256,inf) on q(z/256),
+ *    q(x) = x^n p(1/x) the reversed polynomial. Each domain polynomial is
+ *    scaled exactly (powers of two) and renormalised, so the coefficients that
+ *    matter in that range of kappa are not lost relative to the others: with
+ *    only the split at 1 (MATH.md §6) the float32 chain missed in-band roots
+ *    near kappa = 40 (K2 = 320) of realistic windows. Every evaluation is on
+ *    [0, 1.004]: nothing overflows in float32. Roots closer than 2^-36
+ *    relative are reported once (a root found from two domains, or two
+ *    distinct roots that close). An ill-conditioned multiple root at a domain
+ *    boundary can be reported twice, as two float64 roots further apart than
+ *    2^-36 (each a root to round-off level).
  *  - Chain precision (sreal_t): float32 by default, float64 with
  *    -DIMEST_ROOTS_DOUBLE. The chain P0 = p, P1 = p', P_{k+1} = -rem(P_{k-1},P_k)
  *    keeps each P_k normalised to max|c| = 1, drops leading coefficients
@@ -21,7 +26,7 @@
  *    TOL*len(P_{k-1}) (a gcd: multiple roots; the chain then counts distinct
  *    roots) or at degree 0. V(x) = sign changes of the chain (zeros ignored);
  *    distinct roots in (a,b] = V(a) - V(b).
- *  - Isolation: depth-first halving of (0,1] while the count is >= 2, at most
+ *  - Isolation: depth-first halving of the domain while the count is >= 2, at most
  *    IMEST_ROOTS_MAX_DEPTH halvings deep and IMEST_ROOTS_MAX_SPLITS halvings per
  *    domain; an interval that cannot be split further (depth, split budget, or
  *    its midpoint not representable) is refined as one root ("unresolved").
@@ -46,15 +51,14 @@
  *    reported root is a float64 root (sign change or |p| at round-off level):
  *    a chain that lost accuracy can miss roots but never invent one.
  *
- * Bounds, per call (two domains, n <= 20): V(x) evaluations <= 2 x (2 +
- * MAX_SPLITS + 20 MAX_BISECT), chain-precision bisection steps <= 2 x 20 x
- * MAX_BISECT, float64 polish evaluations <= 2 x 20 x (2 + 2 MAX_EXPAND + 2
- * MAX_POLISH + 1) + 2 x (19 + 20 MAX_POLISH) (rescue). Typical (testvector, n = 18): see test/solve (about 30
+ * Bounds, per call: IMEST_ROOTS_BOUND_STURM (7944) V(x) evaluations,
+ * IMEST_ROOTS_BOUND_BISECT (3840) chain-precision bisection steps,
+ * IMEST_ROOTS_BOUND_POLISH (12320) float64 polish evaluations (bg_poly.h). Typical (testvector, n = 18): see test/solve (about 30
  * V evaluations, 60 bisection steps and 20 float64 evaluations).
  *
  * Stack: chain 21 x 21 sreal_t (1764 B float32, 3528 B float64) + isolation
- * stack 50 intervals (<= 1 KB) + two coefficient copies (2 x 168 B) + roots
- * (2 x 20 doubles): about 3.5 KB (float32 chain) or 5.3 KB (float64 chain).
+ * stack 50 intervals (0.8 KB) + three coefficient copies (3 x 168 B) + found
+ * roots (80 doubles, 640 B): about 3.9 KB (float32 chain) or 5.7 KB (float64).
  */
 #include <float.h>
 #include <math.h>
@@ -72,10 +76,15 @@ typedef float sreal_t;
 #endif
 
 #define NMAX IMEST_POLY_MAXDEG
-#define IMEST_ROOTS_MAX_SPLITS 1024
 #define REFINE_REL ((sreal_t)9.5367431640625e-07) /* 2^-20 */
 #define NEWTON_STOP 9.313225746154785e-10          /* 2^-30 */
 #define DOMAIN_TOP ((sreal_t)1.00390625)           /* 1 + 2^-8: the domains overlap */
+/* Domains in kappa: (0,1] on p, (1,16] on p(16y), (16,256] on p(256y), each
+ * y in (1/16 - 2^-12, 1 + 2^-8], and (256, inf) on q(z/256), q the reversed p. */
+#define DOMAINS ((int)IMEST_ROOTS_DOMAINS)
+static const int DOMAIN_EXP[DOMAINS] = {0, 4, 8, 8};
+static const int DOMAIN_REV[DOMAINS] = {0, 0, 0, 1};
+static const double DOMAIN_LO[DOMAINS] = {0.0, 0.062255859375, 0.062255859375, 0.0};
 #define MERGE_REL 1.4551915228366852e-11           /* 2^-36 */
 
 typedef struct {
@@ -349,17 +358,24 @@ static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double 
  * between 0+ and TOP. If not, p is sampled in float64 at a fixed grid
  * (0, 2^-16 .. 2^-1, 0.75, TOP; 19 points) and every grid cell with a sign
  * change and no root yet is solved by the bracketed float64 Newton. */
-static int parity_rescue(const double *pd, int n, double *out, int *odd, int nout, imest_roots_stats_t *st) {
+static int parity_rescue(const double *pd, int n, double ylo, double *out, int *odd, int nout,
+                         imest_roots_stats_t *st) {
   const double top = (double)DOMAIN_TOP;
   const double ftop = imest_poly_eval(pd, n, top);
+  double flo = pd[0];
+  if (ylo > 0.0) {
+    flo = imest_poly_eval(pd, n, ylo);
+    ++st->polish_evals;
+  }
   ++st->polish_evals;
   int nodd = 0;
   for (int i = 0; i < nout; ++i) nodd += odd[i];
-  if (sgn_d(ftop) == 0 || ((sgn_d(pd[0]) != sgn_d(ftop)) == ((nodd & 1) == 1))) return nout;
+  if (sgn_d(ftop) == 0 || sgn_d(flo) == 0 || ((sgn_d(flo) != sgn_d(ftop)) == ((nodd & 1) == 1))) return nout;
   ++st->rescues;
-  double glo = 0.0, flo = pd[0];
+  double glo = ylo;
   for (int k = 1; k <= 18; ++k) {
     const double ghi = (k <= 16) ? ldexp(1.0, k - 17) : (k == 17) ? 0.75 : top;
+    if (ghi <= glo) continue;
     const double fhi = imest_poly_eval(pd, n, ghi);
     ++st->polish_evals;
     if (sgn_d(flo) * sgn_d(fhi) < 0) {
@@ -376,17 +392,17 @@ static int parity_rescue(const double *pd, int n, double *out, int *odd, int nou
   return nout;
 }
 
-/* Roots of pd (float64, normalised, degree n >= 1, pd[0] != 0) in (0, 1 + 2^-8]. */
-static int domain_roots(chain_t *ch, const double *pd, int n, double *out, imest_roots_stats_t *st) {
+/* Roots of pd (float64, normalised, degree n >= 1, pd[0] != 0) in (ylo, 1 + 2^-8]. */
+static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double *out, imest_roots_stats_t *st) {
   ival_t stack[IMEST_ROOTS_MAX_DEPTH + 2];
   int odd[NMAX];
   int top = 0, nout = 0, splits = 0;
   chain_build(ch, pd, n);
   if ((unsigned int)ch->len > st->chain_len) st->chain_len = (unsigned int)ch->len;
   if (ch->deg[0] == 0) return 0;
-  stack[top].a = 0;
+  stack[top].a = (sreal_t)ylo;
   stack[top].b = DOMAIN_TOP;
-  stack[top].va = sign_changes(ch, 0, st);
+  stack[top].va = sign_changes(ch, (sreal_t)ylo, st);
   stack[top].vb = sign_changes(ch, DOMAIN_TOP, st);
   stack[top].depth = 0;
   ++top;
@@ -426,7 +442,7 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double *out, imest
       ++st->rejected;
     }
   }
-  return parity_rescue(pd, n, out, odd, nout, st);
+  return parity_rescue(pd, n, ylo, out, odd, nout, st);
 }
 
 int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int max, imest_roots_stats_t *st) {
@@ -451,20 +467,35 @@ int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int ma
   if (n == 0) return 0;
   int e;
   (void)frexp(mx, &e);
-  double p[NMAX + 1], q[NMAX + 1];
+  double p[NMAX + 1], q[NMAX + 1], d[NMAX + 1];
   for (int k = 0; k <= n; ++k) {
     p[k] = ldexp(c[lo + k], -e);
     q[n - k] = p[k];
   }
 
   chain_t ch;
-  double found[2 * NMAX];
+  double found[DOMAINS * NMAX];
   double xd[NMAX];
-  int nf = domain_roots(&ch, p, n, found, st);
-  const int nq = domain_roots(&ch, q, n, xd, st);
-  for (int i = 0; i < nq; ++i) found[nf++] = 1.0 / xd[i];
+  int nf = 0;
+  for (int dom = 0; dom < DOMAINS; ++dom) {
+    /* domain polynomial: p(2^e y) or q(2^-e z), exactly scaled, renormalised */
+    const int ex = DOMAIN_EXP[dom], rev = DOMAIN_REV[dom];
+    const double *base = rev ? q : p;
+    double dmax = 0.0;
+    for (int k = 0; k <= n; ++k) {
+      d[k] = ldexp(base[k], rev ? -ex * k : ex * k);
+      if (fabs(d[k]) > dmax) dmax = fabs(d[k]);
+    }
+    int de;
+    (void)frexp(dmax, &de);
+    for (int k = 0; k <= n; ++k) d[k] = ldexp(d[k], -de);
+    const double ylo = DOMAIN_LO[dom];
+    const int nd = domain_roots(&ch, d, n, ylo, xd, st);
+    for (int i = 0; i < nd && nf < DOMAINS * NMAX; ++i)
+      found[nf++] = rev ? ldexp(1.0 / xd[i], ex) : ldexp(xd[i], ex);
+  }
 
-  /* sort ascending (insertion; nf <= 40) and merge near-duplicates */
+  /* sort ascending (insertion; nf <= 80) and merge near-duplicates */
   for (int i = 1; i < nf; ++i) {
     const double v = found[i];
     int j = i - 1;

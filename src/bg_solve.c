@@ -1,17 +1,20 @@
 /* Stage 6: the background solve of one window (MATH.md §3..§7), orchestrating
  * bg_tables.c -> bg_resultant.c -> bg_roots.c -> bg_select.c -> bg_quality.c.
  *
- * Bounded: every loop has a compile-time bound (bg_poly.h):
- *   roots:   <= 2 x (2 + 1024 + 20 x 48) Sturm evaluations, <= 2 x 20 x 48
- *            bisection steps, <= 2 x 20 x 99 float64 polish evaluations;
- *   quality: <= 2 x 80 x 41 + 2 x 61 profile evaluations.
- * Typical (testvector): ~30 Sturm evaluations, ~60 bisection steps, ~20 polish
- * and ~45 quality evaluations (out->work holds the sum).
+ * Bounded: every loop has a compile-time bound (bg_poly.h): out->work, the sum
+ * of Sturm evaluations, bisection steps, float64 polish evaluations and
+ * quality-profile evaluations, is <= IMEST_SOLVE_WORK_BOUND (24466). Typical
+ * (testvector): 12 Sturm evaluations, 63 float32 bisection steps, 20 float64
+ * polish evaluations, 34 profile evaluations (work 129; at most 422 seen in
+ * test/solve over 3000 garbage and 320 realistic windows).
+ * Plus a fixed part: tables (~150 float64 ops), resultant (~700 float64
+ * multiply-adds), selection (~80 per root), Hessian (~80).
  *
- * Stack (worst case, measured with -fstack-usage for Cortex-M4F, -O2, float32
- * chain): imest_solve ~0.9 KB (tables, r, roots, candidates) + the root finder
- * ~2.6 KB (Sturm chain 1.8 KB, isolation stack 0.6 KB) = about 3.5 KB; the
- * quality stage (~0.3 KB) runs after the root finder has returned. No static
+ * Stack (worst case, GCC 12 -O2 -fstack-usage for Cortex-M4F, float32 chain):
+ * imest_solve_ex 2272 B (tables, r, 20 candidates) + imest_poly_positive_roots_ex
+ * 4560 B (Sturm chain 1.8 KB, isolation stack 0.8 KB, domain polynomials and
+ * found roots, helpers inlined) + polish helpers ~300 B = about 7.2 KB; the
+ * quality stage (~0.6 KB) runs after the root finder has returned. No static
  * mutable data, no allocation. */
 #include <math.h>
 
@@ -73,7 +76,8 @@ int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_s
   out->tr_s = c->tr_s;
   out->rs_ohm = c->rs_ohm;
   out->e = (c->e > 0.0) ? c->e : 0.0;
-  out->e_i = sqrt(out->e / in->ry);
+  /* E below zero is the cancellation floor of float32-accumulated sums */
+  out->e_i = sqrt(fmax(out->e, 0.0) / in->ry);
   stats->quality_evals = imest_quality(&t, cfg, c, out);
   out->work += stats->quality_evals;
 

@@ -370,11 +370,10 @@ TEST(SturmVsCompanion, RandomFamilies) {
   }
   std::printf("[sturm-vs-companion] chain %s: max Sturm evals %u, bisect steps %u, polish evals %u\n",
               SOLVE_CHAIN_F32 ? "float32" : "float64", max_evals, max_bisect, max_polish);
-  // iteration bounds of bg_roots.c (two domains)
-  EXPECT_LE(max_evals, 2u * (2 + 1024 + 20 * IMEST_ROOTS_MAX_BISECT));
-  EXPECT_LE(max_bisect, 2u * 20 * IMEST_ROOTS_MAX_BISECT);
-  EXPECT_LE(max_polish, 2u * 20 * (2 + 2 * IMEST_ROOTS_MAX_EXPAND + 2 * IMEST_ROOTS_MAX_POLISH + 1) +
-                            2u * (19 + 20 * IMEST_ROOTS_MAX_POLISH));
+  // iteration bounds of bg_roots.c (bg_poly.h)
+  EXPECT_LE(max_evals, IMEST_ROOTS_BOUND_STURM);
+  EXPECT_LE(max_bisect, IMEST_ROOTS_BOUND_BISECT);
+  EXPECT_LE(max_polish, IMEST_ROOTS_BOUND_POLISH);
 }
 
 TEST(SturmVsCompanion, BadInput) {
