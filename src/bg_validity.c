@@ -33,7 +33,8 @@ void imest_judge(const imest_t *s, const imest_window_stats_t *st, const imest_s
 
   if (status == IMEST_OK && !(st->i_rms_a >= (double)s->min_current_a)) status = IMEST_ST_NO_CURRENT;
   if (status == IMEST_OK && !(r->slip_ratio >= (double)s->min_slip_ratio)) {
-    status = (st->w_rms < 1.0) ? IMEST_ST_STANDSTILL : IMEST_ST_ZERO_SLIP;
+    /* about 10 rpm: an encoder toggling by a count averages to zero here */
+    status = (fabs(st->w_mean) < 1.0) ? IMEST_ST_STANDSTILL : IMEST_ST_ZERO_SLIP;
   }
   if (status == IMEST_OK && so->status != IMEST_OK) status = so->status;
   if (status == IMEST_OK && !so->hessian_pd) status = IMEST_ST_NOT_MINIMUM;

@@ -202,7 +202,6 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   const double k1 = m * k2;
   imest_centre_from_k(s->win[0].c0, k1, k2, m);
   imest_centre_from_k(s->win[1].c0, k1, k2, m);
-  s->fill = 0;
   s->win[0].flags = s->warm ? IMEST_FLAG_WARMUP : 0u;
   return IMEST_OK;
 }

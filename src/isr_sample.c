@@ -29,22 +29,21 @@ static void isr_open_window(imest_t *s, imest_window_t *w, uint32_t pending_flag
   w->samples = 0;
   w->used = 0;
   w->flags = pending_flags | (s->warm ? IMEST_FLAG_WARMUP : 0u);
+  w->rot = RL(0);
   s->k = 0;
-  s->fold = 0;
 }
 
 /* Window complete: hand it over if the background has released the other
  * buffer, else drop it (counted, never torn). Returns 1 if handed over. */
 static int isr_close_window(imest_t *s)
 {
-  imest_window_t *w = &s->win[s->fill];
+  imest_window_t *w = &s->win[s->published & 1u];
   w->samples = s->k;
   s->seq++;
   if (s->published == s->released) {
     IMEST_BARRIER();            /* window contents before the index */
-    s->published = s->published + 1u;
-    s->fill ^= 1u;
-    isr_open_window(s, &s->win[s->fill], 0u);
+    s->published = s->published + 1u; /* the ISR now fills the other buffer */
+    isr_open_window(s, &s->win[s->published & 1u], 0u);
     return 1;
   }
   /* overrun: the background still owns the other buffer */
@@ -62,7 +61,7 @@ static int isr_close_window(imest_t *s)
 static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t ia,
                     imest_real_t ib, imest_real_t th, uint32_t fault)
 {
-  imest_window_t *w = &s->win[s->fill];
+  imest_window_t *w = &s->win[s->published & 1u];
 
   /* plausibility: NaN and Inf fail every comparison */
   const int ok_in = isr_within(ua, s->u_abs) & isr_within(ub, s->u_abs) &
@@ -115,8 +114,8 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
       isr_regressor(s, &g, w->c0, zx, zy);
       /* i x di/dt: in steady state |i|^2 times the slip frequency */
       const imest_real_t cross = g.ix.x * g.iy.dx - g.iy.x * g.ix.dx;
-      isr_accumulate(w, zx, zy, cross, s->fold);
-      s->fold = (s->fold + 1u == IMEST_NACC) ? 0u : s->fold + 1u;
+      isr_accumulate(w, zx, zy, cross, s->k % IMEST_NACC);
+      w->rot += dth;
       w->used++;
     }
   }

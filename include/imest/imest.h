@@ -233,6 +233,7 @@ typedef struct {
   imest_real_t sum[IMEST_NACC];   /**< folded block sums */
   imest_real_t blk[IMEST_NACC];   /**< the current (unfolded) block of each entry */
   imest_real_t c0[7];             /**< centring vector used for this window (y - W c0 accumulated) */
+  imest_real_t rot;               /**< sum of the angle steps of the used samples [rad] */
   uint32_t seq;
   uint32_t samples;
   uint32_t used;
@@ -273,11 +274,10 @@ typedef struct {
   imest_real_t th_prev;                 /* previous mechanical angle (as given) */
   uint32_t k;                    /* sample index in the current window */
   uint32_t warm;                 /* warm-up samples still to discard */
-  uint32_t fold;                 /* next entry to fold */
   uint32_t seq;                  /* sequence number of the window being filled */
   uint32_t started;              /* first sample seen */
-  uint32_t fill;                 /* buffer index the ISR fills (0/1) */
-  volatile uint32_t published;   /* ISR -> background: count of buffers handed over */
+  volatile uint32_t published;   /* ISR -> background: count of buffers handed over; the
+                                    ISR fills win[published & 1] */
   volatile uint32_t released;    /* background -> ISR: count of buffers released */
   volatile uint32_t overruns;    /* windows dropped */
   imest_window_t win[2];

@@ -377,7 +377,7 @@ TEST(RobustCondition, StandstillWithDcExcitation) {
 // src/bg_validity.c (imest_judge, slip_ratio / w_rms test) does not fire and
 // the window is reported no_root instead of standstill (still invalid).
 // Enable when fixed.
-TEST(RobustCondition, DISABLED_StandstillAtMagnetisingCurrent) {
+TEST(RobustCondition, StandstillAtMagnetisingCurrent) {
   Rig r;
   r.sc.freq_hz = 0.0;
   r.sc.vll_v = 10.0;  // i_rms ~2 A
@@ -439,7 +439,7 @@ TEST(RobustCondition, DISABLED_IfocLoadedSteadyStateEveryWindowValid) {
 // the encoder toggling by one count (1.5 mrad = 6 rad/s for one sample) makes
 // the filtered speed rms exceed the fixed 1 rad/s standstill bound in
 // src/bg_validity.c (imest_judge: `st->w_rms < 1.0`). Enable when fixed.
-TEST(RobustCondition, DISABLED_IfocAtRestIsStandstill) {
+TEST(RobustCondition, IfocAtRestIsStandstill) {
   Rig r;
   r.sc.supply = IMSIM_SUPPLY_IFOC;
   r.sc.start = IMSIM_START_REST;
