@@ -202,6 +202,12 @@ static void est_config(const imsim_config *c, imest_config_t *cfg)
   cfg->start_at_rest = 1;
   cfg->i_limit_a = (float)(c->i_range_a * (1.0 - ldexp(1.0, 1 - c->adc_bits)));
   cfg->u_limit_v = (float)(c->u_range_v * (1.0 - ldexp(1.0, 1 - c->adc_bits)));
+  /* Its phase voltages are the volt-seconds of the PWM period that just
+   * ended (duty cycles x DC bus): they lag the current samples by half a
+   * carrier period, which uncompensated biases R_S by about +5 %. */
+  const int pwm = c->supply == IMSIM_SUPPLY_PWM || (c->supply == IMSIM_SUPPLY_IFOC && !c->ifoc_ideal_stage);
+  if (pwm && (c->vmeas == IMSIM_VMEAS_AUTO || c->vmeas == IMSIM_VMEAS_AVG))
+    cfg->u_delay_s = (float)(0.5 / c->carrier_hz);
 }
 
 static FILE *open_out(job_t *j, const char *dir, const char *name)
