@@ -11,7 +11,10 @@
 #include "imsim_cli.h"
 
 namespace {
-int parse(std::vector<std::string> args, imsim_config &c, imsim_cli_opts &o, std::string *err = nullptr) {
+int parse(std::vector<std::string> in, imsim_config &c, imsim_cli_opts &o, std::string *err = nullptr) {
+  // the parsed options point into argv (as with a real main): keep it alive
+  static std::vector<std::string> args;
+  args = std::move(in);
   args.insert(args.begin(), "imest-sim");
   std::vector<char *> argv;
   for (auto &a : args) argv.push_back(a.data());
