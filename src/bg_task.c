@@ -38,7 +38,7 @@ int imest_background(imest_t *s, imest_result_t *out)
   so.status = IMEST_ST_NUMERIC;
   so.tr_s = NAN;
   if (w->used >= 16u) {
-    imest_solve_cfg_t cfg;
+    imest_solve_cfg_t cfg = {0}; /* fields added later default to 0 */
     cfg.sigma = (double)s->sigma;
     cfg.ls_h = (double)s->ls_h;
     cfg.tr_nominal_s = (double)s->tr_nominal_s;
