@@ -162,8 +162,9 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   s->n = (imest_real_t)cfg->pole_pairs;
   s->m = (imest_real_t)m;
   s->inv_s = (imest_real_t)(1.0 / (sigma * ls));
-  s->i_lim = (imest_real_t)cfg->i_limit_a;
-  s->u_lim = (imest_real_t)cfg->u_limit_v;
+  /* no ADC limit configured: the absurd-value limit takes its place */
+  s->i_lim = (imest_real_t)(cfg->i_limit_a > 0.0f ? cfg->i_limit_a : cfg->i_absurd_a);
+  s->u_lim = (imest_real_t)(cfg->u_limit_v > 0.0f ? cfg->u_limit_v : cfg->u_absurd_v);
   s->i_abs = (imest_real_t)cfg->i_absurd_a;
   s->u_abs = (imest_real_t)cfg->u_absurd_v;
   s->dth_max = (imest_real_t)cfg->speed_limit_rad_s;
@@ -172,6 +173,7 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
 
   design_bw3(&s->bw, (double)cfg->filter_hz, fs);
   design_aa(&s->aa, (double)cfg->aa_hz, fs);
+  s->aa_on = cfg->aa_hz > 0.0f;
 
   /* warm-up: the slowest Butterworth-3 pole decays as exp(-pi fc t); 3/fc
    * leaves < 1e-4 of a start-up transient; the anti-alias model adds its own. */

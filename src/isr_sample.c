@@ -56,19 +56,24 @@ static int isr_close_window(imest_t *s)
   return 0;
 }
 
-/* Common part once alpha/beta are known. fault: bits already detected on the
- * phase quantities (saturation). */
+/* Common part once alpha/beta are known. in_range: every electrical input
+ * was strictly inside its ADC limit (the absurd-value limit when no ADC limit
+ * is configured); NaN fails that test too. */
 static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t ia,
-                    imest_real_t ib, imest_real_t th, uint32_t fault)
+                    imest_real_t ib, imest_real_t th, int in_range)
 {
   imest_window_t *w = &s->win[s->published & 1u];
+  uint32_t fault = 0;
 
-  /* plausibility: NaN and Inf fail every comparison */
-  const int ok_in = isr_within(ua, s->u_abs) & isr_within(ub, s->u_abs) &
-                    isr_within(ia, s->i_abs) & isr_within(ib, s->i_abs) &
-                    isr_within(th, RL(1.0e8));
-  if (!ok_in) {
-    fault |= IMEST_FLAG_INPUT_FAULT;
+  /* Only an out-of-range sample pays for telling saturation from garbage:
+   * NaN and Inf fail every comparison. */
+  if (!in_range) {
+    const int plausible = isr_within(ua, s->u_abs) & isr_within(ub, s->u_abs) &
+                          isr_within(ia, s->i_abs) & isr_within(ib, s->i_abs);
+    fault = plausible ? IMEST_FLAG_ADC_SAT : IMEST_FLAG_INPUT_FAULT;
+  }
+  if (!isr_within(th, RL(1.0e8))) fault |= IMEST_FLAG_INPUT_FAULT;
+  if (fault & IMEST_FLAG_INPUT_FAULT) {
     th = s->th_prev;            /* keep the last good angle */
   }
   const imest_real_t dth = s->started ? isr_wrap_pi(th - s->th_prev) : RL(0);
@@ -83,27 +88,37 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
     w->flags |= fault | IMEST_FLAG_WARMUP;
     isr_restart_filters(s);
   } else {
-    /* align currents and angle with lagging voltage samples (dly = 0: no-op) */
-    const imest_real_t a = s->dly;
-    const imest_real_t ia_d = ia - a * (ia - s->ia_prev), ib_d = ib - a * (ib - s->ib_prev);
-    const imest_real_t w_now = dth * s->fs, w_d = w_now - a * (w_now - s->wr_prev);
-    s->ia_prev = ia;
-    s->ib_prev = ib;
-    s->wr_prev = w_now;
+    /* Optional stages branch on configuration only (the same path every
+     * sample), so a drive that does not use them does not pay for them. */
+    imest_real_t w_raw = dth * s->fs, th_r = th;
+    if (s->dly != RL(0)) {
+      /* align currents and angle with lagging voltage samples */
+      const imest_real_t a = s->dly, ia_now = ia, ib_now = ib, w_now = w_raw;
+      ia = ia_now - a * (ia_now - s->ia_prev);
+      ib = ib_now - a * (ib_now - s->ib_prev);
+      w_raw = w_now - a * (w_now - s->wr_prev);
+      th_r = th - a * dth;
+      s->ia_prev = ia_now;
+      s->ib_prev = ib_now;
+      s->wr_prev = w_now;
+    }
+    if (s->aa_on) {
+      /* the angle through a model of the electrical channels' AA filter */
+      w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, w_raw);
+    }
 
     /* rotation into the rotor frame by n_p * theta */
     imest_real_t sn, cs;
-    isr_sincos(isr_wrap_pi(s->n * (th - a * dth)), &sn, &cs);
+    isr_sincos(isr_wrap_pi(s->n * th_r), &sn, &cs);
     imest_real_t ux, uy, ix, iy;
     isr_rotate(sn, cs, ua, ub, &ux, &uy);
-    isr_rotate(sn, cs, ia_d, ib_d, &ix, &iy);
+    isr_rotate(sn, cs, ia, ib, &ix, &iy);
 
     isr_signals_t g;
     g.ux = isr_filter_deriv(s, &s->ch[0], ux);
     g.uy = isr_filter_deriv(s, &s->ch[1], uy);
     g.ix = isr_filter_deriv(s, &s->ch[2], ix);
     g.iy = isr_filter_deriv(s, &s->ch[3], iy);
-    const imest_real_t w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, w_d);
     isr_filter_speed(s, &s->ch[4], w_raw, &g.w, &g.dw);
 
     if (s->warm) {
@@ -129,31 +144,24 @@ int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a, f
 {
   const imest_real_t ua = (imest_real_t)u_alpha_v, ub = (imest_real_t)u_beta_v;
   const imest_real_t ia = (imest_real_t)i_alpha_a, ib = (imest_real_t)i_beta_a;
-  uint32_t fault = 0;
-  /* saturation limits apply to whatever quantities the caller passes */
-  if (s->i_lim > RL(0) && !(isr_within(ia, s->i_lim) & isr_within(ib, s->i_lim))) {
-    fault |= IMEST_FLAG_ADC_SAT;
-  }
-  if (s->u_lim > RL(0) && !(isr_within(ua, s->u_lim) & isr_within(ub, s->u_lim))) {
-    fault |= IMEST_FLAG_ADC_SAT;
-  }
-  return isr_step(s, ua, ub, ia, ib, (imest_real_t)theta_rad, fault);
+  /* the limits apply to whatever quantities the caller passes */
+  const int in_range = (isr_abs(ia) < s->i_lim) & (isr_abs(ib) < s->i_lim) &
+                       (isr_abs(ua) < s->u_lim) & (isr_abs(ub) < s->u_lim);
+  return isr_step(s, ua, ub, ia, ib, (imest_real_t)theta_rad, in_range);
 }
 
 int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], float theta_rad)
 {
   imest_real_t u[3], i[3];
-  uint32_t sat = 1u;
+  int in_range = 1;
   for (unsigned int p = 0; p < 3u; ++p) {
     u[p] = (imest_real_t)u_abc_v[p];
     i[p] = (imest_real_t)i_abc_a[p];
-    /* a sample at (or beyond) the ADC limit: the true value is unknown. NaN
-     * passes here and is caught by the plausibility check. */
-    if (s->i_lim > RL(0)) sat &= (uint32_t)!(isr_abs(i[p]) >= s->i_lim);
-    if (s->u_lim > RL(0)) sat &= (uint32_t)!(isr_abs(u[p]) >= s->u_lim);
+    /* a sample at (or beyond) the ADC limit: the true value is unknown */
+    in_range &= (isr_abs(i[p]) < s->i_lim) & (isr_abs(u[p]) < s->u_lim);
   }
   imest_real_t ua, ub, ia, ib;
   isr_clarke(u, &ua, &ub);
   isr_clarke(i, &ia, &ib);
-  return isr_step(s, ua, ub, ia, ib, (imest_real_t)theta_rad, sat ? 0u : IMEST_FLAG_ADC_SAT);
+  return isr_step(s, ua, ub, ia, ib, (imest_real_t)theta_rad, in_range);
 }

@@ -264,6 +264,7 @@ typedef struct {
   imest_real_t n, m, inv_s;             /* n_p, M*beta, 1/(sigma L_S) */
   imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max;
   uint32_t window_n, warmup_n;
+  uint32_t aa_on;                       /* anti-alias model in use */
   imest_bw3_t bw;
   imest_sos_t aa;
   /* ISR state */
