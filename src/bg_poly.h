@@ -16,26 +16,40 @@ extern "C" {
 /* ---------------------------------------------------------------- bg_tables.c
  * Power-of-two scalings (MATH.md §5) and the scaled cost tables (§3) and
  * p1/p2 coefficients (§4), all float64, in the scaled unknowns (k, kappa):
- * K1 = g k, K2 = s kappa, E = c E~. */
+ * K1 = g k, K2 = s kappa, E = c E~.
+ * Weighted cost (cfg.weight_c = c_w, scaled cw = c_w/s^2, D = kappa^2 + cw):
+ * E_w~ = P/D^2 with P = sum_m (e2[m] k^2 + e1[m] k + e0[m]) kappa^m
+ * (E_p^2~ = P/kappa^4). dE_w/dk = 0 <=> p1 = a1 k + a0 = 0 (as the paper);
+ * dE_w/dkappa = 0 <=> p2w = D P' - 4 kappa P = bw2 k^2 + bw1 k + bw0 = 0 with
+ * bw_t(kappa) = kappa b_t(kappa) + cw t'(kappa), b_t[m] = (m-4) t[m] the
+ * paper's. With cw = 0, p2w = kappa p2 exactly (bw_t[m+1] = b_t[m], bw_t[0] = 0). */
 typedef struct {
   int sexp, gexp, cexp;       /* s = 2^sexp, g = 2^gexp, c = 2^cexp */
   double s, g, c;
+  double cw;                  /* weight c_w / s^2 (0: the paper's cost) */
   double e2[7], e1[8], e0[9]; /* E~ = kappa^-4 sum_m (e2[m] k^2 + e1[m] k + e0[m]) kappa^m */
   double a1[7], a0[8];        /* p1 = a1(kappa) k + a0(kappa) */
-  double b2[7], b1[8], b0[9]; /* p2 = b2 k^2 + b1 k + b0 */
+  double bw2[8], bw1[9], bw0[10]; /* p2w = bw2 k^2 + bw1 k + bw0 */
 } imest_tables_t;
 
-/* round(log2(x)) for finite x > 0, computed exactly with frexp. */
+/* Exact power-of-two and IEEE-754 helpers (no libm: ldexp/frexp/isfinite cost
+ * ~70 instructions per call on a soft-double core). */
+double imest_pow2(int e);           /* 2^e, e clamped to [-1022, 1023] */
+int imest_finite(double x);         /* isfinite by the exponent bits */
+/* round(log2(x)) for finite x > 0, exact (mantissa compared with sqrt 2). */
 int imest_round_log2(double x);
 
 /* Tables for given exponents (no data-driven choice): R~ = D R D / c with
  * D = diag(g, s, s^2, g s, 1/s, g/s, g/s^2, 1/s^2), each entry scaled by one
- * ldexp (exact unless it under/overflows). Also fills a*, b*. */
+ * power-of-two multiplication (exact unless it under/overflows). cw is set
+ * from weight_c (c_w / s^2). Also fills a*, bw*. */
 void imest_tables_scaled(const imest_sums_t *in, int sexp, int gexp, int cexp, imest_tables_t *t);
+void imest_tables_weight(imest_tables_t *t, double weight_c); /* sets cw, refills bw* */
 
 /* Choose s from tr_nominal_s, c from R_y and g from the data (MATH.md §5) and
- * build the tables. Returns IMEST_OK, or IMEST_ST_NUMERIC for non-finite sums,
- * R_y <= 0 or non-finite tables. */
+ * build the tables (cw = 0; call imest_tables_weight for c_w > 0). Returns
+ * IMEST_OK, or IMEST_ST_NUMERIC for non-finite sums, R_y <= 0 or non-finite
+ * tables. */
 int imest_tables_build(const imest_sums_t *in, double tr_nominal_s, imest_tables_t *t);
 
 /* Values of e2(kappa), e1(kappa), e0(kappa) (polynomials in kappa) and their
@@ -46,12 +60,17 @@ typedef struct {
   double dd2, dd1, dd0; /* second derivatives */
 } imest_tabval_t;
 void imest_tables_eval(const imest_tables_t *t, double kappa, imest_tabval_t *v);
+/* Values only: v[0] = e2, v[1] = e1, v[2] = e0 at kappa. */
+void imest_tables_values(const imest_tables_t *t, double kappa, double v[3]);
 
 /* ------------------------------------------------------------- bg_resultant.c
- * r = a0^2 b2 - a0 a1 b1 + a1^2 b0, 21 coefficients ascending (MATH.md §4).
- * generic = 0: this regressor (deg 18): r[19] = r[20] = 0 are set.
- * generic = 1: keep all 21 coefficients (degree 20, arbitrary symmetric R_W). */
-void imest_resultant(const imest_tables_t *t, double r[21], int generic);
+ * r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0, 22 coefficients ascending (MATH.md §4
+ * with the weighted p2w): with cw = 0, r_w = kappa r (r the paper's).
+ * generic = 0: this regressor: degree 19, r_w[20] = r_w[21] = 0 are set (they
+ *   vanish identically because W.3 = -m W.4, for any cw; r_w[19] = r[18]).
+ * generic = 1: keep all 22 coefficients (degree 21, arbitrary symmetric R_W). */
+#define IMEST_RES_DEG 19
+void imest_resultant(const imest_tables_t *t, double r[22], int generic);
 
 /* ----------------------------------------------------------------- bg_roots.c
  * All distinct positive roots of sum_k c[k] x^k (deg <= IMEST_POLY_MAXDEG) by
@@ -99,15 +118,21 @@ double imest_poly_eval(const double *c, int deg, double x);
 typedef struct {
   double kappa, k;   /* scaled root and back-substituted k = -a0/a1 */
   double k1, k2;     /* K1 = g k, K2 = s kappa */
-  double e;          /* E_p^2 (unscaled; may be slightly negative from cancellation) */
+  double e;          /* the paper's E_p^2 (unscaled; centred form if the sums have it) */
+  double ew;         /* the minimised cost E_w = E_p^2 kappa^4 / (kappa^2 + cw)^2 (unscaled) */
   double tr_s, rs_ohm;
-  int admissible;    /* K1 > 0, T_R in band, all finite, E above -1e-9 R_y */
+  int admissible;    /* K1 > 0, T_R in band, all finite, E above -1e-4 R_y */
 } imest_cand_t;
 
-/* Evaluate every root as a candidate and pick the admissible one with least E.
- * Returns the index of the selected candidate, or -1 if none is admissible. */
+/* Evaluate every root as a candidate and pick the admissible one with least
+ * E_w (first one on a tie) into *best. cand (may be NULL) receives every
+ * candidate. Returns the index of the selected candidate, or -1 if none is
+ * admissible. */
 int imest_select(const imest_tables_t *t, const double *kappa, int n, const imest_solve_cfg_t *cfg,
-                 double ry, imest_cand_t *cand, unsigned int *n_admissible);
+                 const imest_sums_t *in, imest_cand_t *best, imest_cand_t *cand, unsigned int *n_admissible);
+
+/* E_p^2(K1, K2) from the centred sums (in->centred must be set). */
+double imest_e_centred(const imest_sums_t *in, double k1, double k2);
 
 /* --------------------------------------------------------------- bg_quality.c */
 #define IMEST_PE_UNBOUNDED 1e30 /* PE reported when it has no finite meaning (H not PD) */
@@ -118,8 +143,8 @@ int imest_select(const imest_tables_t *t, const double *kappa, int n, const imes
 
 #define IMEST_PE_MAX_PROBE 80  /* step-out probes per side */
 #define IMEST_PE_MAX_ROOT 40   /* Illinois iterations per crossing */
-#define IMEST_PE_MAX_MIN 60    /* Brent minimisation iterations per K1 extreme */
-#define IMEST_QUALITY_BOUND (2u * (IMEST_PE_MAX_PROBE + IMEST_PE_MAX_ROOT) + 2u * (1u + IMEST_PE_MAX_MIN))
+#define IMEST_PE_MAX_MIN 40    /* parabolic/outward steps per K1 extreme (after 3 start points) */
+#define IMEST_QUALITY_BOUND (2u * (IMEST_PE_MAX_PROBE + IMEST_PE_MAX_ROOT) + 2u * (3u + IMEST_PE_MAX_MIN))
 #define IMEST_SOLVE_WORK_BOUND \
   (IMEST_ROOTS_BOUND_STURM + IMEST_ROOTS_BOUND_BISECT + IMEST_ROOTS_BOUND_POLISH + IMEST_QUALITY_BOUND)
 

@@ -4,7 +4,9 @@
  *
  * Design
  *  - Normalise: strip exact-zero leading and trailing coefficients (a root at 0
- *    is not positive), scale by a power of two so that max|c| is in [0.5, 1).
+ *    is not positive), scale by a power of two so that max|c| is in
+ *    [2^-1/2, 2^1/2). All power-of-two scalings are multiplications by exact
+ *    powers of two (imest_pow2), no ldexp/frexp.
  *  - Four domains, each searched on (lo, 1 + 2^-8] so that neighbouring
  *    domains overlap (a root at a domain boundary, where the sign of p is
  *    round-off, lies inside one of them): kappa in (0,1] on p(y); (1,16] on
@@ -34,10 +36,11 @@
  *    bisection when p changes sign on the interval, else (even multiplicity, or
  *    float32 sign noise) bisection on the Sturm count; <= IMEST_ROOTS_MAX_BISECT.
  *  - Polish in float64 on the full (untruncated) polynomial: find a float64
- *    sign change on the refined bracket, widening it by 4x up to
+ *    sign change (values only) on the refined bracket, widening it by 4x up to
  *    IMEST_ROOTS_MAX_EXPAND times (limited to the isolating interval plus 1/16
  *    of its width), then safeguarded Newton (a Newton step that leaves the
- *    bracket becomes a bisection), <= IMEST_ROOTS_MAX_POLISH evaluations, until
+ *    bracket becomes a bisection; each step evaluates p and p' only),
+ *    <= IMEST_ROOTS_MAX_POLISH evaluations, until
  *    a Newton step is <= 2^-30 |x| (then the error is ~ |x p''/(2p')| 2^-60 |x|:
  *    full double accuracy for simple roots) or the bracket is 4 ulp wide. If
  *    float64 sees no sign change (even multiplicity), the same is done on p'
@@ -56,9 +59,15 @@
  * IMEST_ROOTS_BOUND_POLISH (12320) float64 polish evaluations (bg_poly.h). Typical (testvector, n = 18): see test/solve (about 30
  * V evaluations, 60 bisection steps and 20 float64 evaluations).
  *
- * Stack: chain 21 x 21 sreal_t (1764 B float32, 3528 B float64) + isolation
- * stack 50 intervals (0.8 KB) + three coefficient copies (3 x 168 B) + found
- * roots (80 doubles, 640 B): about 3.9 KB (float32 chain) or 5.7 KB (float64).
+ * Typical cost per root: 2 float64 value evaluations at the bracket ends and
+ * 2 Newton steps (p, p'), i.e. 6 Horner passes: the float32 bracket of 2^-20
+ * puts Newton in its quadratic regime at once.
+ *
+ * Stack: chain packed triangular (P_k has at most n - k + 1 coefficients):
+ * 231 sreal_t (924 B float32, 1848 B float64) + one remainder scratch +
+ * isolation stack 50 intervals (0.8 KB) + two coefficient copies (2 x 168 B) +
+ * one domain's roots; found roots are merged straight into roots[] (sorted,
+ * near-duplicates dropped). About 2.4 KB with the float32 chain.
  */
 #include <float.h>
 #include <math.h>
@@ -87,15 +96,18 @@ static const int DOMAIN_REV[DOMAINS] = {0, 0, 0, 1};
 static const double DOMAIN_LO[DOMAINS] = {0.0, 0.062255859375, 0.062255859375, 0.0};
 #define MERGE_REL 1.4551915228366852e-11           /* 2^-36 */
 
+#define CHAIN_CAP (((NMAX) + 1) * ((NMAX) + 2) / 2)
 typedef struct {
-  sreal_t c[NMAX + 1][NMAX + 1]; /* chain polynomials, ascending coefficients */
-  int deg[NMAX + 1];
+  sreal_t c[CHAIN_CAP]; /* chain polynomials, ascending coefficients, packed */
+  short off[NMAX + 1];  /* P_k starts at c + off[k] (capacity n - k + 1) */
+  short deg[NMAX + 1];
   int len;
 } chain_t;
+#define CH(ch, k) ((ch)->c + (ch)->off[k])
 
 typedef struct {
   sreal_t a, b;
-  int va, vb, depth;
+  short va, vb, depth;
 } ival_t;
 
 static int sgn_s(sreal_t v) { return (v > 0) - (v < 0); }
@@ -113,21 +125,33 @@ double imest_poly_eval(const double *c, int deg, double x) {
   return p;
 }
 
-/* f = p^(order)(x), df = p^(order+1)(x), order 0 or 1. */
+/* f = p^(order)(x), df = p^(order+1)(x), order 0 (two Horner passes) or 1 (three). */
 static void eval_d(const double *c, int n, int order, double x, double *f, double *df) {
-  double p = 0.0, p1 = 0.0, p2 = 0.0;
-  for (int k = n; k >= 0; --k) {
+  double p = c[n], p1 = 0.0, p2 = 0.0;
+  if (order == 0) {
+    for (int k = n - 1; k >= 0; --k) {
+      p1 = p1 * x + p;
+      p = p * x + c[k];
+    }
+    *f = p;
+    *df = p1;
+    return;
+  }
+  for (int k = n - 1; k >= 0; --k) {
     p2 = p2 * x + 2.0 * p1;
     p1 = p1 * x + p;
     p = p * x + c[k];
   }
-  if (order == 0) {
-    *f = p;
-    *df = p1;
-  } else {
-    *f = p1;
-    *df = p2;
-  }
+  *f = p1;
+  *df = p2;
+}
+
+/* p^(order)(x) alone (order 0: one Horner pass). */
+static double eval_v(const double *c, int n, int order, double x) {
+  if (order == 0) return imest_poly_eval(c, n, x);
+  double f, df;
+  eval_d(c, n, 1, x, &f, &df);
+  return f;
 }
 
 static double abs_sum_d(const double *c, int n, double x) {
@@ -138,31 +162,40 @@ static double abs_sum_d(const double *c, int n, double x) {
 
 /* Normalise P_k to max|c| = 1 (optionally negated) and drop small leading terms. */
 static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
+  sreal_t *c = CH(ch, k);
+  int d = ch->deg[k];
   sreal_t mx = 0;
-  for (int i = 0; i <= ch->deg[k]; ++i)
-    if (SR_ABS(ch->c[k][i]) > mx) mx = SR_ABS(ch->c[k][i]);
+  for (int i = 0; i <= d; ++i)
+    if (SR_ABS(c[i]) > mx) mx = SR_ABS(c[i]);
   if (mx > 0) {
     const sreal_t f = sign / mx;
-    for (int i = 0; i <= ch->deg[k]; ++i) ch->c[k][i] *= f;
+    for (int i = 0; i <= d; ++i) c[i] *= f;
   }
-  while (ch->deg[k] > 0 && SR_ABS(ch->c[k][ch->deg[k]]) <= SR_TOL) --ch->deg[k];
+  while (d > 0 && SR_ABS(c[d]) <= SR_TOL) --d;
+  ch->deg[k] = (short)d;
 }
 
 static void chain_build(chain_t *ch, const double *pd, int n) {
-  for (int i = 0; i <= n; ++i) ch->c[0][i] = (sreal_t)pd[i];
-  ch->deg[0] = n;
+  for (int k = 0, o = 0; k <= n; ++k) { /* P_k has degree <= n - k */
+    ch->off[k] = (short)o;
+    o += n - k + 1;
+  }
+  sreal_t *c0 = CH(ch, 0);
+  for (int i = 0; i <= n; ++i) c0[i] = (sreal_t)pd[i];
+  ch->deg[0] = (short)n;
   chain_normalise(ch, 0, 1);
   ch->len = 1;
   if (ch->deg[0] == 0) return;
-  ch->deg[1] = ch->deg[0] - 1;
-  for (int i = 0; i < ch->deg[0]; ++i) ch->c[1][i] = (sreal_t)(i + 1) * ch->c[0][i + 1];
+  ch->deg[1] = (short)(ch->deg[0] - 1);
+  sreal_t *c1 = CH(ch, 1);
+  for (int i = 0; i < ch->deg[0]; ++i) c1[i] = (sreal_t)(i + 1) * c0[i + 1];
   chain_normalise(ch, 1, 1);
   ch->len = 2;
-  while (ch->deg[ch->len - 1] > 0 && ch->len <= NMAX) {
-    const sreal_t *a = ch->c[ch->len - 2];
-    const sreal_t *b = ch->c[ch->len - 1];
+  while (ch->deg[ch->len - 1] > 0 && ch->len <= n) {
+    const sreal_t *a = CH(ch, ch->len - 2);
+    const sreal_t *b = CH(ch, ch->len - 1);
     const int da = ch->deg[ch->len - 2], db = ch->deg[ch->len - 1];
-    sreal_t *r = ch->c[ch->len];
+    sreal_t r[NMAX + 1] = {0}; /* remainder scratch (P_len has room for db terms only) */
     for (int i = 0; i <= da; ++i) r[i] = a[i];
     for (int i = da; i >= db; --i) {
       const sreal_t q = r[i] / b[db];
@@ -173,7 +206,9 @@ static void chain_build(chain_t *ch, const double *pd, int n) {
     for (int i = 0; i < db; ++i)
       if (SR_ABS(r[i]) > mx) mx = SR_ABS(r[i]);
     if (!(mx > SR_TOL * (sreal_t)(da + 1))) break; /* gcd reached (or NaN) */
-    ch->deg[ch->len] = db - 1;
+    sreal_t *cr = CH(ch, ch->len);
+    for (int i = 0; i < db; ++i) cr[i] = r[i];
+    ch->deg[ch->len] = (short)(db - 1);
     chain_normalise(ch, ch->len, -1);
     ++ch->len;
   }
@@ -183,7 +218,7 @@ static int sign_changes(const chain_t *ch, sreal_t x, imest_roots_stats_t *st) {
   int v = 0, last = 0;
   ++st->sturm_evals;
   for (int k = 0; k < ch->len; ++k) {
-    const int s = sgn_s(horner_s(ch->c[k], ch->deg[k], x));
+    const int s = sgn_s(horner_s(CH(ch, k), ch->deg[k], x));
     if (s != 0) {
       if (last != 0 && s != last) ++v;
       last = s;
@@ -225,9 +260,7 @@ static double newton_bracketed(const double *c, int n, int order, double a, doub
  * [lo,hi]; then polish. Returns 1 and *root on success. */
 static int polish_order(const double *c, int n, int order, double a, double b, double lo, double hi,
                         double *root, imest_roots_stats_t *st) {
-  double fa, fb, dummy;
-  eval_d(c, n, order, a, &fa, &dummy);
-  eval_d(c, n, order, b, &fb, &dummy);
+  double fa = eval_v(c, n, order, a), fb = eval_v(c, n, order, b);
   st->polish_evals += 2;
   if (fa == 0.0) {
     *root = a;
@@ -241,10 +274,10 @@ static int polish_order(const double *c, int n, int order, double a, double b, d
   if (!(w > 0.0)) w = fabs(b) * 1e-6 + DBL_MIN;
   for (int j = 0; sgn_d(fa) == sgn_d(fb) && j < IMEST_ROOTS_MAX_EXPAND; ++j) {
     w *= 4.0;
-    const double a2 = fmax(lo, a - w), b2 = fmin(hi, b + w);
+    const double a2 = (a - w > lo) ? a - w : lo, b2 = (b + w < hi) ? b + w : hi;
     double fa2 = fa, fb2 = fb;
     if (a2 < a) {
-      eval_d(c, n, order, a2, &fa2, &dummy);
+      fa2 = eval_v(c, n, order, a2);
       ++st->polish_evals;
     }
     if (sgn_d(fa2) != sgn_d(fa)) { /* sign change on [a2, a] */
@@ -255,7 +288,7 @@ static int polish_order(const double *c, int n, int order, double a, double b, d
       break;
     }
     if (b2 > b) {
-      eval_d(c, n, order, b2, &fb2, &dummy);
+      fb2 = eval_v(c, n, order, b2);
       ++st->polish_evals;
     }
     if (sgn_d(fb2) != sgn_d(fb)) { /* sign change on [b, b2] */
@@ -287,7 +320,7 @@ static int polish_order(const double *c, int n, int order, double a, double b, d
 static int polish(const double *c, int n, double a, double b, double lo, double hi, double *root,
                   imest_roots_stats_t *st) {
   const double ext = (hi - lo) * 0.0625;
-  lo = fmax(0.0, lo - ext);
+  lo = (lo - ext > 0.0) ? lo - ext : 0.0;
   hi = hi + ext;
   if (polish_order(c, n, 0, a, b, lo, hi, root, st)) return 1;
   /* no float64 sign change: even multiplicity? polish the root of p' */
@@ -307,7 +340,7 @@ static int polish(const double *c, int n, double a, double b, double lo, double 
 static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root, imest_roots_stats_t *st) {
   const double lo = (double)iv.a, hi = (double)iv.b;
   sreal_t a = iv.a, b = iv.b;
-  const sreal_t *p0 = ch->c[0];
+  const sreal_t *p0 = CH(ch, 0);
   const int d0 = ch->deg[0];
   sreal_t fa = horner_s(p0, d0, a), fb = horner_s(p0, d0, b);
   if (sgn_s(fa) * sgn_s(fb) < 0) {
@@ -374,7 +407,7 @@ static int parity_rescue(const double *pd, int n, double ylo, double *out, int *
   ++st->rescues;
   double glo = ylo;
   for (int k = 1; k <= 18; ++k) {
-    const double ghi = (k <= 16) ? ldexp(1.0, k - 17) : (k == 17) ? 0.75 : top;
+    const double ghi = (k <= 16) ? imest_pow2(k - 17) : (k == 17) ? 0.75 : top;
     if (ghi <= glo) continue;
     const double fhi = imest_poly_eval(pd, n, ghi);
     ++st->polish_evals;
@@ -402,8 +435,8 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double
   if (ch->deg[0] == 0) return 0;
   stack[top].a = (sreal_t)ylo;
   stack[top].b = DOMAIN_TOP;
-  stack[top].va = sign_changes(ch, (sreal_t)ylo, st);
-  stack[top].vb = sign_changes(ch, DOMAIN_TOP, st);
+  stack[top].va = (short)sign_changes(ch, (sreal_t)ylo, st);
+  stack[top].vb = (short)sign_changes(ch, DOMAIN_TOP, st);
   stack[top].depth = 0;
   ++top;
   while (top > 0) {
@@ -414,20 +447,20 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double
       const sreal_t m = iv.a + (iv.b - iv.a) * (sreal_t)0.5;
       if (iv.depth < IMEST_ROOTS_MAX_DEPTH && splits < IMEST_ROOTS_MAX_SPLITS && m > iv.a && m < iv.b &&
           top + 2 <= IMEST_ROOTS_MAX_DEPTH + 2) {
-        const int vm = sign_changes(ch, m, st);
+        const short vm = (short)sign_changes(ch, m, st);
         ++splits;
         /* right half first so that the left half is processed first */
         stack[top].a = m;
         stack[top].b = iv.b;
         stack[top].va = vm;
         stack[top].vb = iv.vb;
-        stack[top].depth = iv.depth + 1;
+        stack[top].depth = (short)(iv.depth + 1);
         ++top;
         stack[top].a = iv.a;
         stack[top].b = m;
         stack[top].va = iv.va;
         stack[top].vb = vm;
-        stack[top].depth = iv.depth + 1;
+        stack[top].depth = (short)(iv.depth + 1);
         ++top;
         continue;
       }
@@ -445,6 +478,26 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double
   return parity_rescue(pd, n, ylo, out, odd, nout, st);
 }
 
+/* Insert x into the ascending roots[0..*nr-1] (at most max), dropping it if a
+ * root within MERGE_REL lies next to it; when full, the largest is dropped. */
+static void merge_root(double x, double *roots, int *nr, int max, imest_roots_stats_t *st) {
+  if (!(x > 0.0) || !imest_finite(x)) {
+    ++st->rejected;
+    return;
+  }
+  int i = *nr;
+  while (i > 0 && roots[i - 1] > x) --i; /* roots[i-1] <= x < roots[i] */
+  if ((i > 0 && x - roots[i - 1] <= MERGE_REL * x) || (i < *nr && roots[i] - x <= MERGE_REL * roots[i])) {
+    ++st->merged;
+    return;
+  }
+  if (i >= max) return;
+  const int last = (*nr < max) ? *nr : max - 1;
+  for (int k = last; k > i; --k) roots[k] = roots[k - 1];
+  roots[i] = x;
+  if (*nr < max) ++*nr;
+}
+
 int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int max, imest_roots_stats_t *st) {
   imest_roots_stats_t dummy;
   if (st == 0) st = &dummy;
@@ -455,7 +508,7 @@ int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int ma
   int hi = -1, lo = -1;
   double mx = 0.0;
   for (int k = 0; k <= deg; ++k) {
-    if (!isfinite(c[k])) return -1;
+    if (!imest_finite(c[k])) return -1;
     if (c[k] != 0.0) {
       if (lo < 0) lo = k;
       hi = k;
@@ -465,61 +518,30 @@ int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int ma
   if (hi < 0) return -1; /* all zero */
   const int n = hi - lo;
   if (n == 0) return 0;
-  int e;
-  (void)frexp(mx, &e);
-  double p[NMAX + 1], q[NMAX + 1], d[NMAX + 1];
-  for (int k = 0; k <= n; ++k) {
-    p[k] = ldexp(c[lo + k], -e);
-    q[n - k] = p[k];
-  }
+  double p[NMAX + 1], d[NMAX + 1];
+  const double pn = imest_pow2(-imest_round_log2(mx));
+  for (int k = 0; k <= n; ++k) p[k] = c[lo + k] * pn;
 
   chain_t ch;
-  double found[DOMAINS * NMAX];
   double xd[NMAX];
-  int nf = 0;
+  int nr = 0;
   for (int dom = 0; dom < DOMAINS; ++dom) {
-    /* domain polynomial: p(2^e y) or q(2^-e z), exactly scaled, renormalised */
+    /* domain polynomial: p(2^e y) or q(2^-e z) with q[k] = p[n-k] (the
+     * reversed p), exactly scaled by powers of two, renormalised */
     const int ex = DOMAIN_EXP[dom], rev = DOMAIN_REV[dom];
-    const double *base = rev ? q : p;
-    double dmax = 0.0;
+    const double step = imest_pow2(rev ? -ex : ex);
+    double f = 1.0, dmax = 0.0;
     for (int k = 0; k <= n; ++k) {
-      d[k] = ldexp(base[k], rev ? -ex * k : ex * k);
+      d[k] = (rev ? p[n - k] : p[k]) * f;
+      f *= step;
       if (fabs(d[k]) > dmax) dmax = fabs(d[k]);
     }
-    int de;
-    (void)frexp(dmax, &de);
-    for (int k = 0; k <= n; ++k) d[k] = ldexp(d[k], -de);
+    const double dn = imest_pow2(-imest_round_log2(dmax));
+    for (int k = 0; k <= n; ++k) d[k] *= dn;
     const double ylo = DOMAIN_LO[dom];
     const int nd = domain_roots(&ch, d, n, ylo, xd, st);
-    for (int i = 0; i < nd && nf < DOMAINS * NMAX; ++i)
-      found[nf++] = rev ? ldexp(1.0 / xd[i], ex) : ldexp(xd[i], ex);
-  }
-
-  /* sort ascending (insertion; nf <= 80) and merge near-duplicates */
-  for (int i = 1; i < nf; ++i) {
-    const double v = found[i];
-    int j = i - 1;
-    while (j >= 0 && found[j] > v) {
-      found[j + 1] = found[j];
-      --j;
-    }
-    found[j + 1] = v;
-  }
-  int nr = 0;
-  for (int i = 0; i < nf; ++i) {
-    if (!(found[i] > 0.0) || !isfinite(found[i])) {
-      ++st->rejected;
-      continue;
-    }
-    if (nr > 0 && found[i] - roots[nr - 1] <= MERGE_REL * found[i]) {
-      ++st->merged;
-      continue;
-    }
-    if (nr < max) {
-      roots[nr++] = found[i];
-    } else {
-      break;
-    }
+    const double back = imest_pow2(ex);
+    for (int i = 0; i < nd; ++i) merge_root(rev ? back / xd[i] : xd[i] * back, roots, &nr, max, st);
   }
   return nr;
 }

@@ -21,8 +21,17 @@
 #include "bg_poly.h"
 
 static int cfg_ok(const imest_solve_cfg_t *cfg) {
-  return isfinite(cfg->sigma) && cfg->sigma > 0.0 && cfg->sigma < 1.0 && isfinite(cfg->ls_h) && cfg->ls_h > 0.0 &&
-         isfinite(cfg->tr_min_s) && isfinite(cfg->tr_max_s) && cfg->tr_min_s > 0.0 && cfg->tr_max_s > cfg->tr_min_s;
+  return imest_finite(cfg->sigma) && cfg->sigma > 0.0 && cfg->sigma < 1.0 && imest_finite(cfg->ls_h) &&
+         cfg->ls_h > 0.0 && imest_finite(cfg->tr_min_s) && imest_finite(cfg->tr_max_s) && cfg->tr_min_s > 0.0 &&
+         cfg->tr_max_s > cfg->tr_min_s && imest_finite(cfg->weight_c) && cfg->weight_c >= 0.0;
+}
+
+double imest_solve_weight_c(const imest_sums_t *in) {
+  if (in == 0) return 0.0;
+  const double r44 = in->rw[3][3], r66 = in->rw[5][5];
+  if (!(imest_finite(r44) && imest_finite(r66) && r44 > 0.0 && r66 >= 0.0)) return 0.0;
+  const double c = sqrt(r66 / r44);
+  return imest_finite(c) ? c : 0.0;
 }
 
 int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_solve_out_t *out,
@@ -35,7 +44,7 @@ int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_s
   out->n_roots = out->n_admissible = 0;
   for (int i = 0; i < IMEST_MAX_ROOTS; ++i) out->roots_k2[i] = 0.0;
   out->k1 = out->k2 = out->tr_s = out->rs_ohm = nan;
-  out->e = out->e_i = nan;
+  out->e = out->e_i = out->e_w = nan;
   out->hessian[0][0] = out->hessian[0][1] = out->hessian[1][0] = out->hessian[1][1] = nan;
   out->hessian_pd = 0;
   out->pe_k1 = out->pe_k2 = nan;
@@ -51,39 +60,42 @@ int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_s
     stats->roots.sturm_evals = stats->roots.bisect_steps = stats->roots.polish_evals = 0;
     return out->status = IMEST_ST_NUMERIC;
   }
+  if (cfg->weight_c > 0.0) imest_tables_weight(&t, cfg->weight_c);
   out->scale_s = t.s;
   out->scale_g = t.g;
   out->scale_c = t.c;
 
-  double r[21];
+  double r[22];
   imest_resultant(&t, r, 0);
   double kappa[IMEST_MAX_ROOTS];
-  const int nr = imest_poly_positive_roots_ex(r, 18, kappa, IMEST_MAX_ROOTS, &stats->roots);
+  const int nr = imest_poly_positive_roots_ex(r, IMEST_RES_DEG, kappa, IMEST_MAX_ROOTS, &stats->roots);
   out->work = stats->roots.sturm_evals + stats->roots.bisect_steps + stats->roots.polish_evals;
   if (nr < 0) return out->status = IMEST_ST_NUMERIC; /* non-finite or all-zero resultant */
   out->n_roots = (unsigned int)nr;
-  for (int i = 0; i < nr; ++i) out->roots_k2[i] = ldexp(kappa[i], t.sexp);
+  for (int i = 0; i < nr; ++i) out->roots_k2[i] = kappa[i] * t.s;
 
-  imest_cand_t cand[IMEST_MAX_ROOTS];
+  imest_cand_t best;
   unsigned int nad = 0;
-  const int b = imest_select(&t, kappa, nr, cfg, in->ry, cand, &nad);
+  const int b = imest_select(&t, kappa, nr, cfg, in, &best, 0, &nad);
   out->n_admissible = nad;
   if (b < 0) return out->status = IMEST_ST_NO_ROOT;
 
-  const imest_cand_t *c = &cand[b];
+  const imest_cand_t *c = &best;
   out->k1 = c->k1;
   out->k2 = c->k2;
   out->tr_s = c->tr_s;
   out->rs_ohm = c->rs_ohm;
-  out->e = (c->e > 0.0) ? c->e : 0.0;
   /* E below zero is the cancellation floor of float32-accumulated sums */
-  out->e_i = sqrt(fmax(out->e, 0.0) / in->ry);
+  out->e = (c->e > 0.0) ? c->e : 0.0;
+  out->e_w = (c->ew > 0.0) ? c->ew : 0.0;
+  out->e_i = sqrt(out->e / in->ry);
   stats->quality_evals = imest_quality(&t, cfg, c, out);
   out->work += stats->quality_evals;
 
-  const int finite = isfinite(out->e_i) && isfinite(out->hessian[0][0]) && isfinite(out->hessian[0][1]) &&
-                     isfinite(out->hessian[1][1]) && isfinite(out->pe_k1) && isfinite(out->pe_k2) &&
-                     isfinite(out->pe_quad[0]) && isfinite(out->pe_quad[1]);
+  const int finite = imest_finite(out->e_i) && imest_finite(out->hessian[0][0]) &&
+                     imest_finite(out->hessian[0][1]) && imest_finite(out->hessian[1][1]) &&
+                     imest_finite(out->pe_k1) && imest_finite(out->pe_k2) && imest_finite(out->pe_quad[0]) &&
+                     imest_finite(out->pe_quad[1]);
   if (!finite) {
     out->hessian_pd = 0;
     return out->status = IMEST_ST_NUMERIC;

@@ -17,6 +17,15 @@ typedef struct {
   double rw[8][8];
   double rwy[8];
   double ry;
+  /* Optional centred form (centred != 0): the ISR accumulated e = y - W c0,
+   * so E(K) = R_ee - 2 R_We'd + d'R_W d with d = K - c0 is formed without the
+   * cancellation of R_y - 2 R_Wy'K + K'R_W K (whose floor is ~1e-5 R_y with
+   * float32-accumulated sums). 8-column form: c0[2] = 0, rwe[2] = -m rwe[3].
+   * centred = 0 (e.g. a zero-initialised struct): E from the tables. */
+  int centred;
+  double c0[8];
+  double rwe[8];
+  double ree;
 } imest_sums_t;
 
 typedef struct {
@@ -25,6 +34,15 @@ typedef struct {
   double tr_nominal_s; /* for the power-of-two scaling s of K2 */
   double tr_min_s;     /* admissible T_R band for the selection */
   double tr_max_s;
+  /* Speed normalisation of the cost, c [(1/s)^2]: the solve minimises
+   * E_w = E_p^2 K2^4 / (K2^2 + c)^2 instead of the paper's E_p^2. The
+   * eliminated equation was multiplied by (1 + n_p^2 w^2 T_R^2) (MATH.md §2),
+   * which weights the residual ~(1 + n_p^2 w^2 T_R^2)^2 and lets any noise
+   * floor pull the minimum to the spurious K2 ~ n_p w; with c = n_p^2 w^2
+   * that weight is divided out. Use imest_solve_weight_c() (current-weighted
+   * n_p^2 w^2 of the window). 0 = the paper's cost (exactly); negative or
+   * non-finite: IMEST_ERR_CONFIG. */
+  double weight_c;
 } imest_solve_cfg_t;
 
 typedef struct {
@@ -34,11 +52,12 @@ typedef struct {
   double roots_k2[IMEST_MAX_ROOTS];
   double k1, k2;              /* selected minimiser */
   double tr_s, rs_ohm;
-  double e;                   /* E_p^2 at the minimiser (unscaled) */
-  double e_i;                 /* sqrt(E / R_y) */
-  double hessian[2][2];       /* unscaled, in (K1, K2) */
+  double e;                   /* the paper's E_p^2 at the minimiser (unscaled) */
+  double e_i;                 /* sqrt(E_p^2 / R_y) */
+  double e_w;                 /* the minimised cost E_w at the minimiser (= e if weight_c = 0) */
+  double hessian[2][2];       /* of E_w (the minimised cost), unscaled, in (K1, K2) */
   int hessian_pd;
-  double pe_k1, pe_k2;        /* parametric error indices (absolute), MATH.md §7 */
+  double pe_k1, pe_k2;        /* parametric error indices (absolute), MATH.md §7, of E_w */
   double pe_quad[2];          /* quadratic approximations sqrt(0.5 E (H^-1)_ii) */
   double scale_s, scale_g, scale_c; /* the power-of-two scalings used */
   unsigned int pe_flags;      /* IMEST_PE_FLAG_* (bg_poly.h): how the PE indices were obtained */
@@ -49,6 +68,11 @@ typedef struct {
 /* Solve one window. Always terminates within fixed iteration bounds; never
  * returns a non-finite value with status IMEST_OK. */
 int imest_solve(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_solve_out_t *out);
+
+/* The cost weight c = sqrt(R66/R44) (1-based: |W6|^2 ~ (n_p w)^4 |i|^2 per
+ * |i|^2 = |W4|^2), i.e. the current-weighted n_p^2 w^2 of the window; 0 if
+ * undefined (no current, non-finite sums). */
+double imest_solve_weight_c(const imest_sums_t *in);
 
 #ifdef __cplusplus
 }

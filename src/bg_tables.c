@@ -1,9 +1,11 @@
 /* Stage 1 of the background solve: power-of-two scaling (MATH.md §5), the
- * scaled cost tables e2, e1, e0 (§3) and the p1/p2 coefficients (§4).
- * float64 throughout. Every scaling is a power of two applied with one ldexp
- * per entry, so it is exact (barring under/overflow of garbage input): the
- * scaled tables equal the unscaled ones times powers of two, bit for bit. */
-#include <math.h>
+ * scaled cost tables e2, e1, e0 (§3) and the p1/p2w coefficients (§4, with the
+ * speed-normalised cost of bg_poly.h). float64 throughout. Every scaling is a
+ * multiplication by an exact power of two, so the scaled tables equal the
+ * unscaled ones times powers of two, bit for bit (barring under/overflow of
+ * garbage input). No libm: ldexp/frexp/isfinite cost ~70 instructions per call
+ * on a soft-double core, a bit test a few. */
+#include <stdint.h>
 
 #include "bg_poly.h"
 
@@ -11,39 +13,77 @@
 static const int EXP_E[8] = {1, 0, 0, 1, 0, 1, 1, 0};
 static const int EXP_F[8] = {0, 1, 2, 1, -1, -1, -2, -2};
 
+typedef union {
+  double d;
+  uint64_t u;
+} bits64_t;
+
+double imest_pow2(int e) {
+  if (e < -1022) e = -1022;
+  if (e > 1023) e = 1023;
+  bits64_t b;
+  b.u = (uint64_t)(e + 1023) << 52;
+  return b.d;
+}
+
+int imest_finite(double x) {
+  bits64_t b;
+  b.d = x;
+  return ((unsigned int)(b.u >> 52) & 0x7FFu) != 0x7FFu;
+}
+
 int imest_round_log2(double x) {
-  int e = 0;
-  double f = frexp(x, &e); /* x = f 2^e, f in [0.5, 1) */
-  /* log2 x = e + log2 f with log2 f in [-1, 0): round up iff f >= 2^-1/2 */
-  return (f >= 0.70710678118654752440) ? e : e - 1;
+  bits64_t b;
+  int off = 0;
+  b.d = x;
+  if (((b.u >> 52) & 0x7FFu) == 0u) { /* subnormal: make it normal */
+    b.d = x * 18446744073709551616.0;  /* 2^64 */
+    off = 64;
+  }
+  const int ex = (int)((b.u >> 52) & 0x7FFu) - 1023;
+  /* log2 x = ex + log2(1.f): round up iff 1.f >= sqrt 2 (mantissa of sqrt 2) */
+  return ex - off + (((b.u & 0xFFFFFFFFFFFFFull) >= 0x6A09E667F3BCDull) ? 1 : 0);
 }
 
 static double *table_of(imest_tables_t *t, int order) {
   return (order == 2) ? t->e2 : (order == 1) ? t->e1 : t->e0;
 }
 
+/* bw[j] = (j-5) t[j-1] + cw (j+1) t[j+1], j = 0..len (t has len entries). */
+static void weighted_b(const double *tab, int len, double cw, double *bw) {
+  for (int j = 0; j <= len; ++j) {
+    double v = (j >= 1) ? (double)(j - 5) * tab[j - 1] : 0.0;
+    if (cw != 0.0 && j + 1 < len) v += cw * (double)(j + 1) * tab[j + 1];
+    bw[j] = v;
+  }
+}
+
+void imest_tables_weight(imest_tables_t *t, double weight_c) {
+  t->cw = weight_c * imest_pow2(-2 * t->sexp);
+  weighted_b(t->e2, 7, t->cw, t->bw2);
+  weighted_b(t->e1, 8, t->cw, t->bw1);
+  weighted_b(t->e0, 9, t->cw, t->bw0);
+}
+
 static void p_coefficients(imest_tables_t *t) {
-  for (int m = 0; m < 7; ++m) {
-    t->a1[m] = 2.0 * t->e2[m];
-    t->b2[m] = (double)(m - 4) * t->e2[m];
-  }
-  for (int m = 0; m < 8; ++m) {
-    t->a0[m] = t->e1[m];
-    t->b1[m] = (double)(m - 4) * t->e1[m];
-  }
-  for (int m = 0; m < 9; ++m) t->b0[m] = (double)(m - 4) * t->e0[m];
+  for (int m = 0; m < 7; ++m) t->a1[m] = 2.0 * t->e2[m];
+  for (int m = 0; m < 8; ++m) t->a0[m] = t->e1[m];
+  imest_tables_weight(t, 0.0);
 }
 
 void imest_tables_scaled(const imest_sums_t *in, int sexp, int gexp, int cexp, imest_tables_t *t) {
   t->sexp = sexp;
   t->gexp = gexp;
   t->cexp = cexp;
-  t->s = ldexp(1.0, sexp);
-  t->g = ldexp(1.0, gexp);
-  t->c = ldexp(1.0, cexp);
+  t->s = imest_pow2(sexp);
+  t->g = imest_pow2(gexp);
+  t->c = imest_pow2(cexp);
   for (int m = 0; m < 7; ++m) t->e2[m] = 0.0;
   for (int m = 0; m < 8; ++m) t->e1[m] = 0.0;
   for (int m = 0; m < 9; ++m) t->e0[m] = 0.0;
+  /* every entry of table_q[f + 4] is scaled by 2^(q gexp + f sexp - cexp) */
+  double fs[9];
+  for (int f = -4; f <= 4; ++f) fs[f + 4] = imest_pow2(sexp * f - cexp);
 
   for (int i = 0; i < 8; ++i) {
     /* diagonal, then each unordered pair once with R_ij + R_ji (= 2 R_ij exactly
@@ -52,47 +92,74 @@ void imest_tables_scaled(const imest_sums_t *in, int sexp, int gexp, int cexp, i
       const int order = EXP_E[i] + EXP_E[j];
       const int pow_k2 = EXP_F[i] + EXP_F[j];
       const double rij = (i == j) ? in->rw[i][i] : in->rw[i][j] + in->rw[j][i];
-      table_of(t, order)[pow_k2 + 4] += ldexp(rij, gexp * order + sexp * pow_k2 - cexp);
+      table_of(t, order)[pow_k2 + 4] += rij * fs[pow_k2 + 4];
     }
-    table_of(t, EXP_E[i])[EXP_F[i] + 4] +=
-        ldexp(-2.0 * in->rwy[i], gexp * EXP_E[i] + sexp * EXP_F[i] - cexp);
+    table_of(t, EXP_E[i])[EXP_F[i] + 4] += (-2.0 * in->rwy[i]) * fs[EXP_F[i] + 4];
   }
-  t->e0[4] += ldexp(in->ry, -cexp);
+  t->e0[4] += in->ry * fs[4];
+  if (gexp != 0) {
+    const double g1 = imest_pow2(gexp), g2 = imest_pow2(2 * gexp);
+    for (int m = 0; m < 7; ++m) t->e2[m] *= g2;
+    for (int m = 0; m < 8; ++m) t->e1[m] *= g1;
+  }
   p_coefficients(t);
 }
 
 static int all_finite(const double *v, int n) {
   for (int i = 0; i < n; ++i)
-    if (!isfinite(v[i])) return 0;
+    if (!imest_finite(v[i])) return 0;
   return 1;
 }
 
 int imest_tables_build(const imest_sums_t *in, double tr_nominal_s, imest_tables_t *t) {
-  if (!all_finite(&in->rw[0][0], 64) || !all_finite(in->rwy, 8) || !isfinite(in->ry) || !(in->ry > 0.0)) {
+  if (!all_finite(&in->rw[0][0], 64) || !all_finite(in->rwy, 8) || !imest_finite(in->ry) || !(in->ry > 0.0)) {
     imest_tables_scaled(in, 0, 0, 0, t); /* defined content; caller reports NUMERIC */
     return IMEST_ST_NUMERIC;
   }
   /* s = 2^round(log2(1/T_R0)); a bad nominal falls back to 0.1 s (s = 8). */
-  const double trn = (isfinite(tr_nominal_s) && tr_nominal_s > 1e-9 && tr_nominal_s < 1e9) ? tr_nominal_s : 0.1;
-  const int sexp = imest_round_log2(1.0 / trn);
+  const double trn = (imest_finite(tr_nominal_s) && tr_nominal_s > 1e-9 && tr_nominal_s < 1e9) ? tr_nominal_s : 0.1;
+  const int sx = imest_round_log2(1.0 / trn);
   const int cexp = imest_round_log2(in->ry);
 
-  /* g from k^ = -sum(e1)/(2 sum(e2)) at kappa = 1 with g = 1. */
-  imest_tables_scaled(in, sexp, 0, cexp, t);
+  /* g from k^ = -sum(e1)/(2 sum(e2)) at kappa = 1 with g = 1; the g scaling
+   * is then applied to e2 (g^2) and e1 (g) exactly, without a second pass. */
+  imest_tables_scaled(in, sx, 0, cexp, t);
   double se1 = 0.0, se2 = 0.0;
   for (int m = 0; m < 7; ++m) se2 += t->e2[m];
   for (int m = 0; m < 8; ++m) se1 += t->e1[m];
   const double khat = -se1 / (2.0 * se2);
   int gexp = 0;
-  if (isfinite(khat) && khat != 0.0) {
-    gexp = imest_round_log2(fabs(khat));
+  if (imest_finite(khat) && khat != 0.0) {
+    gexp = imest_round_log2(khat < 0.0 ? -khat : khat);
     if (gexp > 200) gexp = 200;
     if (gexp < -200) gexp = -200;
   }
-  if (gexp != 0) imest_tables_scaled(in, sexp, gexp, cexp, t);
+  if (gexp != 0) {
+    t->gexp = gexp;
+    t->g = imest_pow2(gexp);
+    const double g1 = t->g, g2 = imest_pow2(2 * gexp);
+    for (int m = 0; m < 7; ++m) t->e2[m] *= g2;
+    for (int m = 0; m < 8; ++m) t->e1[m] *= g1;
+    p_coefficients(t);
+  }
 
   if (!all_finite(t->e2, 7) || !all_finite(t->e1, 8) || !all_finite(t->e0, 9)) return IMEST_ST_NUMERIC;
   return IMEST_OK;
+}
+
+void imest_tables_values(const imest_tables_t *t, double x, double v[3]) {
+  double p2 = t->e2[6], p1 = t->e1[7], p0 = t->e0[8];
+  p1 = p1 * x + t->e1[6];
+  p0 = p0 * x + t->e0[7];
+  p0 = p0 * x + t->e0[6];
+  for (int m = 5; m >= 0; --m) {
+    p2 = p2 * x + t->e2[m];
+    p1 = p1 * x + t->e1[m];
+    p0 = p0 * x + t->e0[m];
+  }
+  v[0] = p2;
+  v[1] = p1;
+  v[2] = p0;
 }
 
 void imest_tables_eval(const imest_tables_t *t, double kappa, imest_tabval_t *v) {

@@ -44,6 +44,7 @@ int imest_background(imest_t *s, imest_result_t *out)
     cfg.tr_nominal_s = (double)s->tr_nominal_s;
     cfg.tr_min_s = (double)s->tr_min_s;
     cfg.tr_max_s = (double)s->tr_max_s;
+    cfg.weight_c = imest_solve_weight_c(&sums); /* speed-normalised cost (bg_solve.h) */
     (void)imest_solve(&sums, &cfg, &so);
   }
 

@@ -1,7 +1,8 @@
 /* Background stage 1: take one window's ISR sums to float64 8x8 form.
  * The ISR accumulated Z = [W1 W2 W4 W5 W6 W7 W8 e] with e = y - W c0; here
  * R_Wy = R_We + R_W c0 and R_y = R_ee + 2 c0.R_We + c0' R_W c0 (float64), and
- * row/column 3 = -m x row/column 4 (MATH.md §2). */
+ * row/column 3 = -m x row/column 4 (MATH.md §2). The centred form (c0, R_We,
+ * R_ee) is passed on too, for E without cancellation (bg_select.c). */
 #include <math.h>
 
 #include "bg_internal.h"
@@ -46,6 +47,16 @@ void imest_window_sums(const imest_window_t *w, double m, unsigned int pole_pair
   out->rw[2][2] = m * m * out->rw[3][3];
   out->rwy[2] = -m * out->rwy[3];
   out->ry = ry;
+  /* centred form (bg_solve.h): E of a candidate without the cancellation of
+   * the un-centred R_y, R_Wy (floor ~1e-5 R_y with float32 sums) */
+  out->centred = 1;
+  out->ree = z[7][7];
+  for (unsigned int i = 0; i < 7u; ++i) {
+    out->c0[k_of_col[i]] = c0[i];
+    out->rwe[k_of_col[i]] = z[i][7];
+  }
+  out->c0[2] = 0.0;
+  out->rwe[2] = -m * out->rwe[3];
 
   const double n = w->used > 0u ? (double)w->used : 1.0;
   const double r44 = out->rw[3][3], r66 = out->rw[5][5];

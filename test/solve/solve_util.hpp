@@ -190,4 +190,80 @@ inline imest_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double
   return S;
 }
 
+// Errors in variables: the same random signals, but white noise (rms
+// d2_noise_rel x rms of d2i/dt2) on the measured d2i/dt2, which enters y with
+// coefficient 1 and W.8 with -n^2 w^2 (MATH.md §9: the cause of the paper's
+// spurious minimum at K2 ~ n_p w). steady: nearly constant speed and slowly
+// varying rotor-frame currents (a loaded steady state), else synthetic_sums'.
+inline imest_sums_t eiv_sums(std::mt19937_64 &rng, const Motor &mo, double d2_noise_rel, int nsamp = 2000,
+                             bool steady = false) {
+  std::uniform_real_distribution<double> U(0, 1);
+  const double fs = 4000.0;
+  struct Sin {
+    double a, f, ph;
+  };
+  auto mk = [&](double amp, double fmax) {
+    std::vector<Sin> v;
+    for (int k = 0; k < 3; ++k) v.push_back({amp * (0.2 + U(rng)), fmax * (0.05 + U(rng)), 6.283 * U(rng)});
+    return v;
+  };
+  const double fmax = steady ? 3.0 : 20.0;
+  const auto six = mk(2.0, fmax), siy = mk(2.0, fmax), sux = mk(150.0, fmax), suy = mk(150.0, fmax),
+             sw = mk(steady ? 0.5 : 10.0, 5);
+  const double w0 = 100 + 80 * U(rng);
+  auto ev = [](const std::vector<Sin> &v, double t, int d) {
+    double r = 0;
+    for (const auto &s : v) {
+      const double om = 6.283185307179586 * s.f, ph = om * t + s.ph;
+      const double c = std::cos(ph), sn = std::sin(ph);
+      r += (d == 0) ? s.a * sn : (d == 1) ? s.a * om * c : -s.a * om * om * sn;
+    }
+    return r;
+  };
+  // rms of d2i over the window, for the noise level
+  double d2rms = 0;
+  for (int n = 0; n < nsamp; ++n) {
+    const double t = n / fs, a = ev(six, t, 2), b = ev(siy, t, 2);
+    d2rms += a * a + b * b;
+  }
+  d2rms = std::sqrt(d2rms / (2.0 * nsamp));
+  long double K[8];
+  kvec(mo.k1(), mo.k2(), K);
+  imest_sums_t S{};
+  std::normal_distribution<double> N(0, 1);
+  for (int n = 0; n < nsamp; ++n) {
+    const double t = n / fs;
+    Sample q{ev(six, t, 0), ev(siy, t, 0), ev(six, t, 1), ev(siy, t, 1), ev(six, t, 2), ev(siy, t, 2),
+             ev(sux, t, 0), ev(suy, t, 0), ev(sux, t, 1), ev(suy, t, 1), w0 + ev(sw, t, 0), ev(sw, t, 1)};
+    double W[2][8];
+    regressor(mo, q, W);
+    double y[2];
+    for (int r = 0; r < 2; ++r) {
+      y[r] = 0;
+      for (int i = 0; i < 8; ++i) y[r] += W[r][i] * (double)K[i];
+    }
+    const double dx = d2_noise_rel * d2rms * N(rng), dy = d2_noise_rel * d2rms * N(rng);
+    q.d2ix += dx;
+    q.d2iy += dy;
+    regressor(mo, q, W);
+    y[0] += dx;
+    y[1] += dy;
+    for (int r = 0; r < 2; ++r) {
+      for (int i = 0; i < 8; ++i) {
+        for (int j = 0; j < 8; ++j) S.rw[i][j] += W[r][i] * W[r][j];
+        S.rwy[i] += W[r][i] * y[r];
+      }
+      S.ry += y[r] * y[r];
+    }
+  }
+  const double m = mo.m();
+  for (int i = 0; i < 8; ++i) {
+    S.rw[2][i] = -m * S.rw[3][i];
+    S.rw[i][2] = -m * S.rw[i][3];
+  }
+  S.rw[2][2] = m * m * S.rw[3][3];
+  S.rwy[2] = -m * S.rwy[3];
+  return S;
+}
+
 }  // namespace solvetest

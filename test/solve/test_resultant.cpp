@@ -39,10 +39,12 @@ TEST(Resultant, GenericDegree20) {
     const imest_sums_t s = random_psd(rng, false, 0);
     imest_tables_t t;
     imest_tables_scaled(&s, 0, 0, 0, &t);
-    double r[21];
-    imest_resultant(&t, r, 1);
+    double rw[22];
+    imest_resultant(&t, rw, 1);
+    EXPECT_EQ(rw[0], 0.0);  // weight 0: r_w = kappa r
+    const double *r = rw + 1;
     double mag = 0;
-    for (double v : r) mag = std::max(mag, std::fabs(v));
+    for (int k = 0; k < 21; ++k) mag = std::max(mag, std::fabs(r[k]));
     const double lead = 16 * R(s, 4, 4) * (R(s, 3, 3) * R(s, 4, 4) - R(s, 3, 4) * R(s, 3, 4));
     const double r0 = -16 * R(s, 7, 7) * (R(s, 7, 7) * R(s, 8, 8) - R(s, 7, 8) * R(s, 7, 8));
     EXPECT_NEAR(r[20], lead, 1e-11 * mag) << it;
@@ -50,11 +52,11 @@ TEST(Resultant, GenericDegree20) {
     EXPECT_GE(lead, 0.0);
     EXPECT_LE(r[0], 1e-12 * mag);
     // generic flag keeps r[19], r[20]; the regressor flag zeroes them
-    double r18[21];
+    double r18[22];
     imest_resultant(&t, r18, 0);
-    EXPECT_EQ(r18[19], 0.0);
     EXPECT_EQ(r18[20], 0.0);
-    for (int k = 0; k < 19; ++k) EXPECT_EQ(r18[k], r[k]);
+    EXPECT_EQ(r18[21], 0.0);
+    for (int k = 0; k < 20; ++k) EXPECT_EQ(r18[k], rw[k]);
     // r(0) < 0 and lead > 0 => at least one positive root, found
     double roots[20];
     const int n = imest_poly_positive_roots(r, 20, roots, 20);
@@ -69,10 +71,11 @@ TEST(Resultant, StructuredDegree18) {
     const imest_sums_t s = random_psd(rng, true, m);
     imest_tables_t t;
     imest_tables_scaled(&s, 0, 0, 0, &t);
-    double r[21];
-    imest_resultant(&t, r, 1);
+    double rw[22];
+    imest_resultant(&t, rw, 1);
+    const double *r = rw + 1;
     double mag = 0;
-    for (double v : r) mag = std::max(mag, std::fabs(v));
+    for (int k = 0; k < 21; ++k) mag = std::max(mag, std::fabs(r[k]));
     EXPECT_LE(std::fabs(r[20]), 1e-12 * mag) << it;
     EXPECT_LE(std::fabs(r[19]), 1e-12 * mag) << it;
     const double R11 = R(s, 1, 1), R12 = R(s, 1, 2), R14 = R(s, 1, 4), R22 = R(s, 2, 2), R24 = R(s, 2, 4),
@@ -83,5 +86,54 @@ TEST(Resultant, StructuredDegree18) {
     EXPECT_NEAR(r[18], lead18, 1e-10 * mag) << it;
     EXPECT_GE(lead18, -1e-12 * mag);
     EXPECT_LE(r[0], 1e-12 * mag);
+  }
+}
+
+// Weighted cost (bg_poly.h): r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0 with
+// bw_t = kappa b_t + cw t'. For this regressor r_w[21] and r_w[20] vanish for
+// any cw (the K2^19 coefficient of the cw part is 8 e2[6] (4 e2[6] e0[8] -
+// e1[7]^2) = 32 R44 (R33 R44 - R34^2) = 0) and r_w[19] = r[18] (cw-free).
+// Defining property: r_w(kappa) = a1^2 p2w(k = -a0/a1) with
+// p2w = (kappa^2 + cw) dP/dkappa - 4 kappa P, P = sum (e2 k^2 + e1 k + e0) kappa^m.
+TEST(Resultant, WeightedStructuredDegree19) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> U(0, 1);
+  const double m = (1 - 0.096) / 0.096;
+  for (int it = 0; it < 300; ++it) {
+    const imest_sums_t s = random_psd(rng, true, m);
+    imest_tables_t t;
+    imest_tables_scaled(&s, 0, 0, 0, &t);
+    double r0[22];
+    imest_resultant(&t, r0, 1);
+    const double cw = std::pow(10.0, -2 + 4 * U(rng));
+    imest_tables_weight(&t, cw);
+    EXPECT_EQ(t.cw, cw);
+    double r[22];
+    imest_resultant(&t, r, 1);
+    double mag = 0;
+    for (double v : r) mag = std::max(mag, std::fabs(v));
+    EXPECT_LE(std::fabs(r[21]), 1e-12 * mag) << it;
+    EXPECT_LE(std::fabs(r[20]), 1e-12 * mag) << it;
+    EXPECT_NEAR(r[19], r0[19], 1e-10 * mag) << it;
+    for (int q = 0; q < 4; ++q) {
+      const long double x = std::pow(10.0, -1.5 + 3 * U(rng));
+      long double e[3] = {0, 0, 0}, de[3] = {0, 0, 0}, mg = 0;
+      const double *tab[3] = {t.e2, t.e1, t.e0};
+      const int len[3] = {7, 8, 9};
+      for (int o = 0; o < 3; ++o)
+        for (int k = 0; k < len[o]; ++k) {
+          e[o] += tab[o][k] * std::pow(x, k);
+          if (k > 0) de[o] += k * tab[o][k] * std::pow(x, k - 1);
+        }
+      const long double a1 = 2 * e[0], a0 = e[1], k = -a0 / a1;
+      const long double P = (e[0] * k + e[1]) * k + e[2], Px = (de[0] * k + de[1]) * k + de[2];
+      const long double ref = a1 * a1 * ((x * x + cw) * Px - 4 * x * P);
+      long double val = 0;
+      for (int j = 21; j >= 0; --j) {
+        val = val * x + r[j];
+        mg = mg * x + std::fabs(r[j]);
+      }
+      EXPECT_LE(std::fabs((double)(val - ref)), 1e-9 * (double)mg) << it << " x " << (double)x;
+    }
   }
 }

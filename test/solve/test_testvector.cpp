@@ -5,8 +5,13 @@
 //    to themselves); in practice they agree to round-off;
 //  - roots, candidates, K1, K2, T_R, R_S, E, E_I, Hessian, quadratic PE:
 //    1e-9 relative (H12 relative to sqrt(H11 H22));
-//  - exact PE indices: 1e-6 relative (the reference's own 1-D optimisation
-//    tolerance; ours is 2^-40 on the crossings, 1e-8 on the K1 extremes).
+//  - exact PE indices: 1e-3 relative (the reference's own 1-D optimisation
+//    tolerance is 1e-6; ours stops the crossings at 2^-12 of their distance
+//    from K2* and the K1 extremes when the parabola vertex moves by less than
+//    2^-10 of a quarter of the quadratic K2 index: that is what a 1.25 x E*
+//    level set needs, and it saves ~100k soft-double instructions on a M4F).
+// With weight_c = 0 the solve minimises the paper's cost: the weighted
+// p2w = kappa p2 (bw_t[m+1] = b_t[m]) and r_w = kappa r, checked here.
 // The same test runs for the float32-chain build and the float64-chain build
 // (IMEST_ROOTS_DOUBLE); both polish in float64, so both must meet these.
 #include <gtest/gtest.h>
@@ -35,9 +40,9 @@ imest_tables_t abs_tables(const imest_tables_t &t) {
   for (double &v : s.rwy) v = -std::fabs(v);  // the builder adds -2 g
   imest_tables_t a;
   imest_tables_scaled(&s, t.sexp, t.gexp, t.cexp, &a);
-  for (int m = 0; m < 7; ++m) a.b2[m] = std::fabs(a.b2[m]);
-  for (int m = 0; m < 8; ++m) a.b1[m] = std::fabs(a.b1[m]);
-  for (int m = 0; m < 9; ++m) a.b0[m] = std::fabs(a.b0[m]);
+  for (int m = 0; m < 8; ++m) a.bw2[m] = std::fabs(a.bw2[m]);
+  for (int m = 0; m < 9; ++m) a.bw1[m] = std::fabs(a.bw1[m]);
+  for (int m = 0; m < 10; ++m) a.bw0[m] = std::fabs(a.bw0[m]);
   return a;
 }
 
@@ -70,9 +75,14 @@ TEST(Testvector, ScalingsAndTables) {
   }
   cmp("a1", t.a1, a1m, 7);
   cmp("a0", t.a0, a.e1, 8);
-  cmp("b2", t.b2, b2m, 7);
-  cmp("b1", t.b1, a.b1, 8);
-  cmp("b0", t.b0, a.b0, 9);
+  // c = 0: bw_t[m + 1] = b_t[m] = (m - 4) t[m], bw_t[0] = 0
+  cmp("b2", t.bw2 + 1, b2m, 7);
+  cmp("b1", t.bw1 + 1, a.bw1 + 1, 8);
+  cmp("b0", t.bw0 + 1, a.bw0 + 1, 9);
+  EXPECT_EQ(t.bw2[0], 0.0);
+  EXPECT_EQ(t.bw1[0], 0.0);
+  EXPECT_EQ(t.bw0[0], 0.0);
+  EXPECT_EQ(t.cw, 0.0);
   std::printf("[tables] worst plain relative difference %.3g\n", worst);
 }
 
@@ -81,18 +91,20 @@ TEST(Testvector, Resultant) {
   const imest_sums_t s = tv_sums();
   imest_tables_t t;
   ASSERT_EQ(imest_tables_build(&s, 0.1, &t), IMEST_OK);
-  double r[21];
-  imest_resultant(&t, r, 0);
+  double rw[22];
+  imest_resultant(&t, rw, 0);
+  EXPECT_EQ(rw[0], 0.0);  // c = 0: r_w = kappa r
+  const double *r = rw + 1;
   const imest_tables_t a = abs_tables(t);
   double mag[21] = {0}, tmp[15], term[21];
   abs_conv(a.a0, 8, a.a0, 8, tmp);
-  abs_conv(tmp, 15, a.b2, 7, term);
+  abs_conv(tmp, 15, a.bw2 + 1, 7, term);
   for (int k = 0; k < 21; ++k) mag[k] += term[k];
   abs_conv(a.a0, 8, a.a1, 7, tmp);
-  abs_conv(tmp, 14, a.b1, 8, term);
+  abs_conv(tmp, 14, a.bw1 + 1, 8, term);
   for (int k = 0; k < 21; ++k) mag[k] += term[k];
   abs_conv(a.a1, 7, a.a1, 7, tmp);
-  abs_conv(tmp, 13, a.b0, 9, term);
+  abs_conv(tmp, 13, a.bw0 + 1, 9, term);
   for (int k = 0; k < 21; ++k) mag[k] += term[k];
   double worst = 0;
   for (int k = 0; k < 21; ++k) {
@@ -125,14 +137,17 @@ TEST(Testvector, SolveEndToEnd) {
   ASSERT_EQ(imest_tables_build(&s, 0.1, &t), IMEST_OK);
   double kap[3];
   for (int i = 0; i < 3; ++i) kap[i] = o.roots_k2[i] / t.s;
-  imest_cand_t cand[3];
+  imest_cand_t cand[3], best;
   unsigned nad = 0;
-  EXPECT_EQ(imest_select(&t, kap, 3, &cfg, s.ry, cand, &nad), 0);
+  EXPECT_EQ(imest_select(&t, kap, 3, &cfg, &s, &best, cand, &nad), 0);
+  EXPECT_EQ(best.k2, cand[0].k2);
+  EXPECT_EQ(nad, 3u);
   for (int i = 0; i < 3; ++i) {
     const auto &c = j["candidates"][i];
     EXPECT_LE(rel(cand[i].k1, c["K1"].get<double>()), 1e-9) << i;
     EXPECT_LE(rel(cand[i].k2, c["K2"].get<double>()), 1e-9) << i;
     EXPECT_LE(rel(cand[i].e, c["E"].get<double>()), 1e-9) << i;
+    EXPECT_EQ(cand[i].ew, cand[i].e) << i;  // c = 0: E_w = E_p^2
   }
   const double ks[] = {rel(o.k1, j["K1"].get<double>()),     rel(o.k2, j["K2"].get<double>()),
                        rel(o.tr_s, j["T_R"].get<double>()),  rel(o.rs_ohm, j["R_S"].get<double>()),
@@ -154,8 +169,9 @@ TEST(Testvector, SolveEndToEnd) {
   std::printf("[solve] H rel diff %.2g %.2g %.2g\n", rel(o.hessian[0][0], h11), rel(o.hessian[0][1], h12),
               rel(o.hessian[1][1], h22));
   const double pk1 = rel(o.pe_k1, j["PE_K1"].get<double>()), pk2 = rel(o.pe_k2, j["PE_K2"].get<double>());
-  EXPECT_LE(pk1, 1e-6);
-  EXPECT_LE(pk2, 1e-6);
+  EXPECT_LE(pk1, 1e-3);
+  EXPECT_LE(pk2, 1e-3);
+  EXPECT_EQ(o.e_w, o.e);
   EXPECT_EQ(o.pe_flags, 0u);
   std::printf("[solve] PE_K1 %.12g (ref %.12g, rel %.2g)  PE_K2 %.12g (ref %.12g, rel %.2g)\n", o.pe_k1,
               j["PE_K1"].get<double>(), pk1, o.pe_k2, j["PE_K2"].get<double>(), pk2);
@@ -171,9 +187,10 @@ TEST(Testvector, ChainPrecisionDoesNotMatterAfterPolish) {
   const imest_sums_t s = tv_sums();
   imest_tables_t t;
   ASSERT_EQ(imest_tables_build(&s, 0.1, &t), IMEST_OK);
-  double r[21], x[20];
-  imest_resultant(&t, r, 0);
-  const int n = imest_poly_positive_roots(r, 18, x, 20);
+  double rw[22], x[20];
+  imest_resultant(&t, rw, 0);
+  const int n = imest_poly_positive_roots(rw, IMEST_RES_DEG, x, 20);
+  const double *r = rw + 1;
   ASSERT_EQ(n, 3);
   const auto &j = testvector();
   for (int i = 0; i < n; ++i) {
