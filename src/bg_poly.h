@@ -10,6 +10,15 @@
 extern "C" {
 #endif
 
+/* Helpers called from several places are kept out of line: at -O2 GCC
+ * inlines them into every caller, which costs flash (the ISR flags must stay
+ * -O2, so the background code says it here). */
+#if defined(__GNUC__)
+#define IMEST_NOINLINE __attribute__((noinline))
+#else
+#define IMEST_NOINLINE
+#endif
+
 /* Largest polynomial degree the root finder accepts (generic resultant: 20). */
 #define IMEST_POLY_MAXDEG 20
 

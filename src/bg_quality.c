@@ -46,7 +46,7 @@ typedef struct {
 } pe_ctx_t;
 
 /* g(x) = 4 e2 (e0 - L D^2) - e1^2 (< 0 inside the level set); v = tables. */
-static double level_g(pe_ctx_t *c, double x, double v[3]) {
+IMEST_NOINLINE static double level_g(pe_ctx_t *c, double x, double v[3]) {
   ++c->nev;
   imest_tables_values(c->t, x, v);
   const double dd = x * x + c->t->cw;
@@ -61,7 +61,7 @@ static double level_fn(pe_ctx_t *c, double x) {
 }
 
 /* sign = +1: k+(x); sign = -1: -k-(x) (both to be maximised). */
-static double kbound(pe_ctx_t *c, double x, int sign) {
+IMEST_NOINLINE static double kbound(pe_ctx_t *c, double x, int sign) {
   double v[3];
   const double g = level_g(c, x, v);
   double k;
@@ -75,7 +75,7 @@ static double kbound(pe_ctx_t *c, double x, int sign) {
 }
 
 /* Illinois on [x0, x1] with f0 < 0 <= f1 (either order); xs = kappa*. */
-static double illinois(pe_ctx_t *c, double xs, double x0, double f0, double x1, double f1) {
+IMEST_NOINLINE static double illinois(pe_ctx_t *c, double xs, double x0, double f0, double x1, double f1) {
   int retained = 0; /* +1: x0 kept last time, -1: x1 kept last time */
   double x = x1;
   for (int it = 0; it < IMEST_PE_MAX_ROOT; ++it) {
@@ -102,7 +102,7 @@ static double illinois(pe_ctx_t *c, double xs, double x0, double f0, double x1, 
 
 /* First crossing of the profile with L on one side of xs; 1 if found (in *xc),
  * 0 if the band edge is reached first (*xc = edge). */
-static int crossing(pe_ctx_t *c, double xs, double fs, double d0, double edge, int dir, double *xc) {
+IMEST_NOINLINE static int crossing(pe_ctx_t *c, double xs, double fs, double d0, double edge, int dir, double *xc) {
   double xprev = xs, fprev = fs, step = d0;
   for (int j = 0; j < IMEST_PE_MAX_PROBE; ++j) {
     double x = xs + (double)dir * step;
@@ -127,7 +127,7 @@ static int crossing(pe_ctx_t *c, double xs, double fs, double d0, double edge, i
 
 /* Maximum of kbound(., sign) on [a, b] by successive parabolic interpolation
  * from x0 with spacing h (see the file comment). */
-static double pe_max(pe_ctx_t *c, int sign, double a, double b, double x0, double h) {
+IMEST_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, double x0, double h) {
   if (!(b > a)) return kbound(c, a, sign);
   if (!(h > 0.0) || h > 0.25 * (b - a)) h = 0.25 * (b - a);
   if (x0 < a + h) x0 = a + h;

@@ -126,7 +126,7 @@ double imest_poly_eval(const double *c, int deg, double x) {
 }
 
 /* f = p^(order)(x), df = p^(order+1)(x), order 0 (two Horner passes) or 1 (three). */
-static void eval_d(const double *c, int n, int order, double x, double *f, double *df) {
+IMEST_NOINLINE static void eval_d(const double *c, int n, int order, double x, double *f, double *df) {
   double p = c[n], p1 = 0.0, p2 = 0.0;
   if (order == 0) {
     for (int k = n - 1; k >= 0; --k) {
@@ -147,21 +147,21 @@ static void eval_d(const double *c, int n, int order, double x, double *f, doubl
 }
 
 /* p^(order)(x) alone (order 0: one Horner pass). */
-static double eval_v(const double *c, int n, int order, double x) {
+IMEST_NOINLINE static double eval_v(const double *c, int n, int order, double x) {
   if (order == 0) return imest_poly_eval(c, n, x);
   double f, df;
   eval_d(c, n, 1, x, &f, &df);
   return f;
 }
 
-static double abs_sum_d(const double *c, int n, double x) {
+IMEST_NOINLINE static double abs_sum_d(const double *c, int n, double x) {
   double p = 0.0;
   for (int k = n; k >= 0; --k) p = p * fabs(x) + fabs(c[k]);
   return p;
 }
 
 /* Normalise P_k to max|c| = 1 (optionally negated) and drop small leading terms. */
-static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
+IMEST_NOINLINE static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
   sreal_t *c = CH(ch, k);
   int d = ch->deg[k];
   sreal_t mx = 0;
@@ -175,7 +175,7 @@ static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
   ch->deg[k] = (short)d;
 }
 
-static void chain_build(chain_t *ch, const double *pd, int n) {
+IMEST_NOINLINE static void chain_build(chain_t *ch, const double *pd, int n) {
   for (int k = 0, o = 0; k <= n; ++k) { /* P_k has degree <= n - k */
     ch->off[k] = (short)o;
     o += n - k + 1;
@@ -229,7 +229,7 @@ static int sign_changes(const chain_t *ch, sreal_t x, imest_roots_stats_t *st) {
 
 /* Safeguarded Newton on p^(order) in [a,b], where the signs at a and b differ
  * (fa is the value at a). */
-static double newton_bracketed(const double *c, int n, int order, double a, double b, double fa,
+IMEST_NOINLINE static double newton_bracketed(const double *c, int n, int order, double a, double b, double fa,
                                imest_roots_stats_t *st) {
   double x = 0.5 * (a + b);
   int prev_newton = 0;
@@ -258,7 +258,7 @@ static double newton_bracketed(const double *c, int n, int order, double a, doub
 
 /* Find a float64 sign change of p^(order) on [a,b] or a widening of it within
  * [lo,hi]; then polish. Returns 1 and *root on success. */
-static int polish_order(const double *c, int n, int order, double a, double b, double lo, double hi,
+IMEST_NOINLINE static int polish_order(const double *c, int n, int order, double a, double b, double lo, double hi,
                         double *root, imest_roots_stats_t *st) {
   double fa = eval_v(c, n, order, a), fb = eval_v(c, n, order, b);
   st->polish_evals += 2;
@@ -337,7 +337,7 @@ static int polish(const double *c, int n, double a, double b, double lo, double 
 
 /* Refine one interval (count >= 1) in chain precision and polish it in float64.
  * Returns 0 (rejected), 1 (float64 sign change: odd multiplicity) or 2 (even). */
-static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root, imest_roots_stats_t *st) {
+IMEST_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root, imest_roots_stats_t *st) {
   const double lo = (double)iv.a, hi = (double)iv.b;
   sreal_t a = iv.a, b = iv.b;
   const sreal_t *p0 = CH(ch, 0);
@@ -391,7 +391,7 @@ static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double 
  * between 0+ and TOP. If not, p is sampled in float64 at a fixed grid
  * (0, 2^-16 .. 2^-1, 0.75, TOP; 19 points) and every grid cell with a sign
  * change and no root yet is solved by the bracketed float64 Newton. */
-static int parity_rescue(const double *pd, int n, double ylo, double *out, int *odd, int nout,
+IMEST_NOINLINE static int parity_rescue(const double *pd, int n, double ylo, double *out, int *odd, int nout,
                          imest_roots_stats_t *st) {
   const double top = (double)DOMAIN_TOP;
   const double ftop = imest_poly_eval(pd, n, top);
@@ -440,7 +440,8 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double
   stack[top].depth = 0;
   ++top;
   while (top > 0) {
-    const ival_t iv = stack[--top];
+    const ival_t *ivp = &stack[--top];
+    const ival_t iv = *ivp;
     const int cnt = iv.va - iv.vb;
     if (cnt <= 0) continue;
     if (cnt >= 2) {
@@ -480,7 +481,7 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double
 
 /* Insert x into the ascending roots[0..*nr-1] (at most max), dropping it if a
  * root within MERGE_REL lies next to it; when full, the largest is dropped. */
-static void merge_root(double x, double *roots, int *nr, int max, imest_roots_stats_t *st) {
+IMEST_NOINLINE static void merge_root(double x, double *roots, int *nr, int max, imest_roots_stats_t *st) {
   if (!(x > 0.0) || !imest_finite(x)) {
     ++st->rejected;
     return;

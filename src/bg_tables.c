@@ -50,7 +50,7 @@ static double *table_of(imest_tables_t *t, int order) {
 }
 
 /* bw[j] = (j-5) t[j-1] + cw (j+1) t[j+1], j = 0..len (t has len entries). */
-static void weighted_b(const double *tab, int len, double cw, double *bw) {
+IMEST_NOINLINE static void weighted_b(const double *tab, int len, double cw, double *bw) {
   for (int j = 0; j <= len; ++j) {
     double v = (j >= 1) ? (double)(j - 5) * tab[j - 1] : 0.0;
     if (cw != 0.0 && j + 1 < len) v += cw * (double)(j + 1) * tab[j + 1];
@@ -65,13 +65,13 @@ void imest_tables_weight(imest_tables_t *t, double weight_c) {
   weighted_b(t->e0, 9, t->cw, t->bw0);
 }
 
-static void p_coefficients(imest_tables_t *t) {
+IMEST_NOINLINE static void p_coefficients(imest_tables_t *t) {
   for (int m = 0; m < 7; ++m) t->a1[m] = 2.0 * t->e2[m];
   for (int m = 0; m < 8; ++m) t->a0[m] = t->e1[m];
   imest_tables_weight(t, 0.0);
 }
 
-void imest_tables_scaled(const imest_sums_t *in, int sexp, int gexp, int cexp, imest_tables_t *t) {
+IMEST_NOINLINE void imest_tables_scaled(const imest_sums_t *in, int sexp, int gexp, int cexp, imest_tables_t *t) {
   t->sexp = sexp;
   t->gexp = gexp;
   t->cexp = cexp;
