@@ -30,7 +30,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     s.rw[2][2] = m * m * s.rw[3][3];
     s.rwy[2] = -m * s.rwy[3];
   }
-  imest_solve_cfg_t cfg;
+  imest_solve_cfg_t cfg{};
+  cfg.weight_c = (mode & 4) ? imest_solve_weight_c(&s) : 0.0;
   cfg.sigma = 0.096;
   cfg.ls_h = 0.2908;
   cfg.tr_nominal_s = 0.1;
@@ -42,6 +43,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     cfg.tr_nominal_s = in.get<double>(cfg.tr_nominal_s);
     cfg.tr_min_s = in.get<double>(cfg.tr_min_s);
     cfg.tr_max_s = in.get<double>(cfg.tr_max_s);
+    cfg.weight_c = in.get<double>(cfg.weight_c);
   }
   imest_solve_out_t out;
   std::memset(&out, 0xA5, sizeof out);
