@@ -29,11 +29,23 @@
  *
  * Per window (background path, bounded iterations):
  *   rebuild the 8x8 R_W -> power-of-two scaling -> cost tables e0,e1,e2 ->
- *   p1, p2 coefficients -> resultant r(K2) (degree 18) -> every positive root by
- *   a Sturm sequence with bisection -> back-substitution K1 = -a0/a1 ->
- *   selection (K1 > 0, T_R in [tr_min_s, tr_max_s], least E) -> T_R = 1/K2,
+ *   p1, p2 coefficients -> resultant r(K2) (degree 19) -> every positive root by
+ *   a Sturm sequence with bisection (float32 chain, float64 polish) ->
+ *   back-substitution K1 = -a0/a1 -> selection (K1 > 0, T_R in
+ *   [tr_min_s, tr_max_s], least cost) -> T_R = 1/K2,
  *   R_S = sigma*L_S*K1 - (1-sigma)*L_S*K2 -> Hessian, E_I, parametric error
  *   indices -> validity with a reason.
+ *
+ * The cost minimised is the paper's E_p^2 divided by (1 + c/K2^2)^2 with
+ * c = n_p^2 w^2 of the window (current-weighted). The paper's regressor
+ * equation is its model equation multiplied by (1 + n_p^2 w^2 T_R^2); E_p^2
+ * therefore weighs the residual ~2e5 times more at the true T_R than at the
+ * spurious stationary point K2 ~ n_p w, and with 12-bit sensors the spurious
+ * point wins in most steady-state windows below rated load. Dividing the
+ * weight out keeps every exact-data solution (it is the same model) and
+ * removes that bias (README, "Method"). E and E_I are reported as the
+ * paper's E_p^2 at the selected point; the Hessian and the parametric error
+ * indices are those of the minimised cost.
  *
  * Concurrency contract (ISR <-> background):
  *   - imest_isr_abc()/imest_isr_ab() are called from exactly one context (the
