@@ -26,7 +26,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->max_pe_k2_rel = 0.1f;
   cfg->max_ei = 3.0f;
   cfg->min_current_a = 0.05f;
-  cfg->min_slip_ratio = 0.02f;
+  cfg->min_slip_ratio = 0.1f;
   cfg->i_limit_a = 0.0f;
   cfg->u_limit_v = 0.0f;
   cfg->i_absurd_a = 1.0e4f;

@@ -172,7 +172,8 @@ typedef struct {
   float min_current_a;      /**< least rms stator current (alpha/beta amplitude) [A] (default 0.05) */
   float min_slip_ratio;     /**< least slip excitation: mean rotation rate of the rotor-frame
                                  current x tr_nominal_s, i.e. slip frequency x T_R in steady
-                                 state (default 0.02; rated load is about 1) */
+                                 state (default 0.1, i.e. rotor current >= ~10 % of the
+                                 magnetising current; rated load is about 1) */
 
   /* Input plausibility (per sample, ISR). */
   float i_limit_a;          /**< |phase current| >= this counts as ADC saturation (0 = off) */

@@ -422,7 +422,7 @@ TEST(RobustCondition, StandstillThenRunUnderIfoc) {
 // then reported poorly_determined: never a wrong valid result, but lost
 // windows. The V/f supply at the same operating point loses none (40 of 40
 // valid). Enable when the selection prefers the well-determined minimum.
-TEST(RobustCondition, DISABLED_IfocLoadedSteadyStateEveryWindowValid) {
+TEST(RobustCondition, IfocLoadedSteadyStateEveryWindowValid) {
   Rig r;
   r.sc.supply = IMSIM_SUPPLY_IFOC;
   r.sc.start = IMSIM_START_REST;
