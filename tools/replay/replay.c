@@ -3,6 +3,7 @@
  * float32 ISR call per sample, the background call when a window completes.
  * Prints one CSV row per window on stdout. */
 #include <errno.h>
+#include <stddef.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -60,6 +61,28 @@ static int parse_num(const char *opt, const char *s, double *out)
   }
   *out = x;
   return 0;
+}
+
+/* The config fields set by a plain numeric option. */
+static float *float_option(imest_config_t *cfg, const char *opt)
+{
+  static const struct {
+    const char *name;
+    size_t offset;
+  } table[] = {
+      {"--window", offsetof(imest_config_t, window_s)},
+      {"--filter-hz", offsetof(imest_config_t, filter_hz)},
+      {"--aa-hz", offsetof(imest_config_t, aa_hz)},
+      {"--u-delay", offsetof(imest_config_t, u_delay_s)},
+      {"--tr-nominal", offsetof(imest_config_t, tr_nominal_s)},
+      {"--tr-min", offsetof(imest_config_t, tr_min_s)},
+      {"--tr-max", offsetof(imest_config_t, tr_max_s)},
+      {"--max-pe-k2", offsetof(imest_config_t, max_pe_k2_rel)},
+  };
+  for (size_t k = 0; k < sizeof table / sizeof table[0]; ++k) {
+    if (!strcmp(opt, table[k].name)) return (float *)(void *)((char *)cfg + table[k].offset);
+  }
+  return NULL;
 }
 
 typedef struct {
@@ -131,38 +154,10 @@ int main(int argc, char **argv)
       if (parse_num(o, v, &d)) return 2;
       cfg.sigma = (float)d;
       have_sigma = 1;
-    } else if (!strcmp(o, "--window")) {
+    } else if (float_option(&cfg, o) != NULL) {
       NEED_VALUE;
       if (parse_num(o, v, &d)) return 2;
-      cfg.window_s = (float)d;
-    } else if (!strcmp(o, "--filter-hz")) {
-      NEED_VALUE;
-      if (parse_num(o, v, &d)) return 2;
-      cfg.filter_hz = (float)d;
-    } else if (!strcmp(o, "--aa-hz")) {
-      NEED_VALUE;
-      if (parse_num(o, v, &d)) return 2;
-      cfg.aa_hz = (float)d;
-    } else if (!strcmp(o, "--u-delay")) {
-      NEED_VALUE;
-      if (parse_num(o, v, &d)) return 2;
-      cfg.u_delay_s = (float)d;
-    } else if (!strcmp(o, "--tr-nominal")) {
-      NEED_VALUE;
-      if (parse_num(o, v, &d)) return 2;
-      cfg.tr_nominal_s = (float)d;
-    } else if (!strcmp(o, "--tr-min")) {
-      NEED_VALUE;
-      if (parse_num(o, v, &d)) return 2;
-      cfg.tr_min_s = (float)d;
-    } else if (!strcmp(o, "--tr-max")) {
-      NEED_VALUE;
-      if (parse_num(o, v, &d)) return 2;
-      cfg.tr_max_s = (float)d;
-    } else if (!strcmp(o, "--max-pe-k2")) {
-      NEED_VALUE;
-      if (parse_num(o, v, &d)) return 2;
-      cfg.max_pe_k2_rel = (float)d;
+      *float_option(&cfg, o) = (float)d;
     } else if (!strcmp(o, "--i-limit")) {
       NEED_VALUE;
       if (strcmp(v, "auto") && parse_num(o, v, &i_limit)) return 2;
