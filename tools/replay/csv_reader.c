@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L /* getline */
 #include "csv_reader.h"
 
 #include <ctype.h>
@@ -11,23 +12,9 @@ const char *const CSV_NAMES[CSV_NEED] = {"t", "u_a", "u_b", "u_c", "i_a", "i_b",
 /* Read one line (any length); strips \n and \r. Returns length or -1 at EOF. */
 static long read_line(csv_reader_t *r)
 {
-  size_t n = 0;
-  int c;
-  while ((c = fgetc(r->f)) != EOF && c != '\n') {
-    if (n + 2 > r->cap) {
-      size_t cap = r->cap ? 2 * r->cap : 256;
-      char *nb = realloc(r->buf, cap);
-      if (nb == NULL) return -1;
-      r->buf = nb;
-      r->cap = cap;
-    }
-    r->buf[n++] = (char)c;
-  }
-  if (c == EOF && n == 0) return -1;
-  if (r->buf == NULL) {
-    r->buf = malloc(256);
-    r->cap = 256;
-  }
+  ssize_t n = getline(&r->buf, &r->cap, r->f);
+  if (n < 0) return -1;
+  if (n > 0 && r->buf[n - 1] == '\n') n--;
   if (n > 0 && r->buf[n - 1] == '\r') n--;
   r->buf[n] = '\0';
   r->line++;
