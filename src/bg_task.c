@@ -26,8 +26,8 @@ int imest_background(imest_t *s, imest_result_t *out)
   out->used_samples = w->used;
   out->overruns = s->overruns;
   out->flags = w->flags;
-  out->t_end_s = ((double)w->seq + 1.0) * (double)s->window_n / (double)s->fs -
-                 1.0 / (double)s->fs;
+  /* every window before this one was complete (a flushed one ends a run) */
+  out->t_end_s = ((double)w->seq * (double)s->window_n + (double)w->samples - 1.0) / (double)s->fs;
 
   const double m = (double)s->m;
   imest_sums_t sums;

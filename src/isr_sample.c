@@ -139,6 +139,11 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
   return (s->k >= s->window_n) ? isr_close_window(s) : 0;
 }
 
+int imest_isr_flush(imest_t *s)
+{
+  return (s->k > 0u) ? isr_close_window(s) : 0;
+}
+
 int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a, float i_beta_a,
                  float theta_rad)
 {

@@ -333,6 +333,12 @@ int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], fl
 int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a,
                  float i_beta_a, float theta_rad);
 
+/** End the current window now, shorter than window_s (a drive that stops, a
+ *  recording that ends): it is handed to the background like a completed one
+ *  and judged on the samples it has. Call from the ISR context. Returns 1 if
+ *  handed over, 0 if the window was empty or dropped (overrun). */
+int imest_isr_flush(imest_t *s);
+
 /**
  * Background call: if a finished window is waiting, solve it, publish it over
  * the CAN port (if one is attached), fill *out and return 1; else return 0

@@ -182,3 +182,26 @@ TEST(Handoff, EncoderJumpAndSaturationAreFlagged) {
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_EQ(r.status, IMEST_ST_ADC_SATURATION);
 }
+
+TEST(Handoff, FlushHandsOverAShortWindowWithItsOwnEndTime) {
+  imest_config_t cfg = small_config();  // 400-sample windows
+  cfg.start_at_rest = 1;
+  static imest_t s;
+  imest_result_t r;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  EXPECT_EQ(imest_isr_flush(&s), 0);  // nothing to hand over
+  int k = 0;
+  feed(&s, 400 + 250, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_EQ(imest_isr_flush(&s), 1);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_EQ(r.seq, 1u);
+  EXPECT_EQ(r.samples, 250u);
+  EXPECT_EQ(r.used_samples, 250u);
+  EXPECT_NEAR(r.t_end_s, (650 - 1) / 4000.0, 1e-9);
+  // the next window is a full one again, numbered on
+  feed(&s, 400, k);
+  ASSERT_EQ(imest_background(&s, &r), 1);
+  EXPECT_EQ(r.seq, 2u);
+  EXPECT_EQ(r.samples, 400u);
+}

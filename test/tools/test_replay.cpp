@@ -177,6 +177,26 @@ TEST(Replay, Float32PathWithinOneBasisPointOfFloat64) {
   EXPECT_GE(compared, 4);
 }
 
+// A record shorter than a window is estimated as one shorter window; a last
+// partial window of at least half the length is estimated too.
+TEST(Replay, ShortRecordsAndPartialLastWindows) {
+  const std::string &p = sim_csv("exp1_short.csv", "--preset exp1 --duration 0.3");
+  Out a = replay(p);
+  ASSERT_EQ(a.code, 0) << a.err;
+  auto r = rows(a.out);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[1][4], "1") << a.out;  // the run-up is valid
+  EXPECT_NEAR(std::stod(r[1][1]), 0.12, 0.12 * 0.02);
+  EXPECT_EQ(r[1][19], "1201");
+  const std::string &q = sim_csv("exp1_1p6.csv", "--preset exp1 --duration 1.6");
+  a = replay(q);
+  ASSERT_EQ(a.code, 0) << a.err;
+  r = rows(a.out);
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[2][19], "2401");
+  EXPECT_NEAR(std::stod(r[2][0]), 1.6, 1e-6);
+}
+
 TEST(Replay, CandumpLogHasOneLineGroupPerWindow) {
   const std::string &p = sim_csv("exp2_short.csv", "--preset exp2 --duration 3.2 --supply vf");
   const std::string log = tmpdir() + "/frames.log";

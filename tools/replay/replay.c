@@ -85,6 +85,15 @@ static float *float_option(imest_config_t *cfg, const char *opt)
   return NULL;
 }
 
+static void print_row(double t0, const imest_result_t *r)
+{
+  printf("%.6f,%.9g,%.9g,%.6g,%d,%s,%u,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%u,%u,%.4g,%.6g,%u,0x%x\n",
+         t0 + r->t_end_s, r->tr_s, r->rs_ohm, r->e_i, r->valid, imest_status_name(r->status),
+         r->seq, r->k1, r->k2, r->pe_k1_rel, r->pe_k2_rel, r->hessian[0][0], r->hessian[0][1],
+         r->hessian[1][1], (r->flags & IMEST_FLAG_HESSIAN_PD) ? 1 : 0, r->n_roots,
+         r->n_admissible, r->slip_ratio, r->i_rms_a, r->used_samples, r->flags);
+}
+
 typedef struct {
   double max_abs;
   long run, plateau;
@@ -364,12 +373,7 @@ int main(int argc, char **argv)
       if (canlog) imest_candump_port_set_time(&cport, v[0]); /* log time = window end */
 #endif
       while (imest_background(&est, &res) == 1) {
-        printf("%.6f,%.9g,%.9g,%.6g,%d,%s,%u,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%u,%u,%.4g,%.6g,%u,0x%x\n",
-               t0 + res.t_end_s, res.tr_s, res.rs_ohm, res.e_i, res.valid,
-               imest_status_name(res.status), res.seq, res.k1, res.k2, res.pe_k1_rel, res.pe_k2_rel,
-               res.hessian[0][0], res.hessian[0][1], res.hessian[1][1],
-               (res.flags & IMEST_FLAG_HESSIAN_PD) ? 1 : 0, res.n_roots, res.n_admissible,
-               res.slip_ratio, res.i_rms_a, res.used_samples, res.flags);
+        print_row(t0, &res);
         windows++;
         valid += res.valid;
         if (res.status >= 0 && res.status < 32) by_status[res.status]++;
@@ -382,6 +386,21 @@ int main(int argc, char **argv)
     return 1;
   }
   csv_close(&r);
+  /* A last partial window of at least half the length is estimated too, and
+   * a record shorter than one window is estimated as one shorter window. */
+  const long win_n = lround((double)cfg.window_s * fs), rest = n % win_n;
+  const int flush = rest > 0 && (2 * rest >= win_n || n < win_n);
+  if (flush && imest_isr_flush(&est)) {
+#ifdef IMEST_HAVE_CANDUMP
+    if (canlog) imest_candump_port_set_time(&cport, tprev);
+#endif
+    while (imest_background(&est, &res) == 1) {
+      print_row(t0, &res);
+      windows++;
+      valid += res.valid;
+      if (res.status >= 0 && res.status < 32) by_status[res.status]++;
+    }
+  }
   if (canlog && canlog != stdout) fclose(canlog);
   fflush(stdout);
   if (!quiet) {
@@ -389,13 +408,14 @@ int main(int argc, char **argv)
             windows, valid);
     for (int k = 1; k < 32; ++k)
       if (by_status[k]) fprintf(stderr, ", %ld %s", by_status[k], imest_status_name(k));
-    const long rest = n % (long)lround((double)cfg.window_s * fs);
-    if (rest) fprintf(stderr, "; last %ld samples do not fill a window", rest);
+    if (rest && !flush)
+      fprintf(stderr, "; last %ld samples (under half a window) not used", rest);
+    else if (rest)
+      fprintf(stderr, "; last window has %ld samples", rest);
     fprintf(stderr, "%s\n", from_rest ? "; started at rest" : "; warm-up at start");
   }
   if (windows == 0) {
-    fprintf(stderr, "imest-replay: the record is shorter than one window (%.6g s)\n",
-            (double)cfg.window_s);
+    fprintf(stderr, "imest-replay: no window could be estimated\n");
     return 1;
   }
   return 0;
