@@ -15,18 +15,16 @@ void imest_centre_from_k(imest_real_t c0[7], double k1, double k2, double m);
  * rebuilds column 3). Also returns rms current and the slip/speed measures. */
 typedef struct {
   double i_rms_a;     /* rms |i| (alpha/beta amplitude) */
-  double w_rms;       /* current-weighted rms mechanical speed [rad/s] */
   double w_mean;      /* mean mechanical speed [rad/s] */
   double slip_rate;   /* mean rotation rate of the rotor-frame current [rad/s]:
                          the slip frequency in steady state */
 } imest_window_stats_t;
 
-void imest_window_sums(const imest_window_t *w, double m, unsigned int pole_pairs, double fs,
-                       imest_sums_t *out, imest_window_stats_t *st);
+void imest_window_sums(const imest_window_t *w, double m, double fs, imest_sums_t *out,
+                       imest_window_stats_t *st);
 
 /* Validity: fills valid/status of r from the window flags, stats and solve. */
 void imest_judge(const imest_t *s, const imest_window_stats_t *st, const imest_solve_out_t *so,
                  imest_result_t *r);
-
 
 #endif

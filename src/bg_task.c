@@ -32,7 +32,7 @@ int imest_background(imest_t *s, imest_result_t *out)
   const double m = (double)s->m;
   imest_sums_t sums;
   imest_window_stats_t st;
-  imest_window_sums(w, m, (unsigned int)s->n, (double)s->fs, &sums, &st);
+  imest_window_sums(w, m, (double)s->fs, &sums, &st);
 
   imest_solve_out_t so = {0};
   so.status = IMEST_ST_NUMERIC;

@@ -27,9 +27,10 @@ void imest_judge(const imest_t *s, const imest_window_stats_t *st, const imest_s
    * state it is slip frequency x T_R, the ratio of rotor to magnetising
    * current; noise averages out of it (0.004..0.008 at no load with 12-bit
    * sensors, 0.05 at 5 % load, 1.1 at rated load). Below 0.1 T_R is weakly
-   * observable and a small systematic error (e.g. an uncompensated voltage
-   * lag) moved it by 20 % in the validity study without raising the PE index. The nominal T_R, not the
-   * estimate, so that a wrong estimate cannot make the window look excited. */
+   * observable: a small systematic error (an uncompensated voltage lag)
+   * moved it by 20 % in the validity study without raising the PE index.
+   * The nominal T_R, not the estimate, so that a wrong estimate cannot make
+   * the window look excited. */
   r->slip_ratio = fabs(st->slip_rate) * (double)s->tr_nominal_s;
   r->i_rms_a = st->i_rms_a;
 

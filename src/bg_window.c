@@ -11,8 +11,8 @@
 /* 7-column index -> 8-column (K) index */
 static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
 
-void imest_window_sums(const imest_window_t *w, double m, unsigned int pole_pairs, double fs,
-                       imest_sums_t *out, imest_window_stats_t *st)
+void imest_window_sums(const imest_window_t *w, double m, double fs, imest_sums_t *out,
+                       imest_window_stats_t *st)
 {
   double z[8][8];
   for (unsigned int i = 0; i < 8u; ++i) {
@@ -59,11 +59,9 @@ void imest_window_sums(const imest_window_t *w, double m, unsigned int pole_pair
   out->rwe[2] = -m * out->rwe[3];
 
   const double n = w->used > 0u ? (double)w->used : 1.0;
-  const double r44 = out->rw[3][3], r66 = out->rw[5][5];
+  const double r44 = out->rw[3][3];
   st->i_rms_a = sqrt(fmax(r44, 0.0) / n);
-  /* |W6|^2 = (n w')^2 + (n w)^4 per |i|^2: a current-weighted speed measure */
   st->w_mean = (double)w->rot * fs / n;
   const double cross = (double)w->sum[36] + (double)w->blk[36];
   st->slip_rate = (r44 > 0.0) ? cross / r44 : 0.0;
-  st->w_rms = (r44 > 0.0) ? sqrt(sqrt(fmax(r66 / r44, 0.0))) / (double)pole_pairs : 0.0;
 }

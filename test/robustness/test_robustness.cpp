@@ -371,12 +371,9 @@ TEST(RobustCondition, StandstillWithDcExcitation) {
   }
 }
 
-// BUG (reported to the lead): with the magnetising current of this motor
-// (i_rms ~2 A DC, 12-bit sensors) the noise of the current rate alone gives a
-// slip ratio of ~0.07 > min_slip_ratio, so the standstill check in
-// src/bg_validity.c (imest_judge, slip_ratio / w_rms test) does not fire and
-// the window is reported no_root instead of standstill (still invalid).
-// Enable when fixed.
+// DC at the magnetising current of this motor (i_rms ~2 A, 12-bit sensors):
+// the old slip measure (rms current rate) read ~0.07 from noise alone and the
+// window came out no_root; the rotation-rate measure reads ~0 -> standstill.
 TEST(RobustCondition, StandstillAtMagnetisingCurrent) {
   Rig r;
   r.sc.freq_hz = 0.0;
@@ -435,10 +432,9 @@ TEST(RobustCondition, IfocLoadedSteadyStateEveryWindowValid) {
     if (w.seq >= 5) EXPECT_TRUE(w.valid) << r.dump();
 }
 
-// BUG (reported to the lead): the same window at rest is reported zero_slip:
-// the encoder toggling by one count (1.5 mrad = 6 rad/s for one sample) makes
-// the filtered speed rms exceed the fixed 1 rad/s standstill bound in
-// src/bg_validity.c (imest_judge: `st->w_rms < 1.0`). Enable when fixed.
+// At rest under IFOC the encoder toggles by one count (1.5 mrad = 6 rad/s for
+// one sample); the standstill test uses the window's mean speed, in which
+// that averages to zero (an rms speed measure called it zero_slip).
 TEST(RobustCondition, IfocAtRestIsStandstill) {
   Rig r;
   r.sc.supply = IMSIM_SUPPLY_IFOC;
