@@ -3,7 +3,9 @@
 # IMEST_ARM_CPU_FLAGS first). Bare metal: no OS, no malloc, no stdio.
 #
 # Flags chosen for the core:
-#   -O2                     optimisation used for every figure in fw/README.md
+#   -O2                     optimisation of the ISR path for every figure in
+#                           fw/README.md (src/CMakeLists.txt builds the
+#                           once-per-window stages with -Os)
 #   -ffreestanding          no hosted environment assumed (__STDC_HOSTED__ == 0)
 #   -fbuiltin               ...but let GCC expand the <math.h> calls of the core
 #                           (fabsf, fabs, sqrt, fmin, fmax, isfinite ...) into FPU
