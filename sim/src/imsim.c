@@ -825,8 +825,9 @@ static void fill_sample(imsim *s, imsim_sample *o) {
     }
     o->theta = s->th;
   } else {
-    for (int k = 0; k < 3; ++k) o->i_abc[k] = adc(s, iabc[k], c->i_range_a);
-    for (int k = 0; k < 3; ++k) o->u_abc[k] = adc(s, uabc[k], c->u_range_v);
+    for (int k = 0; k < 3; ++k)
+      o->i_abc[k] = adc(s, iabc[k] * (1.0 + c->i_gain_err[k]) + c->i_offset_a[k], c->i_range_a);
+    for (int k = 0; k < 3; ++k) o->u_abc[k] = adc(s, uabc[k] + c->u_offset_v[k], c->u_range_v);
     const double cpr = (double)c->encoder_counts;
     o->theta = floor(s->th * cpr / (2.0 * PI)) * (2.0 * PI / cpr);
   }
@@ -929,6 +930,10 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
     if (!(c->i_range_a > 0.0) || !(c->u_range_v > 0.0)) return fail(s, "ADC ranges must be > 0");
     if (c->encoder_counts < 1) return fail(s, "encoder counts must be >= 1");
     if (!(c->noise_lsb >= 0.0)) return fail(s, "noise must be >= 0");
+    for (int k = 0; k < 3; ++k)
+      if (!isfinite(c->i_offset_a[k]) || !isfinite(c->u_offset_v[k]) || !(c->i_gain_err[k] > -1.0) ||
+          !isfinite(c->i_gain_err[k]))
+        return fail(s, "sensor offsets must be finite and gain errors > -1");
     if (!(c->aa_hz >= 0.0)) return fail(s, "aa cut-off must be >= 0");
   }
   if (c->rk4_substeps < 1) return fail(s, "rk4 substeps must be >= 1");

@@ -43,6 +43,8 @@ static const char USAGE[] =
     "sensors:\n"
     "  --ideal-sensors (exact samples: no quantisation, noise, clipping, AA, encoder)\n"
     "  --seed N --adc-bits N --i-range A --u-range V --noise-lsb X --encoder-counts N\n"
+    "  --i-offset A,A,A --u-offset V,V,V --i-gain-err X,X,X   per-phase sensor offsets and\n"
+    "                        relative gain errors (default 0)\n"
     "  --aa-hz HZ (0 = off) --vmeas auto|avg|aa|inst\n"
     "thermal:\n"
     "  --no-thermal --t-amb C --thermal-speedup X\n"
@@ -167,6 +169,20 @@ int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, c
       if (errno != 0 || end == val || *end != '\0' || val[0] == '-')
         return perr(err, errlen, "invalid value for --seed (unsigned integer): ", val);
       c->seed = (uint64_t)u;
+      continue;
+    }
+    if (strcmp(name, "--i-offset") == 0 || strcmp(name, "--u-offset") == 0 ||
+        strcmp(name, "--i-gain-err") == 0) {
+      double *dst = name[2] == 'u' ? c->u_offset_v : name[4] == 'o' ? c->i_offset_a : c->i_gain_err;
+      const char *p = val;
+      for (int k = 0; k < 3; ++k) {
+        char *end = NULL;
+        const double x = strtod(p, &end);
+        if (end == p || !isfinite(x) || (k < 2 ? *end != ',' : *end != '\0'))
+          return perr(err, errlen, "expected three comma-separated numbers (phases a,b,c) for ", name);
+        dst[k] = x;
+        p = end + 1;
+      }
       continue;
     }
     if (strcmp(name, "--supply") == 0) {

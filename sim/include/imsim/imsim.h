@@ -110,6 +110,9 @@ typedef struct {
   double i_range_a, u_range_v; /* symmetric ranges: +-range (clipping)                    */
   double noise_lsb;            /* white Gaussian noise, rms in LSB, added before the ADC    */
   int encoder_counts;          /* counts per mechanical revolution, floor quantisation      */
+  double i_offset_a[3];        /* per-phase sensor offset, added before the ADC [A]         */
+  double u_offset_v[3];        /* per-phase sensor offset, added before the ADC [V]         */
+  double i_gain_err[3];        /* per-phase relative gain error (0.01 = reads 1 % high)     */
   double aa_hz;                /* 2nd-order Butterworth analog AA filter cut-off; 0 = none  */
   imsim_vmeas vmeas;
   uint64_t seed;
