@@ -34,7 +34,14 @@ void imest_judge(const imest_t *s, const imest_window_stats_t *st, const imest_s
   r->slip_ratio = fabs(st->slip_rate) * (double)s->tr_nominal_s;
   r->i_rms_a = st->i_rms_a;
 
-  if (status == IMEST_OK && !(st->i_rms_a >= (double)s->min_current_a)) status = IMEST_ST_NO_CURRENT;
+  if (status == IMEST_OK && !(st->i_rms_a >= (double)s->min_current_a)) {
+    /* i_rms_a is what passed the offset high-pass. A DC current it removed
+     * (magnetising at rest) is in the tracked means: that rotor is at rest
+     * with excitation, not without current. */
+    const double ia = (double)s->dcb[2], ib = (double)s->dcb[3];
+    const int dc = sqrt(ia * ia + ib * ib) >= (double)s->min_current_a;
+    status = (dc && fabs(st->w_mean) < 1.0) ? IMEST_ST_STANDSTILL : IMEST_ST_NO_CURRENT;
+  }
   if (status == IMEST_OK && !(r->slip_ratio >= (double)s->min_slip_ratio)) {
     /* about 10 rpm: an encoder toggling by a count averages to zero here */
     status = (fabs(st->w_mean) < 1.0) ? IMEST_ST_STANDSTILL : IMEST_ST_ZERO_SLIP;

@@ -6,16 +6,26 @@
 
 #include "isr_real.h"
 
+/* One sample through a bilinear second-order low-pass section
+ * c0 (1 + 2 z^-1 + z^-2) / (1 + d1 z^-1 + d2 z^-2), transposed DF-II. */
+static inline imest_real_t isr_lp2(imest_real_t c0, imest_real_t d1, imest_real_t d2,
+                                   imest_real_t *sa, imest_real_t *sb, imest_real_t x)
+{
+  const imest_real_t t = c0 * x;
+  const imest_real_t y = t + *sa;
+  *sa = (t + t) - d1 * y + *sb;
+  *sb = t - d2 * y;
+  return y;
+}
+
 /* One sample through the first- and second-order sections (transposed DF-II).
  * Returns x_f[n]. */
 static inline imest_real_t isr_bw3(const imest_bw3_t *f, imest_chan_t *c, imest_real_t x)
 {
-  const imest_real_t v = f->b0 * x + c->s1;
-  c->s1 = f->b1 * x - f->a1 * v;
-  const imest_real_t w = f->c0 * v + c->s2a;
-  c->s2a = f->c1 * v - f->d1 * w + c->s2b;
-  c->s2b = f->c2 * v - f->d2 * w;
-  return w;
+  const imest_real_t t = f->b0 * x;
+  const imest_real_t v = t + c->s1;
+  c->s1 = t - f->a1 * v;
+  return isr_lp2(f->c0, f->d1, f->d2, &c->s2a, &c->s2b, v);
 }
 
 /* Filtered value and its central derivatives, all referred to sample n-1:
@@ -53,10 +63,7 @@ static inline void isr_filter_speed(const imest_t *s, imest_chan_t *c, imest_rea
 static inline imest_real_t isr_aa(const imest_sos_t *f, imest_real_t *s1, imest_real_t *s2,
                                   imest_real_t x)
 {
-  const imest_real_t y = f->c0 * x + *s1;
-  *s1 = f->c1 * x - f->d1 * y + *s2;
-  *s2 = f->c2 * x - f->d2 * y;
-  return y;
+  return isr_lp2(f->c0, f->d1, f->d2, s1, s2, x);
 }
 
 #endif

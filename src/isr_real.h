@@ -20,8 +20,18 @@
 #endif
 #endif
 
-/* Absolute value without libm (the ISR calls no library function). */
+/* Absolute value without libm (the ISR calls no library function). GCC and
+ * Clang expand the builtin to one instruction (VABS.F32 on Cortex-M4F: the
+ * comparison form costs four, six times per sample). */
+#if defined(__GNUC__) || defined(__clang__)
+#ifdef IMEST_ISR_DOUBLE
+static inline imest_real_t isr_abs(imest_real_t x) { return __builtin_fabs(x); }
+#else
+static inline imest_real_t isr_abs(imest_real_t x) { return __builtin_fabsf(x); }
+#endif
+#else
 static inline imest_real_t isr_abs(imest_real_t x) { return x < RL(0) ? -x : x; }
+#endif
 
 /* 1 if |x| <= lim (false for NaN and +-Inf). */
 static inline int isr_within(imest_real_t x, imest_real_t lim) { return (x <= lim) & (x >= -lim); }

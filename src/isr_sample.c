@@ -76,10 +76,11 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
   if (fault & IMEST_FLAG_INPUT_FAULT) {
     th = s->th_prev;            /* keep the last good angle */
   }
-  const imest_real_t dth = s->started ? isr_wrap_pi(th - s->th_prev) : RL(0);
+  const uint32_t first = !s->started;
+  const imest_real_t dth = first ? RL(0) : isr_wrap_pi(th - s->th_prev);
   s->started = 1u;
   s->th_prev = th;
-  if (!isr_within(dth * s->fs, s->dth_max)) {
+  if (!isr_within(dth, s->dth_max)) {
     fault |= IMEST_FLAG_ENCODER_FAULT;
   }
 
@@ -88,6 +89,25 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
     w->flags |= fault | IMEST_FLAG_WARMUP;
     isr_restart_filters(s);
   } else {
+    /* Sensor offsets: the same first-order high-pass (x - tracked mean) on
+     * all four electrical channels, so the motor's equations still hold for
+     * the filtered signals; no branch: a = 0 passes the samples unchanged. */
+    if (first && s->warmup_n == 0u) {
+      /* start at rest: no current yet, so these samples are the offsets */
+      s->dcb[2] = ia;
+      s->dcb[3] = ib;
+    }
+    {
+      const imest_real_t a = s->dcb_a;
+      ua -= s->dcb[0];
+      ub -= s->dcb[1];
+      ia -= s->dcb[2];
+      ib -= s->dcb[3];
+      s->dcb[0] += a * ua;
+      s->dcb[1] += a * ub;
+      s->dcb[2] += a * ia;
+      s->dcb[3] += a * ib;
+    }
     /* Optional stages branch on configuration only (the same path every
      * sample), so a drive that does not use them does not pay for them. */
     imest_real_t w_raw = dth * s->fs, th_r = th;

@@ -151,6 +151,11 @@ typedef struct {
                                  uncompensated, that biases R_S by about +5 % at 30 Hz. The
                                  currents and the angle are delayed to match (linear
                                  interpolation). */
+  float dc_block_hz;        /**< cut-off [Hz] of a first-order high-pass applied alike to the
+                                 alpha/beta voltages and currents before the rotation: it
+                                 removes sensor offsets (default 1; 0 = off). Applied to
+                                 both, it leaves the motor's equations intact at constant
+                                 speed; see README "Sensor offsets". */
   float warmup_s;           /**< samples discarded after start/fault while the filters
                                  settle [s] (default 0: derived from filter_hz) */
   int start_at_rest;        /**< nonzero: the first sample follows a zero history
@@ -253,10 +258,12 @@ typedef struct {
   uint32_t flags;
 } imest_window_t;
 
-/** Butterworth-3 as a first-order and a second-order section (transposed DF-II). */
+/** Butterworth-3 as a first-order and a second-order section (transposed DF-II).
+ *  Bilinear low-pass sections have binomial numerators, so only their gains
+ *  are stored. */
 typedef struct {
-  imest_real_t b0, b1, a1;        /**< section 1: (b0 + b1 z^-1) / (1 + a1 z^-1) */
-  imest_real_t c0, c1, c2, d1, d2;/**< section 2: (c0 + c1 z^-1 + c2 z^-2) / (1 + d1 z^-1 + d2 z^-2) */
+  imest_real_t b0, a1;            /**< section 1: b0 (1 + z^-1) / (1 + a1 z^-1) */
+  imest_real_t c0, d1, d2;        /**< section 2: c0 (1 + 2 z^-1 + z^-2) / (1 + d1 z^-1 + d2 z^-2) */
 } imest_bw3_t;
 
 /** Filter state of one channel: 3 section states and the last two outputs. */
@@ -265,9 +272,10 @@ typedef struct {
   imest_real_t y1, y2;            /**< x_f[n-1], x_f[n-2] */
 } imest_chan_t;
 
-/** 2nd-order analog anti-alias model applied to the speed channel. */
+/** 2nd-order analog anti-alias model applied to the speed channel (bilinear:
+ *  c0 (1 + 2 z^-1 + z^-2) / (1 + d1 z^-1 + d2 z^-2)). */
 typedef struct {
-  imest_real_t c0, c1, c2, d1, d2;
+  imest_real_t c0, d1, d2;
 } imest_sos_t;
 
 /** Estimator instance. All fields are private; sizes are what the ISR needs. */
@@ -275,7 +283,7 @@ typedef struct {
   /* constants derived at init */
   imest_real_t fs, inv2t, invt2;        /* fs, 1/(2T), 1/T^2 */
   imest_real_t n, m, inv_s;             /* n_p, M*beta, 1/(sigma L_S) */
-  imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max;
+  imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max; /* dth_max: largest angle step [rad] */
   uint32_t window_n, warmup_n;
   uint32_t aa_on;                       /* anti-alias model in use */
   imest_bw3_t bw;
@@ -286,6 +294,8 @@ typedef struct {
   imest_real_t dly;                     /* u_delay_s * fs: currents/angle delay (fraction) */
   imest_real_t ia_prev, ib_prev, wr_prev; /* previous alpha/beta current, raw speed */
   imest_real_t th_prev;                 /* previous mechanical angle (as given) */
+  imest_real_t dcb_a;                   /* offset high-pass: mean-tracking gain per sample */
+  imest_real_t dcb[4];                  /* tracked means of u_alpha, u_beta, i_alpha, i_beta */
   uint32_t k;                    /* sample index in the current window */
   uint32_t warm;                 /* warm-up samples still to discard */
   uint32_t seq;                  /* sequence number of the window being filled */

@@ -55,8 +55,9 @@ static void check_design(double fc, const double b[4], const double a[4]) {
   cfg.filter_hz = (float)fc;
   static imest_t s;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
-  const double n1[2] = {s.bw.b0, s.bw.b1}, d1[2] = {1, s.bw.a1};
-  const double n2[3] = {s.bw.c0, s.bw.c1, s.bw.c2}, d2[3] = {1, s.bw.d1, s.bw.d2};
+  // the sections' numerators are binomial: b0 (1 + z^-1), c0 (1 + 2 z^-1 + z^-2)
+  const double n1[2] = {s.bw.b0, s.bw.b0}, d1[2] = {1, s.bw.a1};
+  const double n2[3] = {s.bw.c0, 2.0 * s.bw.c0, s.bw.c0}, d2[3] = {1, s.bw.d1, s.bw.d2};
   double nb[4] = {0}, da[4] = {0};
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 3; ++j) {
@@ -99,10 +100,10 @@ TEST(IsrFilter, DerivativesAreTimeAlignedCentralDifferences) {
   for (int n = 0; n < 4000; ++n) {
     const double x = 2.0 * std::sin(2 * M_PI * 9 * n * T) + 0.5;
     const double v = (double)s.bw.b0 * x + s1;
-    s1 = (double)s.bw.b1 * x - (double)s.bw.a1 * v;
+    s1 = (double)s.bw.b0 * x - (double)s.bw.a1 * v;
     const double w = (double)s.bw.c0 * v + s2a;
-    s2a = (double)s.bw.c1 * v - (double)s.bw.d1 * w + s2b;
-    s2b = (double)s.bw.c2 * v - (double)s.bw.d2 * w;
+    s2a = 2.0 * (double)s.bw.c0 * v - (double)s.bw.d1 * w + s2b;
+    s2b = (double)s.bw.c0 * v - (double)s.bw.d2 * w;
     xf.push_back(w);
     const isr_deriv_t d = isr_filter_deriv(&s, &c, (float)x);
     if (n >= 2) {

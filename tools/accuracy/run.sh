@@ -3,6 +3,7 @@
 # experiments, ideal and 12-bit sensors: per-window error of T_R and R_S
 # against the truth averaged over the same window, valid/invalid counts.
 # Usage: tools/accuracy/run.sh [BUILD_DIR] [EXP2_SECONDS]
+# Environment: REPLAY_ARGS = extra imest-replay options for every recording.
 set -euo pipefail
 top=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-$top/build}
@@ -16,7 +17,7 @@ printf '| recording | windows | valid | invalid (reasons) | T_R error %% valid: 
 run() { # name, sim args, replay args
   local name=$1 sargs=$2 rargs=${3:-}
   "$sim" $sargs --out "$tmp/$name.csv" --no-progress 2>/dev/null
-  "$rep" $motor $rargs "$tmp/$name.csv" > "$tmp/$name.win" 2>/dev/null
+  "$rep" $motor $rargs ${REPLAY_ARGS:-} "$tmp/$name.csv" > "$tmp/$name.win" 2>/dev/null
   awk -F, -v name="$name" '
     FNR == 1 { next }
     FILENAME ~ /\.csv$/ { t[++n] = $1; tr[n] = $9; rs[n] = $10; next }

@@ -36,6 +36,8 @@ static void usage(FILE *o)
           "                      electrical channels, modelled on the angle (default none)\n"
           "  --u-delay S         the voltage samples lag the currents by S seconds (e.g. 50e-6\n"
           "                      for volt-seconds of the PWM period that just ended at 10 kHz)\n"
+          "  --dc-block-hz HZ    cut-off of the offset high-pass on voltages and currents\n"
+          "                      (default 1; 0 = off)\n"
           "  --tr-nominal S      nominal T_R for scaling (default 0.1)\n"
           "  --tr-min S --tr-max S   admissible T_R band (default 0.001 .. 10)\n"
           "  --max-pe-k2 X       validity threshold on the relative PE index of K2 (0.1)\n"
@@ -74,6 +76,7 @@ static float *float_option(imest_config_t *cfg, const char *opt)
       {"--filter-hz", offsetof(imest_config_t, filter_hz)},
       {"--aa-hz", offsetof(imest_config_t, aa_hz)},
       {"--u-delay", offsetof(imest_config_t, u_delay_s)},
+      {"--dc-block-hz", offsetof(imest_config_t, dc_block_hz)},
       {"--tr-nominal", offsetof(imest_config_t, tr_nominal_s)},
       {"--tr-min", offsetof(imest_config_t, tr_min_s)},
       {"--tr-max", offsetof(imest_config_t, tr_max_s)},
