@@ -155,7 +155,7 @@ typedef struct {
                                  alpha/beta voltages and currents before the rotation: it
                                  removes sensor offsets (default 1; 0 = off). Applied to
                                  both, it leaves the motor's equations intact at constant
-                                 speed; see README "Sensor offsets". */
+                                 speed; see README "Method" (sensor offsets). */
   float warmup_s;           /**< samples discarded after start/fault while the filters
                                  settle [s] (default 0: derived from filter_hz) */
   int start_at_rest;        /**< nonzero: the first sample follows a zero history

@@ -2,6 +2,7 @@
 # One case of the validity study: simulate, optionally cut the first rows,
 # replay, and write per-window truth means next to the replay output.
 # usage: one_case.sh OUT_DIR BUILD_DIR 'name|sim args|replay args|cut_s'
+# Environment: REPLAY_ARGS = extra imest-replay options for every case (e.g. --dc-block-hz 0).
 set -u
 OUT=$1 B=$2 LINE=$3
 IFS='|' read -r NAME SIMARGS REPARGS CUT <<<"$LINE"
@@ -16,7 +17,7 @@ if [ -n "$CUT" ] && [ "$CUT" != 0 ]; then
   awk -F, -v c="$CUT" 'NR == 1 || $1 + 1e-9 >= c' "$CSV" >"$CSV.cut" && mv "$CSV.cut" "$CSV"
 fi
 # shellcheck disable=SC2086
-"$B/tools/replay/imest-replay" $REPARGS "$CSV" >"$OUT/cases/$NAME.replay.csv" 2>"$OUT/cases/$NAME.log"
+"$B/tools/replay/imest-replay" $REPARGS ${REPLAY_ARGS:-} "$CSV" >"$OUT/cases/$NAME.replay.csv" 2>"$OUT/cases/$NAME.log"
 # window k = data rows k*N .. k*N+N-1, N = window length in samples (1 s windows)
 awk -F, -v name="$NAME" '
   NR == 1 { for (j = 1; j <= NF; j++) col[$j] = j; next }
