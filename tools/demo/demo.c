@@ -2,6 +2,7 @@
  * exactly as a drive firmware runs it.
  *
  * For every experiment a simulated motor (imsim: PWM inverter, 12-bit ADCs,
+ * current-sensor offsets,
  * 4096-count encoder, thermal drift) produces one sample per 1/fs; each sample
  * goes through imest_isr_abc() as float32 with the encoder angle wrapped to
  * [0, 2pi); when the ISR call reports a finished window, imest_background()
@@ -187,6 +188,11 @@ static void sim_config(int id, unsigned long seed, imsim_config *c)
     c->ifoc_mode = IMSIM_IFOC_SPEED;
     c->ifoc_tr_s = 0.0; /* cold value */
   }
+  /* Current sensors as delivered: offsets of 0.1 .. 0.2 % of the +-20 A range
+   * (the drive calibrates them at power-up only to within this). */
+  c->i_offset_a[0] = 0.040;
+  c->i_offset_a[1] = -0.025;
+  c->i_offset_a[2] = 0.010;
   c->seed = seed + (unsigned long)id;
 }
 

@@ -453,7 +453,7 @@ def main(argv):
     # ---------------- summary
     md.append("# imest demo: results\n")
     md.append("Simulated motor (imsim: the paper's 0.5 hp motor, 10 kHz sine-triangle PWM inverter, "
-              "12-bit ADCs with 1 LSB noise, 4096-count encoder, copper heating), imest in the loop as "
+              "12-bit ADCs with 1 LSB noise, current-sensor offsets of +40/-25/+10 mA, 4096-count encoder, copper heating), imest in the loop as "
               "firmware runs it (float32 ISR call per 4 kHz sample with the wrapped encoder angle, "
               "background call per 1-s window), every window published over the CAN port as a "
               "`candump -L` log and decoded back with `imest-monitor`. Errors are "
