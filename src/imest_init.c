@@ -184,13 +184,14 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   }
   s->warmup_n = cfg->start_at_rest ? 0u : (uint32_t)(warm_s * fs) + 3u; /* rounded up, +2 */
   s->warm = s->warmup_n;
-  /* At the very first start the offset tracker starts from zero and the
-   * offsets decay as exp(-t/tau): 2.5 tau (0.4 s at 1 Hz) leaves 8 % of them,
-   * a bias below 0.3 % of R_S for a 100 mA offset at 1.6 A (measured), and
-   * still lets a 1 s window starting mid-run be valid. After a fault the
-   * tracker keeps its state; at rest it starts from the first currents. */
+  /* At the very first start the offset tracker starts from zero: the offsets,
+   * and the filter's own response to signals that were already there (a
+   * record that starts mid-run), decay as exp(-t/tau). 5 tau (0.8 s at 1 Hz)
+   * leaves 0.7 % of them; 2.5 tau left a 15 kW motor's first window valid
+   * with R_S +4 % (measured, ideal sensors). After a fault the tracker keeps
+   * its state; at rest it starts from the first currents. */
   if (!cfg->start_at_rest && cfg->warmup_s <= 0.0f && cfg->dc_block_hz > 0.0f)
-    s->warm += (uint32_t)(2.5 / (2.0 * IMEST_PI_D * (double)cfg->dc_block_hz) * fs);
+    s->warm += (uint32_t)(5.0 / (2.0 * IMEST_PI_D * (double)cfg->dc_block_hz) * fs);
 
   /* background constants */
   s->sigma = cfg->sigma;

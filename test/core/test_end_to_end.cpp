@@ -51,9 +51,9 @@ RunOut run(MotorRef &mot, double seconds, double t_start, bool at_rest, float wi
 }  // namespace
 
 // Paper's experiment 2 operating point with exact samples, record starting
-// mid-run: the first window is marked warm-up (123 samples for the filters
-// and 1591 for the offset tracker not used), and every window recovers T_R
-// and R_S.
+// mid-run: the first window is warm-up (123 samples for the filters and
+// 3183 for the offset tracker not used: invalid, more than half of it), and
+// every later window recovers T_R and R_S.
 TEST(EndToEnd, LoadedSteadyStateRecoversTrAndRs) {
   MotorRef mot;
   mot.vll = 115;
@@ -62,8 +62,9 @@ TEST(EndToEnd, LoadedSteadyStateRecoversTrAndRs) {
   RunOut r = run(mot, 4.0, 1.5, false);
   ASSERT_EQ(r.res.size(), 4u);
   EXPECT_TRUE(r.res[0].flags & IMEST_FLAG_WARMUP);
-  EXPECT_EQ(r.res[0].used_samples, 4000u - 123u - 1591u);
-  for (size_t k = 0; k < r.res.size(); ++k) {
+  EXPECT_EQ(r.res[0].used_samples, 4000u - 123u - 3183u);
+  EXPECT_EQ(r.res[0].status, IMEST_ST_WARMUP);
+  for (size_t k = 1; k < r.res.size(); ++k) {
     const imest_result_t &w = r.res[k];
     EXPECT_TRUE(w.valid) << k << " " << imest_status_name(w.status);
     EXPECT_NEAR(w.tr_s, 0.12, 0.12 * 2e-3) << k;

@@ -210,41 +210,41 @@ TEST(Handoff, FlushHandsOverAShortWindowWithItsOwnEndTime) {
 }
 
 // With the offset tracker on (the default), only the very first start waits
-// for it too: 123 filter samples + 2.5 tau of the 1 Hz high-pass (1591
+// for it too: 123 filter samples + 5 tau of the 1 Hz high-pass (3183
 // samples). A restart after a fault waits for the filters only, since the
 // tracker keeps its state; a start at rest waits for nothing.
 TEST(Handoff, OffsetTrackerLengthensOnlyTheFirstWarmup) {
   imest_config_t cfg = small_config();
   cfg.dc_block_hz = 1.0f;
-  cfg.window_s = 0.5f;  // 2000 samples
+  cfg.window_s = 1.0f;  // 4000 samples
   static imest_t s;
   imest_result_t r;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   int k = 0;
-  feed(&s, 2000, k);
+  feed(&s, 4000, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.used_samples, 2000u - 123u - 1591u);
+  EXPECT_EQ(r.used_samples, 4000u - 123u - 3183u);
   EXPECT_EQ(r.status, IMEST_ST_WARMUP);
   // a NaN sample restarts the filters only
   const float nan_u[3] = {NAN, 0, 0}, i[3] = {0, 0, 0};
   (void)imest_isr_abc(&s, nan_u, i, 0.0f);
   ++k;
-  feed(&s, 1999, k);
+  feed(&s, 3999, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.used_samples, 2000u - 1u - 123u);
+  EXPECT_EQ(r.used_samples, 4000u - 1u - 123u);
   EXPECT_EQ(r.status, IMEST_ST_INPUT_FAULT);
   // an explicit warm-up is taken as given
   cfg.warmup_s = 0.01f;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   k = 0;
-  feed(&s, 2000, k);
+  feed(&s, 4000, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.used_samples, 2000u - 42u);  // 0.01f s = 39.99.. samples, rounded down, + 3
+  EXPECT_EQ(r.used_samples, 4000u - 42u);  // 0.01f s = 39.99.. samples, rounded down, + 3
   cfg.warmup_s = 0.0f;
   cfg.start_at_rest = 1;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   k = 0;
-  feed(&s, 2000, k);
+  feed(&s, 4000, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.used_samples, 2000u);
+  EXPECT_EQ(r.used_samples, 4000u);
 }

@@ -64,7 +64,10 @@ struct Rig {
 
   // exp2 operating point (30 Hz V/f, 115 V, rated load 2.064 N m), started in
   // steady state, 12-bit sensors with 1 LSB noise, 4096-count encoder, no
-  // heating (T_R and R_S constant: 0.12 s, 5.04 ohm).
+  // heating (T_R and R_S constant: 0.12 s, 5.04 ohm). Default estimator
+  // config: the first start waits 0.83 s (filters and offset tracker), so
+  // windows 0 and 1 of 0.5 s are warm-up; after a fault only the filters
+  // wait (31 ms).
   explicit Rig(float window_s = 0.5f, double load_nm = 2.064) {
     imsim_config_preset(&sc, "exp2");
     sc.start = IMSIM_START_STEADY;
