@@ -155,7 +155,9 @@ typedef struct {
                                  alpha/beta voltages and currents before the rotation: it
                                  removes sensor offsets (default 1; 0 = off). Applied to
                                  both, it leaves the motor's equations intact at constant
-                                 speed; see README "Method" (sensor offsets). */
+                                 speed; see README "Method" (sensor offsets). The first start
+                                 (unless start_at_rest) waits 5 time constants more for it:
+                                 0.8 s at 1 Hz. */
   float warmup_s;           /**< samples discarded after start/fault while the filters
                                  settle [s] (default 0: derived from filter_hz) */
   int start_at_rest;        /**< nonzero: the first sample follows a zero history
