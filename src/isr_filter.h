@@ -6,6 +6,15 @@
 
 #include "isr_real.h"
 
+/* Offset removal: x minus its tracked mean, first-order (mean += a (x - mean)).
+ * Applied alike to every electrical channel; a = 0 passes x unchanged. */
+static inline imest_real_t isr_dc_block(imest_real_t a, imest_real_t *mean, imest_real_t x)
+{
+  const imest_real_t y = x - *mean;
+  *mean += a * y;
+  return y;
+}
+
 /* One sample through a bilinear second-order low-pass section
  * c0 (1 + 2 z^-1 + z^-2) / (1 + d1 z^-1 + d2 z^-2), transposed DF-II. */
 static inline imest_real_t isr_lp2(imest_real_t c0, imest_real_t d1, imest_real_t d2,

@@ -89,25 +89,18 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
     w->flags |= fault | IMEST_FLAG_WARMUP;
     isr_restart_filters(s);
   } else {
-    /* Sensor offsets: the same first-order high-pass (x - tracked mean) on
-     * all four electrical channels, so the motor's equations still hold for
-     * the filtered signals; no branch: a = 0 passes the samples unchanged. */
+    /* Sensor offsets: the same high-pass on all four electrical channels, so
+     * the motor's equations still hold for the filtered signals. A start at
+     * rest (warmup_n is 0 only then) has no current yet: its first currents
+     * are the offsets. */
     if (first && s->warmup_n == 0u) {
-      /* start at rest: no current yet, so these samples are the offsets */
       s->dcb[2] = ia;
       s->dcb[3] = ib;
     }
-    {
-      const imest_real_t a = s->dcb_a;
-      ua -= s->dcb[0];
-      ub -= s->dcb[1];
-      ia -= s->dcb[2];
-      ib -= s->dcb[3];
-      s->dcb[0] += a * ua;
-      s->dcb[1] += a * ub;
-      s->dcb[2] += a * ia;
-      s->dcb[3] += a * ib;
-    }
+    ua = isr_dc_block(s->dcb_a, &s->dcb[0], ua);
+    ub = isr_dc_block(s->dcb_a, &s->dcb[1], ub);
+    ia = isr_dc_block(s->dcb_a, &s->dcb[2], ia);
+    ib = isr_dc_block(s->dcb_a, &s->dcb[3], ib);
     /* Optional stages branch on configuration only (the same path every
      * sample), so a drive that does not use them does not pay for them. */
     imest_real_t w_raw = dth * s->fs, th_r = th;

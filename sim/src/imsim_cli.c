@@ -171,16 +171,18 @@ int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, c
       c->seed = (uint64_t)u;
       continue;
     }
-    if (strcmp(name, "--i-offset") == 0 || strcmp(name, "--u-offset") == 0 ||
-        strcmp(name, "--i-gain-err") == 0) {
-      double *dst = name[2] == 'u' ? c->u_offset_v : name[4] == 'o' ? c->i_offset_a : c->i_gain_err;
+    double *per_phase = strcmp(name, "--i-offset") == 0   ? c->i_offset_a
+                        : strcmp(name, "--u-offset") == 0   ? c->u_offset_v
+                        : strcmp(name, "--i-gain-err") == 0 ? c->i_gain_err
+                                                            : NULL;
+    if (per_phase != NULL) {
       const char *p = val;
       for (int k = 0; k < 3; ++k) {
         char *end = NULL;
         const double x = strtod(p, &end);
         if (end == p || !isfinite(x) || (k < 2 ? *end != ',' : *end != '\0'))
           return perr(err, errlen, "expected three comma-separated numbers (phases a,b,c) for ", name);
-        dst[k] = x;
+        per_phase[k] = x;
         p = end + 1;
       }
       continue;

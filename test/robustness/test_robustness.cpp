@@ -357,35 +357,29 @@ TEST(RobustEncoder, OneCountGlitchesDoNotMatter) {
 // ---------------------------------------------------------------------------
 // Operating conditions where T_R is not identifiable
 
-// DC magnetisation at standstill (supply at 0 Hz): no rotor currents.
-TEST(RobustCondition, StandstillWithDcExcitation) {
+// DC at standstill (supply at 0 Hz, line-line voltage vll_v): no rotor
+// currents, every window after the first-start warm-up (windows 0, 1) is
+// standstill.
+static void expect_standstill_with_dc(double vll_v) {
   Rig r;
   r.sc.freq_hz = 0.0;
-  r.sc.vll_v = 20.0;  // i_rms ~4 A
+  r.sc.vll_v = vll_v;
   r.sc.load_nm = 0.0;
   r.start();
   r.run(5);
-  for (uint32_t k = 2; k < 5; ++k) {  // 0, 1: first-start warm-up
+  for (uint32_t k = 2; k < 5; ++k) {
     ASSERT_NE(r.window(k), nullptr);
     EXPECT_EQ(r.window(k)->status, IMEST_ST_STANDSTILL) << r.dump();
   }
 }
 
+// DC magnetisation at standstill: i_rms ~4 A.
+TEST(RobustCondition, StandstillWithDcExcitation) { expect_standstill_with_dc(20.0); }
+
 // DC at the magnetising current of this motor (i_rms ~2 A, 12-bit sensors):
 // the old slip measure (rms current rate) read ~0.07 from noise alone and the
 // window came out no_root; the rotation-rate measure reads ~0 -> standstill.
-TEST(RobustCondition, StandstillAtMagnetisingCurrent) {
-  Rig r;
-  r.sc.freq_hz = 0.0;
-  r.sc.vll_v = 10.0;  // i_rms ~2 A
-  r.sc.load_nm = 0.0;
-  r.start();
-  r.run(5);
-  for (uint32_t k = 2; k < 5; ++k) {  // 0, 1: first-start warm-up
-    ASSERT_NE(r.window(k), nullptr);
-    EXPECT_EQ(r.window(k)->status, IMEST_ST_STANDSTILL) << r.dump();
-  }
-}
+TEST(RobustCondition, StandstillAtMagnetisingCurrent) { expect_standstill_with_dc(10.0); }
 
 // Field-oriented drive magnetised at rest (speed reference 0): the encoder
 // dithers by one count, then the drive accelerates to 850 rpm with rated
