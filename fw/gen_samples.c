@@ -3,7 +3,7 @@
  * Simulates the paper's induction motor (n_p = 2, L_S = L_R = 0.2908 H,
  * sigma = 0.096, T_R = 0.12 s, R_S = 5.04 ohm, J = 1.2e-3 kg m^2, viscous
  * friction 1e-4 N m s) on a 30 Hz, 115 V (line-to-line rms) sinusoidal supply
- * with a 2.064 N m load, in the stator frame (MATH.md §1 conventions, RK4,
+ * with a 2.064 N m load, in the stator frame (docs/METHOD.md §1 conventions, RK4,
  * h = 1/64 kHz), lets it settle to steady state (~856.9 rpm), then records
  * samples at fs with a 12-bit ADC model (+-10 A, +-400 V, 1 LSB rms noise from
  * a fixed-seed generator) and a 4096-count encoder, and writes them as a C

@@ -1,4 +1,4 @@
-/* Internal interface of the background-solve stages (MATH.md §3..§7), one
+/* Internal interface of the background-solve stages (docs/METHOD.md §3..§7), one
  * function group per source file, so that tests can call each stage alone.
  * Not part of the public API. No stage allocates, none keeps state. */
 #ifndef IMEST_BG_POLY_H
@@ -23,7 +23,7 @@ extern "C" {
 #define IMEST_POLY_MAXDEG 20
 
 /* ---------------------------------------------------------------- bg_tables.c
- * Power-of-two scalings (MATH.md §5) and the scaled cost tables (§3) and
+ * Power-of-two scalings (docs/METHOD.md §5) and the scaled cost tables (§3) and
  * p1/p2 coefficients (§4), all float64, in the scaled unknowns (k, kappa):
  * K1 = g k, K2 = s kappa, E = c E~.
  * Weighted cost (cfg.weight_c = c_w, scaled cw = c_w/s^2, D = kappa^2 + cw):
@@ -55,7 +55,7 @@ int imest_round_log2(double x);
 void imest_tables_scaled(const imest_sums_t *in, int sexp, int gexp, int cexp, imest_tables_t *t);
 void imest_tables_weight(imest_tables_t *t, double weight_c); /* sets cw, refills bw* */
 
-/* Choose s from tr_nominal_s, c from R_y and g from the data (MATH.md §5) and
+/* Choose s from tr_nominal_s, c from R_y and g from the data (docs/METHOD.md §5) and
  * build the tables (cw = 0; call imest_tables_weight for c_w > 0). Returns
  * IMEST_OK, or IMEST_ST_NUMERIC for non-finite sums, R_y <= 0 or non-finite
  * tables. */
@@ -73,7 +73,7 @@ void imest_tables_eval(const imest_tables_t *t, double kappa, imest_tabval_t *v)
 void imest_tables_values(const imest_tables_t *t, double kappa, double v[3]);
 
 /* ------------------------------------------------------------- bg_resultant.c
- * r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0, 22 coefficients ascending (MATH.md §4
+ * r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0, 22 coefficients ascending (docs/METHOD.md §4
  * with the weighted p2w): with cw = 0, r_w = kappa r (r the paper's).
  * generic = 0: this regressor: degree 19, r_w[20] = r_w[21] = 0 are set (they
  *   vanish identically because W.3 = -m W.4, for any cw; r_w[19] = r[18]).

@@ -1,5 +1,5 @@
 /* Stage 5 of the background solve: quality of the selected minimiser
- * (MATH.md §7), float64, in the scaled unknowns (k, kappa) and scaled back
+ * (docs/METHOD.md §7), float64, in the scaled unknowns (k, kappa) and scaled back
  * exactly (powers of two) to (K1, K2). Everything here refers to the
  * minimised cost E_w = P F(kappa), F = 1/D^2, D = kappa^2 + cw, P = e2 k^2 +
  * e1 k + e0 (E_w = E_p^2 when cw = 0, i.e. exactly the paper's indices).

@@ -1,5 +1,5 @@
 /* Stage 2 of the background solve: the resultant r_w(kappa) of p1 and p2w with
- * respect to k (MATH.md §4, eq. 27, with the weighted p2w of bg_poly.h), float64:
+ * respect to k (docs/METHOD.md §4, eq. 27, with the weighted p2w of bg_poly.h), float64:
  *   r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0 = a0 (a0 bw2 - a1 bw1) + (a1 a1) bw0,
  * five convolutions, about 405 multiply-adds (the three-term form takes 545).
  * With cw = 0, r_w = kappa r: r_w[0] = 0 exactly and r_w[k+1] = r[k] up to
@@ -34,7 +34,7 @@ void imest_resultant(const imest_tables_t *t, double r[22], int generic) {
   if (!generic) {
     /* W.3 = -m W.4 makes these vanish identically (for any cw); in floating
      * point they are round-off that would create spurious roots near
-     * 1e9..1e16 (MATH.md §4). */
+     * 1e9..1e16 (docs/METHOD.md §4). */
     r[20] = 0.0;
     r[21] = 0.0;
   }

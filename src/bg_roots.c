@@ -1,5 +1,5 @@
 /* Stage 3 of the background solve: every distinct positive root of a real
- * polynomial of degree <= 20 by Sturm sequences and bisection (MATH.md §6).
+ * polynomial of degree <= 20 by Sturm sequences and bisection (docs/METHOD.md §6).
  * No companion matrix, no eigenvalues, no allocation, no static mutable data.
  *
  * Design
@@ -14,7 +14,7 @@
  *    q(x) = x^n p(1/x) the reversed polynomial. Each domain polynomial is
  *    scaled exactly (powers of two) and renormalised, so the coefficients that
  *    matter in that range of kappa are not lost relative to the others: with
- *    only the split at 1 (MATH.md §6) the float32 chain missed in-band roots
+ *    only the split at 1 (docs/METHOD.md §6) the float32 chain missed in-band roots
  *    near kappa = 40 (K2 = 320) of realistic windows. Every evaluation is on
  *    [0, 1.004]: nothing overflows in float32. Roots closer than 2^-36
  *    relative are reported once (a root found from two domains, or two

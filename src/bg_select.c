@@ -1,4 +1,4 @@
-/* Stage 4 of the background solve: candidates and selection (MATH.md §7).
+/* Stage 4 of the background solve: candidates and selection (docs/METHOD.md §7).
  * For every positive root kappa of the resultant: k = -a0/a1 (a1 > 0 for
  * K2 > 0 with a positive semi-definite R_W), K1 = g k, K2 = s kappa,
  * T_R = 1/K2, R_S = sigma L_S K1 - (1 - sigma) L_S K2, the paper's E_p^2 and

@@ -1,4 +1,4 @@
-/* Stage 6: the background solve of one window (MATH.md §3..§7), orchestrating
+/* Stage 6: the background solve of one window (docs/METHOD.md §3..§7), orchestrating
  * bg_tables.c -> bg_resultant.c -> bg_roots.c -> bg_select.c -> bg_quality.c.
  *
  * Bounded: every loop has a compile-time bound (bg_poly.h): out->work, the sum

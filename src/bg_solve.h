@@ -1,7 +1,7 @@
 /* Background solve: from one window's sums to T_R, R_S and their quality.
  * Internal interface between the window bookkeeping (bg_task.c) and the solve
  * stages (bg_tables.c, bg_resultant.c, bg_roots.c, bg_select.c, bg_quality.c).
- * MATH.md §3..§7. */
+ * docs/METHOD.md §3..§7. */
 #ifndef IMEST_BG_SOLVE_H
 #define IMEST_BG_SOLVE_H
 
@@ -36,7 +36,7 @@ typedef struct {
   double tr_max_s;
   /* Speed normalisation of the cost, c [(1/s)^2]: the solve minimises
    * E_w = E_p^2 K2^4 / (K2^2 + c)^2 instead of the paper's E_p^2. The
-   * eliminated equation was multiplied by (1 + n_p^2 w^2 T_R^2) (MATH.md §2),
+   * eliminated equation was multiplied by (1 + n_p^2 w^2 T_R^2) (docs/METHOD.md §2),
    * which weights the residual ~(1 + n_p^2 w^2 T_R^2)^2 and lets any noise
    * floor pull the minimum to the spurious K2 ~ n_p w; with c = n_p^2 w^2
    * that weight is divided out. Use imest_solve_weight_c() (current-weighted
@@ -57,7 +57,7 @@ typedef struct {
   double e_w;                 /* the minimised cost E_w at the minimiser (= e if weight_c = 0) */
   double hessian[2][2];       /* of E_w (the minimised cost), unscaled, in (K1, K2) */
   int hessian_pd;
-  double pe_k1, pe_k2;        /* parametric error indices (absolute), MATH.md §7, of E_w */
+  double pe_k1, pe_k2;        /* parametric error indices (absolute), docs/METHOD.md §7, of E_w */
   double pe_quad[2];          /* quadratic approximations sqrt(0.5 E (H^-1)_ii) */
   double scale_s, scale_g, scale_c; /* the power-of-two scalings used */
   unsigned int pe_flags;      /* IMEST_PE_FLAG_* (bg_poly.h): how the PE indices were obtained */

@@ -1,4 +1,4 @@
-/* Stage 1 of the background solve: power-of-two scaling (MATH.md §5), the
+/* Stage 1 of the background solve: power-of-two scaling (docs/METHOD.md §5), the
  * scaled cost tables e2, e1, e0 (§3) and the p1/p2w coefficients (§4, with the
  * speed-normalised cost of bg_poly.h). float64 throughout. Every scaling is a
  * multiplication by an exact power of two, so the scaled tables equal the
@@ -9,7 +9,7 @@
 
 #include "bg_poly.h"
 
-/* Exponents of K_i = K1^EXP_E[i] * K2^EXP_F[i] (MATH.md §3). */
+/* Exponents of K_i = K1^EXP_E[i] * K2^EXP_F[i] (docs/METHOD.md §3). */
 static const int EXP_E[8] = {1, 0, 0, 1, 0, 1, 1, 0};
 static const int EXP_F[8] = {0, 1, 2, 1, -1, -1, -2, -2};
 

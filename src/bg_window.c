@@ -1,7 +1,7 @@
 /* Background stage 1: take one window's ISR sums to float64 8x8 form.
  * The ISR accumulated Z = [W1 W2 W4 W5 W6 W7 W8 e] with e = y - W c0; here
  * R_Wy = R_We + R_W c0 and R_y = R_ee + 2 c0.R_We + c0' R_W c0 (float64), and
- * row/column 3 = -m x row/column 4 (MATH.md §2). The centred form (c0, R_We,
+ * row/column 3 = -m x row/column 4 (docs/METHOD.md §2). The centred form (c0, R_We,
  * R_ee) is passed on too, for E without cancellation (bg_select.c). */
 #include <math.h>
 

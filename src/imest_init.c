@@ -127,7 +127,7 @@ static void design_aa(imest_sos_t *f, double fc, double fs)
   f->d2 = (imest_real_t)((1.0 - IMEST_SQRT2_D * k + k * k) / a0);
 }
 
-/* Centring vector c0 (7-column form) for a given K1, K2 (MATH.md §2, §10). */
+/* Centring vector c0 (7-column form) for a given K1, K2 (docs/METHOD.md §2, §10). */
 void imest_centre_from_k(imest_real_t c0[7], double k1, double k2, double m)
 {
   c0[0] = (imest_real_t)k1;

@@ -1,5 +1,5 @@
 /* ISR stage 2: Butterworth-3 low-pass as second-order sections and
- * time-aligned central differences (MATH.md §8). Every channel passes the same
+ * time-aligned central differences (docs/METHOD.md §8). Every channel passes the same
  * filter so the delays are identical. */
 #ifndef IMEST_ISR_FILTER_H
 #define IMEST_ISR_FILTER_H

@@ -1,4 +1,4 @@
-/* ISR stage 3: regressor W (2x7: columns 1,2,4,5,6,7,8 of MATH.md §2) and the
+/* ISR stage 3: regressor W (2x7: columns 1,2,4,5,6,7,8 of docs/METHOD.md §2) and the
  * centred output e = y - W c0. Column 3 is not formed: W_3 = -m W_4 exactly,
  * so the background rebuilds it. */
 #ifndef IMEST_ISR_REGRESSOR_H
@@ -47,7 +47,7 @@ static inline void isr_regressor(const imest_t *s, const isr_signals_t *g, const
   /* W8 */
   zx[6] = nwnwp * dix - nw2 * d2ix + nw2 * dvx - nwnwp * vx + nw3 * diy;
   zy[6] = nwnwp * diy - nw2 * d2iy + nw2 * dvy - nwnwp * vy - nw3 * dix;
-  /* y, then centred: e = y - W c0 (MATH.md §10: keeps float32 sums accurate) */
+  /* y, then centred: e = y - W c0 (docs/METHOD.md §10: keeps float32 sums accurate) */
   const imest_real_t yx = d2ix - nw * diy - nwp * iy - m * nw2 * ix - dvx;
   const imest_real_t yy = d2iy + nw * dix + nwp * ix - m * nw2 * iy - dvy;
   zx[7] = yx - (zx[0] * c0[0] + zx[1] * c0[1] + zx[2] * c0[2] + zx[3] * c0[3] +

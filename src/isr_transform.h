@@ -1,4 +1,4 @@
-/* ISR stage 1: 3-2 transform and rotation into the rotor frame (MATH.md §1). */
+/* ISR stage 1: 3-2 transform and rotation into the rotor frame (docs/METHOD.md §1). */
 #ifndef IMEST_ISR_TRANSFORM_H
 #define IMEST_ISR_TRANSFORM_H
 

@@ -20,7 +20,7 @@
  *     while (imest_background(&est, &r) == 1) { use r (r.valid, r.tr_s, r.rs_ohm ...) }
  *
  * Algorithm, per sample (ISR path, float32, fixed instruction count):
- *   3-2 transform (power invariant, MATH.md §1) -> rotation by n_p*theta into the
+ *   3-2 transform (power invariant, docs/METHOD.md §1) -> rotation by n_p*theta into the
  *   rotor frame -> 3rd-order Butterworth (second-order sections, same filter on
  *   every channel, including the speed) -> time-aligned central differences
  *   (value, first and second derivative all refer to sample n-1) -> regressor
@@ -69,7 +69,7 @@
  * Numerics: the ISR path is float32 only (builds with -Wdouble-promotion
  * -Werror); products are summed in short float32 blocks folded into the window
  * sums one entry per sample (no data-dependent loop), and y is centred on the
- * previous valid estimate (MATH.md §10), which keeps T_R within 0.01 % of an
+ * previous valid estimate (docs/METHOD.md §10), which keeps T_R within 0.01 % of an
  * all-float64 run. The background uses float64 where the precision needs it
  * (cost tables, E, E_I, Hessian, error indices) and float32 where it does not.
  *
@@ -338,7 +338,7 @@ int imest_init(imest_t *s, const imest_config_t *cfg);
  */
 int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], float theta_rad);
 
-/** ISR call with alpha/beta quantities (power-invariant 3-2 transform, MATH.md
+/** ISR call with alpha/beta quantities (power-invariant 3-2 transform, docs/METHOD.md
  *  §1: amplitude = line-to-line rms; an amplitude-invariant Clarke transform
  *  scales u and i alike, which leaves T_R and R_S unchanged but changes E,
  *  min_current_a and the saturation check, which then apply to alpha/beta). */

@@ -46,7 +46,7 @@ void imsim_ab_to_abc(const double ab[2], double abc[3]) {
 
 void imsim_config_default(imsim_config *c) {
   memset(c, 0, sizeof *c);
-  /* The paper's motor (Section VI) and MATH.md section 9. */
+  /* The paper's motor (Section VI) and docs/METHOD.md §9. */
   c->pole_pairs = 2;
   c->ls_h = 0.2908;
   c->lr_h = 0.2908;

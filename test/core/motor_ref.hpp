@@ -1,4 +1,4 @@
-// A small, independent float64 induction-motor model (MATH.md eq. (1)) for the
+// A small, independent float64 induction-motor model (docs/METHOD.md eq. (1)) for the
 // core tests: RK4 with substeps, sinusoidal supply, constant load. The full
 // simulator lives in sim/; this one only needs to be obviously right.
 #pragma once

@@ -45,7 +45,7 @@ TEST(IsrTransform, ClarkeIsPowerInvariant) {
   }
 }
 
-// Product of the two sections vs the direct-form coefficients of MATH.md §8.
+// Product of the two sections vs the direct-form coefficients of docs/METHOD.md §8.
 static void check_design(double fc, const double b[4], const double a[4]) {
   imest_config_t cfg;
   imest_config_default(&cfg);
@@ -120,7 +120,7 @@ TEST(IsrFilter, DerivativesAreTimeAlignedCentralDifferences) {
   EXPECT_LT(worst_d2, 40.0);  // float32 rounding of x_f times 1/T^2 = 1.6e7
 }
 
-// The 7 regressor columns and y against MATH.md §2 written out in float64.
+// The 7 regressor columns and y against docs/METHOD.md §2 written out in float64.
 TEST(IsrRegressor, MatchesMathMdFormulas) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-1, 1);

@@ -1,4 +1,4 @@
-// Model checks: steady state against an independent equivalent circuit, MATH.md section 9
+// Model checks: steady state against an independent equivalent circuit, docs/METHOD.md §9
 // figures, DOL start, energy balance.
 #include <gtest/gtest.h>
 
@@ -88,7 +88,7 @@ TEST(SimModel, DirectOnLineStartOfExp1) {
     for (double i : x.i_abc_true) peak = std::max(peak, std::fabs(i));
     if (t_at_speed < 0 && x.speed_rad_s > 0.95 * 2 * kPi * 30) t_at_speed = x.t;
   }
-  EXPECT_NEAR(peak, 16.4, 0.05);          // MATH.md section 9
+  EXPECT_NEAR(peak, 16.4, 0.05);          // docs/METHOD.md §9
   EXPECT_GT(t_at_speed, 0.03);
   EXPECT_LT(t_at_speed, 0.08);            // "at speed in about 50 ms"
   imsim_steady st;

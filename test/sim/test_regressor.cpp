@@ -1,5 +1,5 @@
-// y = W K (MATH.md section 2) on simulated trajectories, with an independent double-precision
-// implementation of W and y written here from MATH.md.
+// y = W K (docs/METHOD.md §2) on simulated trajectories, with an independent double-precision
+// implementation of W and y written here from docs/METHOD.md.
 #include <gtest/gtest.h>
 
 #include <array>

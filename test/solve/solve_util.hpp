@@ -1,5 +1,5 @@
 // Helpers shared by the background-solve tests: the testvector, a float64
-// reference of the regressor (MATH.md §2) for realistic random sums, and an
+// reference of the regressor (docs/METHOD.md §2) for realistic random sums, and an
 // independent long-double evaluation of E_p^2.
 #pragma once
 
@@ -107,7 +107,7 @@ struct Sample {
   double ix, iy, dix, diy, d2ix, d2iy, ux, uy, dux, duy, w, dw;
 };
 
-// W (2x8) and, with y := W K_true + noise, the sums. Formulas of MATH.md §2.
+// W (2x8) and, with y := W K_true + noise, the sums. Formulas of docs/METHOD.md §2.
 inline void regressor(const Motor &mo, const Sample &q, double W[2][8]) {
   const double n = mo.np, m = mo.m(), s = mo.s(), w = q.w, wp = q.dw;
   W[0][0] = -q.dix;
@@ -179,7 +179,7 @@ inline imest_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double
       S.ry += y * y;
     }
   }
-  // structure fix (MATH.md §2): row/column 3 := -m row/column 4
+  // structure fix (docs/METHOD.md §2): row/column 3 := -m row/column 4
   const double m = mo.m();
   for (int i = 0; i < 8; ++i) {
     S.rw[2][i] = -m * S.rw[3][i];
@@ -192,7 +192,7 @@ inline imest_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double
 
 // Errors in variables: the same random signals, but white noise (rms
 // d2_noise_rel x rms of d2i/dt2) on the measured d2i/dt2, which enters y with
-// coefficient 1 and W.8 with -n^2 w^2 (MATH.md §9: the cause of the paper's
+// coefficient 1 and W.8 with -n^2 w^2 (docs/METHOD.md §9: the cause of the paper's
 // spurious minimum at K2 ~ n_p w). steady: nearly constant speed and slowly
 // varying rotor-frame currents (a loaded steady state), else synthetic_sums'.
 inline imest_sums_t eiv_sums(std::mt19937_64 &rng, const Motor &mo, double d2_noise_rel, int nsamp = 2000,

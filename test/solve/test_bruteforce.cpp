@@ -1,4 +1,4 @@
-// Brute-force check of the selection (MATH.md §7): the solver's minimiser
+// Brute-force check of the selection (docs/METHOD.md §7): the solver's minimiser
 // must be the global admissible minimum of E_p^2(K1, K2).
 // Reference, independent of the e-tables/resultant: for each K2 on a
 // 20000-point log grid over the T_R band, the exact K1 minimiser of the
@@ -7,7 +7,7 @@
 // Cases whose best point lies at the band edge or next to a K1 <= 0 boundary
 // have no stationary minimum there and are skipped (counted; must be rare).
 // Tolerances: K2 1e-6 relative (a flat profile limits the golden section),
-// E: 1e-9 E + 1e-12 R_y (E comes from cancellation, floor ~1e-12 R_y, MATH.md §7). Also: the roots inside the band equal Eigen's companion
+// E: 1e-9 E + 1e-12 R_y (E comes from cancellation, floor ~1e-12 R_y, docs/METHOD.md §7). Also: the roots inside the band equal Eigen's companion
 // roots of the same r (float32 chain completeness on application polynomials).
 #include <gtest/gtest.h>
 
@@ -120,7 +120,7 @@ void check_case(const imest_sums_t &s, const imest_solve_cfg_t &cfg, const char 
   }
   ASSERT_EQ(st, IMEST_OK) << name;
   const double dk2 = std::fabs(o.k2 - bf.k2) / bf.k2;
-  // E is formed by cancellation: resolution ~1e-12 R_y (MATH.md §7)
+  // E is formed by cancellation: resolution ~1e-12 R_y (docs/METHOD.md §7)
   const double de = std::fabs(o.e_w - bf.e) / (bf.e + 1e-3 * s.ry);
   *worst_k2 = std::max(*worst_k2, dk2);
   *worst_e = std::max(*worst_e, de);
@@ -198,7 +198,7 @@ TEST(BruteForce, WeightedCostRealisticRandomSums) {
 // Errors in variables (noise on d2i/dt2, which enters y with weight 1 and W.8
 // with -n^2 w^2, so the residual carries it weighted by (1 + n^2 w^2 T_R^2)):
 // in a steady state (slow rotor-frame signals, d2i noise 100 x its rms, as
-// with 12-bit sensors, MATH.md §9) the paper's E_p^2 minimum is pulled
+// with 12-bit sensors, docs/METHOD.md §9) the paper's E_p^2 minimum is pulled
 // towards small T_R (the spurious K2 ~ n_p w in the limit: at 400 x some
 // windows land there); the speed-normalised E_w stays at the true T_R.
 TEST(WeightedCost, ErrorsInVariablesPullThePapersMinimumTowardsSmallTR) {

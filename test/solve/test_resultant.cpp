@@ -1,4 +1,4 @@
-// Generic resultant (MATH.md §4) on random symmetric positive semi-definite
+// Generic resultant (docs/METHOD.md §4) on random symmetric positive semi-definite
 // R_W = A'A (no structure): degree 20 with leading coefficient
 // 16 R44 (R33 R44 - R34^2) >= 0 and r(0) = -16 R77 (R77 R88 - R78^2) <= 0;
 // with column 3 = -m column 4 the K2^19, K2^20 coefficients vanish to

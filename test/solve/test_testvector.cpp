@@ -1,4 +1,4 @@
-// Reproduce test/data/testvector.json (MATH.md §12) stage by stage from the
+// Reproduce test/data/testvector.json (docs/METHOD.md §12) stage by stage from the
 // structure-fixed R_W, R_Wy, R_y. Tolerances:
 //  - tables and resultant: 1e-10 x the magnitude of the terms summed into each
 //    coefficient (coefficients with cancellation cannot be compared relative
@@ -195,7 +195,7 @@ TEST(Testvector, ChainPrecisionDoesNotMatterAfterPolish) {
   const auto &j = testvector();
   for (int i = 0; i < n; ++i) {
     const double ref = j["positive_roots_K2"][i].get<double>() / t.s;
-    // polished in float64: a few ulp (MATH.md: 120-digit reference agreed to 1.8e-14)
+    // polished in float64: a few ulp (docs/METHOD.md: 120-digit reference agreed to 1.8e-14)
     EXPECT_LE(rel(x[i], ref), 2e-14) << i;
     double mag = 0;
     for (int k = 18; k >= 0; --k) mag = mag * x[i] + std::fabs(r[k]);

@@ -2,7 +2,7 @@
  * imsim: host-side induction-motor simulator for the imest project.
  *
  * Model: eq. (1) of Wang, Chiasson, Bodson, Tolbert (IEEE TCST 2007) in the stationary
- * (a, b) frame, power-invariant 3-2 transform (MATH.md section 1). Supplies: ideal sine,
+ * (a, b) frame, power-invariant 3-2 transform (docs/METHOD.md §1). Supplies: ideal sine,
  * ideal V/f, sine-triangle PWM inverter (event-exact), indirect field-oriented control (IFOC).
  * Sensors: ADCs (bits, range, clipping, seeded white noise), optional 2nd-order analog
  * anti-alias filter, incremental encoder. Thermal drift of R_S and R_R.
@@ -215,7 +215,7 @@ void imsim_set_load(imsim *sim, double load_nm);   /* overrides the load profile
 int imsim_steady_state(const imsim_config *c, double vll_v, double freq_hz, double load_nm,
                        imsim_steady *out);
 
-/* Power-invariant transforms (MATH.md section 1). */
+/* Power-invariant transforms (docs/METHOD.md §1). */
 void imsim_abc_to_ab(const double abc[3], double ab[2]);
 void imsim_ab_to_abc(const double ab[2], double abc[3]);
 
