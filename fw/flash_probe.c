@@ -23,7 +23,7 @@ int main(void)
   (void)imest_isr_abc(&est, u, i, 0.0f);
   (void)imest_isr_ab(&est, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
   (void)imest_background(&est, &res);
-  (void)imest_status_name(res.status);
+  (void)imest_reason_name(res.status);
   return (int)imest_overruns(&est);
 #else
   fw_mark_b0();

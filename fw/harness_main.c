@@ -189,7 +189,7 @@ int main(void)
       sh_puts(" used ");
       sh_putu(res.used_samples);
       sh_puts(" status ");
-      sh_puts(imest_status_name(res.status));
+      sh_puts(imest_reason_name(res.status));
       sh_puts(" valid ");
       sh_putu((uint64_t)res.valid);
       sh_puts(" tr_s ");

@@ -57,7 +57,7 @@ void imest_tables_weight(imest_tables_t *t, double weight_c); /* sets cw, refill
 
 /* Choose s from tr_nominal_s, c from R_y and g from the data (docs/METHOD.md §5) and
  * build the tables (cw = 0; call imest_tables_weight for c_w > 0). Returns
- * IMEST_OK, or IMEST_ST_NUMERIC for non-finite sums, R_y <= 0 or non-finite
+ * IMEST_OK, or IMEST_REASON_NUMERIC for non-finite sums, R_y <= 0 or non-finite
  * tables. */
 int imest_tables_build(const imest_sums_t *in, double tr_nominal_s, imest_tables_t *t);
 

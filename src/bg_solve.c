@@ -58,7 +58,7 @@ int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_s
   imest_tables_t t;
   if (imest_tables_build(in, cfg->tr_nominal_s, &t) != IMEST_OK) {
     stats->roots.sturm_evals = stats->roots.bisect_steps = stats->roots.polish_evals = 0;
-    return out->status = IMEST_ST_NUMERIC;
+    return out->status = IMEST_REASON_NUMERIC;
   }
   if (cfg->weight_c > 0.0) imest_tables_weight(&t, cfg->weight_c);
   out->scale_s = t.s;
@@ -70,7 +70,7 @@ int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_s
   double kappa[IMEST_MAX_ROOTS];
   const int nr = imest_poly_positive_roots_ex(r, IMEST_RES_DEG, kappa, IMEST_MAX_ROOTS, &stats->roots);
   out->work = stats->roots.sturm_evals + stats->roots.bisect_steps + stats->roots.polish_evals;
-  if (nr < 0) return out->status = IMEST_ST_NUMERIC; /* non-finite or all-zero resultant */
+  if (nr < 0) return out->status = IMEST_REASON_NUMERIC; /* non-finite or all-zero resultant */
   out->n_roots = (unsigned int)nr;
   for (int i = 0; i < nr; ++i) out->roots_k2[i] = kappa[i] * t.s;
 
@@ -78,7 +78,7 @@ int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_s
   unsigned int nad = 0;
   const int b = imest_select(&t, kappa, nr, cfg, in, &best, 0, &nad);
   out->n_admissible = nad;
-  if (b < 0) return out->status = IMEST_ST_NO_ROOT;
+  if (b < 0) return out->status = IMEST_REASON_NO_ROOT;
 
   const imest_cand_t *c = &best;
   out->k1 = c->k1;
@@ -98,7 +98,7 @@ int imest_solve_ex(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_s
                      imest_finite(out->pe_quad[1]);
   if (!finite) {
     out->hessian_pd = 0;
-    return out->status = IMEST_ST_NUMERIC;
+    return out->status = IMEST_REASON_NUMERIC;
   }
   return out->status = IMEST_OK;
 }

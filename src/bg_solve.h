@@ -46,7 +46,7 @@ typedef struct {
 } imest_solve_cfg_t;
 
 typedef struct {
-  int status;                 /* IMEST_OK, IMEST_ST_NUMERIC or IMEST_ST_NO_ROOT */
+  int status;                 /* IMEST_OK, IMEST_REASON_NUMERIC or IMEST_REASON_NO_ROOT */
   unsigned int n_roots;       /* positive roots of the resultant */
   unsigned int n_admissible;  /* of which K1 > 0 and T_R in band */
   double roots_k2[IMEST_MAX_ROOTS];

@@ -114,7 +114,7 @@ static int all_finite(const double *v, int n) {
 int imest_tables_build(const imest_sums_t *in, double tr_nominal_s, imest_tables_t *t) {
   if (!all_finite(&in->rw[0][0], 64) || !all_finite(in->rwy, 8) || !imest_finite(in->ry) || !(in->ry > 0.0)) {
     imest_tables_scaled(in, 0, 0, 0, t); /* defined content; caller reports NUMERIC */
-    return IMEST_ST_NUMERIC;
+    return IMEST_REASON_NUMERIC;
   }
   /* s = 2^round(log2(1/T_R0)); a bad nominal falls back to 0.1 s (s = 8). */
   const double trn = (imest_finite(tr_nominal_s) && tr_nominal_s > 1e-9 && tr_nominal_s < 1e9) ? tr_nominal_s : 0.1;
@@ -143,7 +143,7 @@ int imest_tables_build(const imest_sums_t *in, double tr_nominal_s, imest_tables
     p_coefficients(t);
   }
 
-  if (!all_finite(t->e2, 7) || !all_finite(t->e1, 8) || !all_finite(t->e0, 9)) return IMEST_ST_NUMERIC;
+  if (!all_finite(t->e2, 7) || !all_finite(t->e1, 8) || !all_finite(t->e0, 9)) return IMEST_REASON_NUMERIC;
   return IMEST_OK;
 }
 

@@ -15,7 +15,7 @@ static void result_clear(imest_result_t *r)
 
 int imest_background(imest_t *s, imest_result_t *out)
 {
-  if (s == NULL || out == NULL) return -1;
+  if (s == NULL || out == NULL) return IMEST_ERR_NULL;
   if (s->published == s->released) return 0;
   IMEST_BARRIER(); /* read the window only after seeing it published */
   imest_window_t *w = &s->win[s->released & 1u];
@@ -28,6 +28,10 @@ int imest_background(imest_t *s, imest_result_t *out)
   out->flags = w->flags;
   /* every window before this one was complete (a flushed one ends a run) */
   out->t_end_s = ((double)w->seq * (double)s->window_n + (double)w->samples - 1.0) / (double)s->fs;
+  out->span_s = (double)w->samples / (double)s->fs;
+  out->windows = 1u;
+  out->tr_bound_rel = NAN;
+  out->rs_bound_rel = NAN;
 
   const double m = (double)s->m;
   imest_sums_t sums;
@@ -35,7 +39,7 @@ int imest_background(imest_t *s, imest_result_t *out)
   imest_window_sums(w, m, (double)s->fs, &sums, &st);
 
   imest_solve_out_t so = {0};
-  so.status = IMEST_ST_NUMERIC;
+  so.status = IMEST_REASON_NUMERIC;
   so.tr_s = NAN;
   if (w->used >= 16u) {
     imest_solve_cfg_t cfg = {0}; /* fields added later default to 0 */
@@ -76,8 +80,8 @@ int imest_background(imest_t *s, imest_result_t *out)
     out->pe_k1_rel = NAN;
     out->pe_k2_rel = NAN;
   }
-  out->n_roots = so.status == IMEST_ST_NUMERIC ? 0u : so.n_roots;
-  out->n_admissible = so.status == IMEST_ST_NUMERIC ? 0u : so.n_admissible;
+  out->n_roots = so.status == IMEST_REASON_NUMERIC ? 0u : so.n_roots;
+  out->n_admissible = so.status == IMEST_REASON_NUMERIC ? 0u : so.n_admissible;
   for (unsigned int k = 0; k < out->n_roots && k < IMEST_MAX_ROOTS; ++k) {
     out->roots_k2[k] = so.roots_k2[k];
   }

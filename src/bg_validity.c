@@ -8,13 +8,13 @@
 
 static int first_flag_reason(unsigned int flags, uint32_t used, uint32_t samples)
 {
-  if (flags & IMEST_FLAG_INPUT_FAULT) return IMEST_ST_INPUT_FAULT;
-  if (flags & IMEST_FLAG_ADC_SAT) return IMEST_ST_ADC_SATURATION;
-  if (flags & IMEST_FLAG_ENCODER_FAULT) return IMEST_ST_ENCODER_FAULT;
+  if (flags & IMEST_FLAG_INPUT_FAULT) return IMEST_REASON_INPUT_FAULT;
+  if (flags & IMEST_FLAG_ADC_SAT) return IMEST_REASON_ADC_SATURATION;
+  if (flags & IMEST_FLAG_ENCODER_FAULT) return IMEST_REASON_ENCODER_FAULT;
   /* warm-up samples are not accumulated; the rest of the window is clean
    * data, so warm-up invalidates a window only when it took half of it */
-  if ((flags & IMEST_FLAG_WARMUP) && 2u * used < samples) return IMEST_ST_WARMUP;
-  return IMEST_OK;
+  if ((flags & IMEST_FLAG_WARMUP) && 2u * used < samples) return IMEST_REASON_WARMUP;
+  return IMEST_REASON_NONE;
 }
 
 void imest_judge(const imest_t *s, const imest_window_stats_t *st, const imest_solve_out_t *so,
@@ -34,30 +34,36 @@ void imest_judge(const imest_t *s, const imest_window_stats_t *st, const imest_s
   r->slip_ratio = fabs(st->slip_rate) * (double)s->tr_nominal_s;
   r->i_rms_a = st->i_rms_a;
 
-  if (status == IMEST_OK && !(st->i_rms_a >= (double)s->min_current_a)) {
+  if (status == IMEST_REASON_NONE && !(st->i_rms_a >= (double)s->min_current_a)) {
     /* i_rms_a is what passed the offset high-pass. A DC current it removed
      * (magnetising at rest) is in the tracked means: that rotor is at rest
      * with excitation, not without current. */
     const double ia = (double)s->dcb[2], ib = (double)s->dcb[3];
     const int dc = sqrt(ia * ia + ib * ib) >= (double)s->min_current_a;
-    status = (dc && fabs(st->w_mean) < 1.0) ? IMEST_ST_STANDSTILL : IMEST_ST_NO_CURRENT;
+    status = (dc && fabs(st->w_mean) < 1.0) ? IMEST_REASON_STANDSTILL : IMEST_REASON_NO_CURRENT;
   }
-  if (status == IMEST_OK && !(r->slip_ratio >= (double)s->min_slip_ratio)) {
+  if (status == IMEST_REASON_NONE && !(r->slip_ratio >= (double)s->min_slip_ratio)) {
     /* about 10 rpm: an encoder toggling by a count averages to zero here */
-    status = (fabs(st->w_mean) < 1.0) ? IMEST_ST_STANDSTILL : IMEST_ST_ZERO_SLIP;
+    status = (fabs(st->w_mean) < 1.0) ? IMEST_REASON_STANDSTILL : IMEST_REASON_ZERO_SLIP;
   }
-  if (status == IMEST_OK && so->status != IMEST_OK) status = so->status;
-  if (status == IMEST_OK && !so->hessian_pd) status = IMEST_ST_NOT_MINIMUM;
-  if (status == IMEST_OK && !(r->pe_k2_rel <= (double)s->max_pe_k2_rel))
-    status = IMEST_ST_POORLY_DETERMINED;
-  if (status == IMEST_OK && !(r->e_i <= (double)s->max_ei)) status = IMEST_ST_HIGH_RESIDUAL;
-  if (status == IMEST_OK &&
+  if (status == IMEST_REASON_NONE && so->status != IMEST_OK) status = so->status; /* NUMERIC or NO_ROOT */
+  if (status == IMEST_REASON_NONE && !so->hessian_pd) status = IMEST_REASON_NOT_MINIMUM;
+  if (status == IMEST_REASON_NONE && !(r->pe_k2_rel <= (double)s->max_pe_k2_rel))
+    status = IMEST_REASON_POORLY_DETERMINED;
+  if (status == IMEST_REASON_NONE && !(r->e_i <= (double)s->max_ei)) status = IMEST_REASON_HIGH_RESIDUAL;
+  if (status == IMEST_REASON_NONE &&
       !(r->rs_ohm >= (double)s->rs_min_ohm && r->rs_ohm <= (double)s->rs_max_ohm))
-    status = IMEST_ST_RS_OUT_OF_RANGE;
+    status = IMEST_REASON_RS_OUT_OF_RANGE;
   /* never a confident non-finite number */
-  if (status == IMEST_OK && !(isfinite(r->tr_s) && isfinite(r->rs_ohm) && isfinite(r->e_i)))
-    status = IMEST_ST_NUMERIC;
+  if (status == IMEST_REASON_NONE && !(isfinite(r->tr_s) && isfinite(r->rs_ohm) && isfinite(r->e_i)))
+    status = IMEST_REASON_NUMERIC;
 
+  /* One verdict for both parameters until the per-parameter evidence (voltage
+   * error, timing, gain mismatch) bounds R_S separately. */
   r->status = status;
-  r->valid = (status == IMEST_OK);
+  r->valid = (status == IMEST_REASON_NONE);
+  r->tr_reason = status;
+  r->tr_valid = r->valid;
+  r->rs_reason = status;
+  r->rs_valid = r->valid;
 }

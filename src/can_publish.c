@@ -39,7 +39,7 @@ int imest_can_publish(imest_t *s, const imest_result_t *r) {
   unsigned int i;
   int failed = 0;
   if (s == NULL || r == NULL) {
-    return -IMEST_ERR_NULL;
+    return IMEST_ERR_NULL;
   }
   port = s->can;
   if (port == NULL || port->send == NULL) {

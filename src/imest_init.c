@@ -218,25 +218,34 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
 
 uint32_t imest_overruns(const imest_t *s) { return s ? s->overruns : 0u; }
 
-const char *imest_status_name(int status)
+const char *imest_err_name(int err)
 {
-  switch (status) {
+  switch (err) {
   case IMEST_OK: return "ok";
   case IMEST_ERR_NULL: return "null_argument";
   case IMEST_ERR_CONFIG: return "bad_config";
-  case IMEST_ST_WARMUP: return "warmup";
-  case IMEST_ST_INPUT_FAULT: return "input_fault";
-  case IMEST_ST_ADC_SATURATION: return "adc_saturation";
-  case IMEST_ST_ENCODER_FAULT: return "encoder_fault";
-  case IMEST_ST_NO_CURRENT: return "no_current";
-  case IMEST_ST_STANDSTILL: return "standstill";
-  case IMEST_ST_ZERO_SLIP: return "zero_slip";
-  case IMEST_ST_NUMERIC: return "numeric";
-  case IMEST_ST_NO_ROOT: return "no_root";
-  case IMEST_ST_NOT_MINIMUM: return "not_minimum";
-  case IMEST_ST_POORLY_DETERMINED: return "poorly_determined";
-  case IMEST_ST_HIGH_RESIDUAL: return "high_residual";
-  case IMEST_ST_RS_OUT_OF_RANGE: return "rs_out_of_range";
+  case IMEST_ERR_ARG: return "bad_argument";
+  default: return "unknown";
+  }
+}
+
+const char *imest_reason_name(int reason)
+{
+  switch (reason) {
+  case IMEST_REASON_NONE: return "ok";
+  case IMEST_REASON_WARMUP: return "warmup";
+  case IMEST_REASON_INPUT_FAULT: return "input_fault";
+  case IMEST_REASON_ADC_SATURATION: return "adc_saturation";
+  case IMEST_REASON_ENCODER_FAULT: return "encoder_fault";
+  case IMEST_REASON_NO_CURRENT: return "no_current";
+  case IMEST_REASON_STANDSTILL: return "standstill";
+  case IMEST_REASON_ZERO_SLIP: return "zero_slip";
+  case IMEST_REASON_NUMERIC: return "numeric";
+  case IMEST_REASON_NO_ROOT: return "no_root";
+  case IMEST_REASON_NOT_MINIMUM: return "not_minimum";
+  case IMEST_REASON_POORLY_DETERMINED: return "poorly_determined";
+  case IMEST_REASON_HIGH_RESIDUAL: return "high_residual";
+  case IMEST_REASON_RS_OUT_OF_RANGE: return "rs_out_of_range";
   default: return "unknown";
   }
 }

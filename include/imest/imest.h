@@ -86,33 +86,44 @@ extern "C" {
 #endif
 
 /* ----------------------------------------------------------------------------
- * Status and reason codes
+ * Errors of the API calls, and reasons a window is not valid
  * ------------------------------------------------------------------------- */
 
-/** Return codes of imest_init() and the error reasons of a result. */
+/** Errors of the API calls. Every call that can fail returns an int: 0
+ *  (IMEST_OK) or a non-negative count on success, a negative imest_err_t on
+ *  error; each function documents its values with @retval. */
 typedef enum {
-  IMEST_OK = 0,                  /**< valid estimate / success */
-  /* configuration errors (imest_init) */
-  IMEST_ERR_NULL = 1,            /**< a pointer argument was NULL */
-  IMEST_ERR_CONFIG = 2,          /**< a config field is out of range; see imest_config_check() */
-  /* reasons a window is invalid (imest_result_t.status), most fundamental first */
-  IMEST_ST_WARMUP = 10,          /**< filters were still settling (start or after a fault) */
-  IMEST_ST_INPUT_FAULT = 11,     /**< non-finite or absurd sample (NaN, Inf, beyond limits) */
-  IMEST_ST_ADC_SATURATION = 12,  /**< a current or voltage sample reached the ADC limit */
-  IMEST_ST_ENCODER_FAULT = 13,   /**< angle step beyond the speed limit (glitch, jump) */
-  IMEST_ST_NO_CURRENT = 14,      /**< stator current below min_current_a: nothing to identify */
-  IMEST_ST_STANDSTILL = 15,      /**< rotor (nearly) at rest without AC excitation */
-  IMEST_ST_ZERO_SLIP = 16,       /**< rotor currents ~0 (no load, constant speed): T_R unobservable */
-  IMEST_ST_NUMERIC = 17,         /**< non-finite window sums or polynomial */
-  IMEST_ST_NO_ROOT = 18,         /**< no stationary point with K1 > 0 and T_R in [tr_min, tr_max] */
-  IMEST_ST_NOT_MINIMUM = 19,     /**< Hessian at the selected point not positive definite */
-  IMEST_ST_POORLY_DETERMINED = 20, /**< relative parametric error index of K2 too large */
-  IMEST_ST_HIGH_RESIDUAL = 21,   /**< E_I above max_ei: the data do not fit the model */
-  IMEST_ST_RS_OUT_OF_RANGE = 22  /**< R_S outside [rs_min_ohm, rs_max_ohm] */
-} imest_status_t;
+  IMEST_OK = 0,           /**< success */
+  IMEST_ERR_NULL = -1,    /**< a pointer argument was NULL */
+  IMEST_ERR_CONFIG = -2,  /**< a config field is out of range; imest_config_check() names it */
+  IMEST_ERR_ARG = -3      /**< an argument is out of range (an index, an identifier) */
+} imest_err_t;
 
-/** Short lower-case name of a status code ("ok", "warmup", "zero_slip", ...). */
-const char *imest_status_name(int status);
+/** Short lower-case name of an error ("ok", "null_argument", "bad_config", "bad_argument"). */
+const char *imest_err_name(int err);
+
+/** Why a window's estimate is not valid (imest_result_t.status, .tr_reason,
+ *  .rs_reason), most fundamental first. The values are stable: they travel on
+ *  CAN (tools/imest.dbc). */
+typedef enum {
+  IMEST_REASON_NONE = 0,              /**< valid */
+  IMEST_REASON_WARMUP = 10,           /**< filters were still settling (start or after a fault) */
+  IMEST_REASON_INPUT_FAULT = 11,      /**< non-finite or absurd sample (NaN, Inf, beyond limits) */
+  IMEST_REASON_ADC_SATURATION = 12,   /**< a current or voltage sample reached the ADC limit */
+  IMEST_REASON_ENCODER_FAULT = 13,    /**< angle step beyond the speed limit (glitch, jump) */
+  IMEST_REASON_NO_CURRENT = 14,       /**< stator current below min_current_a: nothing to identify */
+  IMEST_REASON_STANDSTILL = 15,       /**< rotor (nearly) at rest without AC excitation */
+  IMEST_REASON_ZERO_SLIP = 16,        /**< rotor currents ~0 (no load, constant speed): T_R unobservable */
+  IMEST_REASON_NUMERIC = 17,          /**< non-finite window sums or polynomial */
+  IMEST_REASON_NO_ROOT = 18,          /**< no stationary point with K1 > 0 and T_R in [tr_min, tr_max] */
+  IMEST_REASON_NOT_MINIMUM = 19,      /**< Hessian at the selected point not positive definite */
+  IMEST_REASON_POORLY_DETERMINED = 20,/**< relative parametric error index of K2 too large */
+  IMEST_REASON_HIGH_RESIDUAL = 21,    /**< E_I above max_ei: the data do not fit the model */
+  IMEST_REASON_RS_OUT_OF_RANGE = 22   /**< R_S outside [rs_min_ohm, rs_max_ohm] */
+} imest_reason_t;
+
+/** Short lower-case name of a reason ("ok", "warmup", "zero_slip", ...). */
+const char *imest_reason_name(int reason);
 
 /** Window flag bits (imest_result_t.flags): everything noticed in the window. */
 #define IMEST_FLAG_WARMUP        0x0001u /**< some samples were warm-up (not accumulated) */
@@ -194,7 +205,11 @@ typedef struct {
 /** Fill a config with defaults (motor constants zero: the caller must set them). */
 void imest_config_default(imest_config_t *cfg);
 
-/** Check a config: IMEST_OK, or IMEST_ERR_CONFIG with *field naming the first bad field. */
+/** Check a config.
+ *  @param field  optional: receives the name of the first bad field (NULL if none)
+ *  @retval IMEST_OK          the config is usable
+ *  @retval IMEST_ERR_NULL    cfg is NULL
+ *  @retval IMEST_ERR_CONFIG  a field is out of range (*field names it) */
 int imest_config_check(const imest_config_t *cfg, const char **field);
 
 /* ----------------------------------------------------------------------------
@@ -203,18 +218,32 @@ int imest_config_check(const imest_config_t *cfg, const char **field);
 
 #define IMEST_MAX_ROOTS 20
 
-/** Result of one window. Every estimate carries its quality. */
+/** Result of one window. Every estimate carries its quality: T_R and R_S
+ *  each have their own verdict (T_R can be trusted where R_S cannot, e.g.
+ *  with an uncertain inverter voltage error); `valid` is both. An estimate
+ *  keeps its number when it is not valid: only the verdict says whether to
+ *  use it. */
 typedef struct {
   uint32_t seq;             /**< window sequence number (0, 1, 2, ...; gaps = dropped windows) */
   uint32_t samples;         /**< samples in the window */
   uint32_t used_samples;    /**< samples accumulated (not warm-up, not faulty) */
   uint32_t overruns;        /**< windows dropped since init (background too slow) */
-  int valid;                /**< 1: the estimate can be trusted */
-  int status;               /**< IMEST_OK or the first reason it cannot (imest_status_t) */
+  int valid;                /**< 1: T_R and R_S can both be trusted (tr_valid && rs_valid) */
+  int status;               /**< IMEST_REASON_NONE, else the first reason (tr_reason if T_R is
+                                 not valid, else rs_reason): imest_reason_t */
+  int tr_valid;             /**< 1: T_R can be trusted (feed it to the IFOC) */
+  int tr_reason;            /**< why T_R is not valid (imest_reason_t; NONE if tr_valid) */
+  int rs_valid;             /**< 1: R_S can be trusted */
+  int rs_reason;            /**< why R_S is not valid (imest_reason_t; NONE if rs_valid) */
   unsigned int flags;       /**< IMEST_FLAG_* bits */
   double t_end_s;           /**< time of the window's last sample since init [s] */
+  double span_s;            /**< time the estimate is drawn from [s]: the window length,
+                                 longer when consecutive windows were combined */
+  unsigned int windows;     /**< windows combined into this estimate (1: this one alone) */
   double tr_s;              /**< rotor time constant T_R [s] (NaN if no candidate) */
   double rs_ohm;            /**< stator resistance R_S [ohm] */
+  double tr_bound_rel;      /**< error bound of T_R, relative (NaN if not computed) */
+  double rs_bound_rel;      /**< error bound of R_S, relative (NaN if not computed) */
   double k1;                /**< K1 = gamma [1/s] */
   double k2;                /**< K2 = 1/T_R [1/s] */
   double e;                 /**< E_p^2 at the minimum (units of y^2 * samples) */
@@ -321,8 +350,11 @@ typedef struct {
  * API
  * ------------------------------------------------------------------------- */
 
-/** Initialise an instance from a config (checked). Returns IMEST_OK,
- *  IMEST_ERR_NULL or IMEST_ERR_CONFIG. Computes the filter coefficients. */
+/** Initialise an instance from a config (checked); computes the filter
+ *  coefficients. Must not run concurrently with the ISR or background calls.
+ *  @retval IMEST_OK          initialised
+ *  @retval IMEST_ERR_NULL    s or cfg is NULL
+ *  @retval IMEST_ERR_CONFIG  a config field is out of range (imest_config_check() names it) */
 int imest_init(imest_t *s, const imest_config_t *cfg);
 
 /**
@@ -333,29 +365,33 @@ int imest_init(imest_t *s, const imest_config_t *cfg);
  *                  step between calls must stay below pi), increasing with the
  *                  a-b-c field. Pass it wrapped (e.g. [0, 2pi)) so float32
  *                  keeps its resolution.
- * @return 1 when this sample completed a window that was handed to the
- *         background (wake it), 0 otherwise.
+ * @retval 1  this sample completed a window that was handed to the background (wake it)
+ * @retval 0  otherwise (no error is possible: bad samples are flagged in the window)
  */
 int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], float theta_rad);
 
 /** ISR call with alpha/beta quantities (power-invariant 3-2 transform, docs/METHOD.md
  *  §1: amplitude = line-to-line rms; an amplitude-invariant Clarke transform
  *  scales u and i alike, which leaves T_R and R_S unchanged but changes E,
- *  min_current_a and the saturation check, which then apply to alpha/beta). */
+ *  min_current_a and the saturation check, which then apply to alpha/beta).
+ *  @retval 1, 0  as imest_isr_abc() */
 int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a,
                  float i_beta_a, float theta_rad);
 
 /** End the current window now, shorter than window_s (a drive that stops, a
  *  recording that ends): it is handed to the background like a completed one
- *  and judged on the samples it has. Call from the ISR context. Returns 1 if
- *  handed over, 0 if the window was empty or dropped (overrun). */
+ *  and judged on the samples it has. Call from the ISR context.
+ *  @retval 1  the window was handed over
+ *  @retval 0  the window was empty, or dropped (overrun) */
 int imest_isr_flush(imest_t *s);
 
 /**
- * Background call: if a finished window is waiting, solve it, publish it over
- * the CAN port (if one is attached), fill *out and return 1; else return 0
- * (-1 if an argument is NULL). Bounded time (no unbounded iteration).
- * Stack: see README (about 2 KiB). Call it until it returns 0.
+ * Background call: if a finished window is waiting, solve it, judge it and
+ * fill *out. Bounded time (no unbounded iteration); stack: fw/README.md.
+ * Call it until it returns 0.
+ * @retval 1               *out holds the next window's result
+ * @retval 0               no finished window is waiting
+ * @retval IMEST_ERR_NULL  s or out is NULL
  */
 int imest_background(imest_t *s, imest_result_t *out);
 

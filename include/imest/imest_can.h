@@ -113,7 +113,7 @@ int imest_attach_can(imest_t *s, const struct imest_can_port *port, uint32_t bas
  * once for each (no retry), counts every failed send in s->can_tx_failed,
  * and advances the rolling counter s->can_counter by one.
  * @return the number of frames that could not be sent (0: all sent, or no
- *         port attached), or -IMEST_ERR_NULL if s or r is NULL.
+ *         port attached), or IMEST_ERR_NULL if s or r is NULL.
  */
 int imest_can_publish(imest_t *s, const imest_result_t *r);
 

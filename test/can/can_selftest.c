@@ -45,7 +45,7 @@ static void synth(unsigned int k, imest_result_t *r) {
       r->pe_k1_rel = NAN;
       r->pe_k2_rel = NAN;
       r->valid = 0;
-      r->status = IMEST_ST_NO_ROOT;
+      r->status = IMEST_REASON_NO_ROOT;
       r->flags = IMEST_FLAG_WARMUP | IMEST_FLAG_ENCODER_FAULT;
       r->n_admissible = 0u;
       break;
@@ -56,14 +56,14 @@ static void synth(unsigned int k, imest_result_t *r) {
       r->pe_k1_rel = INFINITY;
       r->pe_k2_rel = 2.0;
       r->valid = 0;
-      r->status = IMEST_ST_HIGH_RESIDUAL;
+      r->status = IMEST_REASON_HIGH_RESIDUAL;
       r->flags = IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ADC_SAT | IMEST_FLAG_OVERRUN;
       r->n_roots = 20u;
       r->n_admissible = 17u;
       break;
     case 8u:
       r->valid = 0;
-      r->status = IMEST_ST_POORLY_DETERMINED;
+      r->status = IMEST_REASON_POORLY_DETERMINED;
       r->pe_k2_rel = 0.25;
       break;
     default:

@@ -213,14 +213,14 @@ TEST(CanCodec, U16FieldsScalingSaturationAndNaN) {
 TEST(CanCodec, StatusFlagsAndRootCounts) {
   imest_result_t r = golden_result();
   r.valid = 0;
-  r.status = IMEST_ST_RS_OUT_OF_RANGE;
+  r.status = IMEST_REASON_RS_OUT_OF_RANGE;
   r.flags = IMEST_FLAG_WARMUP | IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ADC_SAT | IMEST_FLAG_ENCODER_FAULT |
             IMEST_FLAG_OVERRUN;
   r.n_roots = 20;
   r.n_admissible = 40;  // saturates at 31
   imest_can_window_t w = roundtrip(r);
   EXPECT_EQ(w.valid, 0);
-  EXPECT_EQ(w.status, IMEST_ST_RS_OUT_OF_RANGE);
+  EXPECT_EQ(w.status, IMEST_REASON_RS_OUT_OF_RANGE);
   EXPECT_EQ(w.flags, r.flags);
   EXPECT_EQ(w.n_roots, 20u);
   EXPECT_EQ(w.n_admissible, 31u);
@@ -322,8 +322,8 @@ TEST(CanPublish, FourFramesPerWindowAndRollingCounter) {
   }
   EXPECT_EQ(s.can_counter, 257u);
   EXPECT_EQ(s.can_tx_failed, 0u);
-  EXPECT_EQ(imest_can_publish(nullptr, &r), -IMEST_ERR_NULL);
-  EXPECT_EQ(imest_can_publish(&s, nullptr), -IMEST_ERR_NULL);
+  EXPECT_EQ(imest_can_publish(nullptr, &r), IMEST_ERR_NULL);
+  EXPECT_EQ(imest_can_publish(&s, nullptr), IMEST_ERR_NULL);
 }
 
 TEST(CanPublish, FailedSendsAreCountedReportedAndNotRetried) {

@@ -63,10 +63,10 @@ TEST(EndToEnd, LoadedSteadyStateRecoversTrAndRs) {
   ASSERT_EQ(r.res.size(), 4u);
   EXPECT_TRUE(r.res[0].flags & IMEST_FLAG_WARMUP);
   EXPECT_EQ(r.res[0].used_samples, 4000u - 123u - 3183u);
-  EXPECT_EQ(r.res[0].status, IMEST_ST_WARMUP);
+  EXPECT_EQ(r.res[0].status, IMEST_REASON_WARMUP);
   for (size_t k = 1; k < r.res.size(); ++k) {
     const imest_result_t &w = r.res[k];
-    EXPECT_TRUE(w.valid) << k << " " << imest_status_name(w.status);
+    EXPECT_TRUE(w.valid) << k << " " << imest_reason_name(w.status);
     EXPECT_NEAR(w.tr_s, 0.12, 0.12 * 2e-3) << k;
     EXPECT_NEAR(w.rs_ohm, 5.04, 5.04 * 5e-3) << k;
     EXPECT_LT(w.pe_k2_rel, 0.04);
@@ -80,12 +80,12 @@ TEST(EndToEnd, RunUpValidThenZeroSlipInvalid) {
   MotorRef mot;
   RunOut r = run(mot, 3.0, 0.0, true);
   ASSERT_EQ(r.res.size(), 3u);
-  EXPECT_TRUE(r.res[0].valid) << imest_status_name(r.res[0].status);
+  EXPECT_TRUE(r.res[0].valid) << imest_reason_name(r.res[0].status);
   EXPECT_NEAR(r.res[0].tr_s, 0.12, 0.12 * 1e-2);
   EXPECT_NEAR(r.res[0].rs_ohm, 5.04, 5.04 * 2e-2);
   for (size_t k = 1; k < r.res.size(); ++k) {
     EXPECT_FALSE(r.res[k].valid) << k;
-    EXPECT_EQ(r.res[k].status, IMEST_ST_ZERO_SLIP) << k << " " << imest_status_name(r.res[k].status);
+    EXPECT_EQ(r.res[k].status, IMEST_REASON_ZERO_SLIP) << k << " " << imest_reason_name(r.res[k].status);
   }
 }
 
@@ -97,6 +97,6 @@ TEST(EndToEnd, NoCurrentIsInvalidWithReason) {
   ASSERT_EQ(r.res.size(), 2u);
   for (const auto &w : r.res) {
     EXPECT_FALSE(w.valid);
-    EXPECT_EQ(w.status, IMEST_ST_NO_CURRENT);
+    EXPECT_EQ(w.status, IMEST_REASON_NO_CURRENT);
   }
 }

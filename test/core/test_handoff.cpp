@@ -106,7 +106,7 @@ TEST(Handoff, WarmupIsMarkedAndStartAtRestSkipsIt) {
   int k = 0;
   feed(&s, 200, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.status, IMEST_ST_WARMUP);
+  EXPECT_EQ(r.status, IMEST_REASON_WARMUP);
   EXPECT_FALSE(r.valid);
   EXPECT_TRUE(r.flags & IMEST_FLAG_WARMUP);
   EXPECT_EQ(r.used_samples, 200u - 123u);
@@ -122,7 +122,7 @@ TEST(Handoff, WarmupIsMarkedAndStartAtRestSkipsIt) {
   feed(&s, 400, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_TRUE(r.flags & IMEST_FLAG_WARMUP);
-  EXPECT_NE(r.status, IMEST_ST_WARMUP);
+  EXPECT_NE(r.status, IMEST_REASON_WARMUP);
   EXPECT_EQ(r.used_samples, 400u - 123u);
   feed(&s, 400, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
@@ -152,7 +152,7 @@ TEST(Handoff, NonFiniteSampleInvalidatesItsWindowAndRecovers) {
   ++k;
   feed(&s, 299, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.status, IMEST_ST_INPUT_FAULT);
+  EXPECT_EQ(r.status, IMEST_REASON_INPUT_FAULT);
   EXPECT_FALSE(r.valid);
   feed(&s, 400, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
@@ -176,14 +176,14 @@ TEST(Handoff, EncoderJumpAndSaturationAreFlagged) {
   ++k;
   feed(&s, 299, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.status, IMEST_ST_ENCODER_FAULT);
+  EXPECT_EQ(r.status, IMEST_REASON_ENCODER_FAULT);
   feed(&s, 100, k);
   const float isat[3] = {5.0f, -2.5f, -2.5f};
   imest_isr_abc(&s, u, isat, 0.0f);
   ++k;
   feed(&s, 299, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.status, IMEST_ST_ADC_SATURATION);
+  EXPECT_EQ(r.status, IMEST_REASON_ADC_SATURATION);
 }
 
 TEST(Handoff, FlushHandsOverAShortWindowWithItsOwnEndTime) {
@@ -224,7 +224,7 @@ TEST(Handoff, OffsetTrackerLengthensOnlyTheFirstWarmup) {
   feed(&s, 4000, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_EQ(r.used_samples, 4000u - 123u - 3183u);
-  EXPECT_EQ(r.status, IMEST_ST_WARMUP);
+  EXPECT_EQ(r.status, IMEST_REASON_WARMUP);
   // a NaN sample restarts the filters only
   const float nan_u[3] = {NAN, 0, 0}, i[3] = {0, 0, 0};
   (void)imest_isr_abc(&s, nan_u, i, 0.0f);
@@ -232,7 +232,7 @@ TEST(Handoff, OffsetTrackerLengthensOnlyTheFirstWarmup) {
   feed(&s, 3999, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_EQ(r.used_samples, 4000u - 1u - 123u);
-  EXPECT_EQ(r.status, IMEST_ST_INPUT_FAULT);
+  EXPECT_EQ(r.status, IMEST_REASON_INPUT_FAULT);
   // an explicit warm-up is taken as given
   cfg.warmup_s = 0.01f;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);

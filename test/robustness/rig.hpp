@@ -129,7 +129,7 @@ struct Rig {
     char b[200];
     for (const auto &r : res) {
       std::snprintf(b, sizeof b, "  seq %2u %-18s valid %d tr %.5f rs %.4f used %u flags 0x%03x pe %.3g slip %.3g ei %.3g\n",
-                    r.seq, imest_status_name(r.status), r.valid, r.tr_s, r.rs_ohm, r.used_samples, r.flags,
+                    r.seq, imest_reason_name(r.status), r.valid, r.tr_s, r.rs_ohm, r.used_samples, r.flags,
                     r.pe_k2_rel, r.slip_ratio, r.e_i);
       o += b;
     }

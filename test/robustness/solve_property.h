@@ -21,7 +21,7 @@ static inline const char *imest_solve_property(int rc, const imest_solve_cfg_t *
                                                const imest_solve_out_t *out)
 {
   if (rc != out->status) return "return value differs from out->status";
-  if (!(rc == IMEST_OK || rc == IMEST_ST_NUMERIC || rc == IMEST_ST_NO_ROOT || rc == IMEST_ERR_CONFIG ||
+  if (!(rc == IMEST_OK || rc == IMEST_REASON_NUMERIC || rc == IMEST_REASON_NO_ROOT || rc == IMEST_ERR_CONFIG ||
         rc == IMEST_ERR_NULL))
     return "status is not one of OK, NUMERIC, NO_ROOT, ERR_CONFIG, ERR_NULL";
   if (out->n_roots > IMEST_MAX_ROOTS) return "n_roots > IMEST_MAX_ROOTS";

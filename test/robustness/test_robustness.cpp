@@ -63,7 +63,7 @@ int check_fault(const Rig &r, const char *name, uint32_t fault_first, uint32_t f
     const imest_result_t *w = r.window(k);
     if (w == nullptr) continue;  // dropped (overrun)
     EXPECT_FALSE(w->valid) << "window " << k << "\n" << r.dump();
-    if (expect != 0) EXPECT_EQ(w->status, expect) << "window " << k << " is " << imest_status_name(w->status) << "\n" << r.dump();
+    if (expect != 0) EXPECT_EQ(w->status, expect) << "window " << k << " is " << imest_reason_name(w->status) << "\n" << r.dump();
   }
   int recovery = -1;
   double tr_after = std::nan("");
@@ -76,14 +76,14 @@ int check_fault(const Rig &r, const char *name, uint32_t fault_first, uint32_t f
     }
     if (strict && after >= kMaxRecovery) {
       EXPECT_TRUE(w.valid) << "window " << w.seq << " (" << after << " after the fault) is "
-                           << imest_status_name(w.status) << "\n" << r.dump();
+                           << imest_reason_name(w.status) << "\n" << r.dump();
     }
     if (w.valid) EXPECT_NEAR(w.tr_s, pre_tr, kTolRel * pre_tr) << "window " << w.seq << "\n" << r.dump();
   }
   EXPECT_GE(recovery, 1) << r.dump();
   EXPECT_LE(recovery, kMaxRecovery) << r.dump();
   std::printf("[ robust   ] %-44s status %-17s recovery %d window(s), T_R %.5f -> %.5f s\n", name,
-              r.window(fault_first) ? imest_status_name(r.window(fault_first)->status) : "(dropped)", recovery,
+              r.window(fault_first) ? imest_reason_name(r.window(fault_first)->status) : "(dropped)", recovery,
               pre_tr, tr_after);
   return recovery;
 }
@@ -124,14 +124,14 @@ void bad_value_case(Chan c, float v, int expect, int pos = 700, int len = 3) {
 
 TEST(RobustInput, NonFiniteSamplesAreInputFaults) {
   for (Chan c : {kCurrent, kVoltage, kAngle})
-    for (float v : {kNaN, kInf, -kInf}) bad_value_case(c, v, IMEST_ST_INPUT_FAULT);
+    for (float v : {kNaN, kInf, -kInf}) bad_value_case(c, v, IMEST_REASON_INPUT_FAULT);
 }
 
 TEST(RobustInput, HugeSamplesAreInputFaults) {
   // beyond i_absurd_a (1e4) / u_absurd_v (1e5) / the 1e8 rad angle bound
-  for (float v : {1.0e30f, FLT_MAX, -FLT_MAX, 1.5e4f}) bad_value_case(kCurrent, v, IMEST_ST_INPUT_FAULT);
-  for (float v : {1.0e30f, FLT_MAX, -2.0e5f}) bad_value_case(kVoltage, v, IMEST_ST_INPUT_FAULT);
-  for (float v : {1.0e9f, -FLT_MAX, FLT_MAX}) bad_value_case(kAngle, v, IMEST_ST_INPUT_FAULT);
+  for (float v : {1.0e30f, FLT_MAX, -FLT_MAX, 1.5e4f}) bad_value_case(kCurrent, v, IMEST_REASON_INPUT_FAULT);
+  for (float v : {1.0e30f, FLT_MAX, -2.0e5f}) bad_value_case(kVoltage, v, IMEST_REASON_INPUT_FAULT);
+  for (float v : {1.0e9f, -FLT_MAX, FLT_MAX}) bad_value_case(kAngle, v, IMEST_REASON_INPUT_FAULT);
 }
 
 // A single-sample spike below the absurd limits cannot be told from a real
@@ -163,9 +163,9 @@ TEST(RobustInput, FaultAtWindowEndSpillsWarmupIntoNextWindow) {
     EXPECT_TRUE(w4->flags & IMEST_FLAG_WARMUP) << r.dump();
     EXPECT_LT(w4->used_samples, r.window_n);
     const int rec = check_fault(r, warmup_s > 0 ? "NaN at window end, warm-up 0.3 s" : "NaN at window end, default warm-up",
-                                3, 3, IMEST_ST_INPUT_FAULT, pre);
+                                3, 3, IMEST_REASON_INPUT_FAULT, pre);
     if (warmup_s > 0) {
-      EXPECT_EQ(w4->status, IMEST_ST_WARMUP) << r.dump();
+      EXPECT_EQ(w4->status, IMEST_REASON_WARMUP) << r.dump();
       EXPECT_EQ(rec, 2);
     }
   }
@@ -181,7 +181,7 @@ TEST(RobustInput, LongFaultBurstOverSeveralWindows) {
   r.run(7, [&](Sample &s) {
     if (s.n >= from && s.n < to) s.u[0] = kInf;
   });
-  check_fault(r, "Inf voltage for 1.4 windows", 3, 5, IMEST_ST_INPUT_FAULT, pre);
+  check_fault(r, "Inf voltage for 1.4 windows", 3, 5, IMEST_REASON_INPUT_FAULT, pre);
   ASSERT_NE(r.window(4), nullptr);
   EXPECT_EQ(r.window(4)->used_samples, 0u);
 }
@@ -211,7 +211,7 @@ TEST(RobustDenormal, DenormalCurrentsAndVoltagesAreNoCurrent) {
     const imest_result_t *w = r.window(k);
     ASSERT_NE(w, nullptr);
     EXPECT_FALSE(w->flags & IMEST_FLAG_INPUT_FAULT) << k;
-    if (k >= 4) EXPECT_EQ(w->status, IMEST_ST_NO_CURRENT) << k << "\n" << r.dump();
+    if (k >= 4) EXPECT_EQ(w->status, IMEST_REASON_NO_CURRENT) << k << "\n" << r.dump();
   }
   // window 3 holds the switch-off (a step no fault check can see), window 6
   // the switch-on: both invalid, whatever the reason
@@ -252,7 +252,7 @@ TEST(RobustDenormal, DenormalAngleIsZero) {
   });
   for (const auto &w : c.res) {
     EXPECT_FALSE(w.flags & (IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ENCODER_FAULT));
-    if (w.seq > 1) EXPECT_EQ(w.status, IMEST_ST_STANDSTILL) << c.dump();  // 0, 1: first-start warm-up
+    if (w.seq > 1) EXPECT_EQ(w.status, IMEST_REASON_STANDSTILL) << c.dump();  // 0, 1: first-start warm-up
   }
 }
 
@@ -281,7 +281,7 @@ TEST(RobustSaturation, CurrentClippedByTheAdcDuringAnOverload) {
         });
   EXPECT_GT(clipped, 100);
   // the overload samples end at window 5 (position 500): windows 3..5 clip
-  check_fault(r, "current ADC clipped (1 s overload)", 3, 5, IMEST_ST_ADC_SATURATION, pre);
+  check_fault(r, "current ADC clipped (1 s overload)", 3, 5, IMEST_REASON_ADC_SATURATION, pre);
 }
 
 // Voltage: a sensor offset burst pushes the voltage channel into its limit.
@@ -294,7 +294,7 @@ TEST(RobustSaturation, VoltageClippedAtTheLimit) {
   r.run(6, [&](Sample &s) {
     if (s.window == 3 && s.pos >= 600 && s.pos < 900) s.u[0] = std::fmin(s.u[0] + 60.0f, r.cfg.u_limit_v);
   });
-  check_fault(r, "voltage offset burst clipped", 3, 3, IMEST_ST_ADC_SATURATION, pre);
+  check_fault(r, "voltage offset burst clipped", 3, 3, IMEST_REASON_ADC_SATURATION, pre);
 }
 
 // ---------------------------------------------------------------------------
@@ -309,7 +309,7 @@ TEST(RobustEncoder, GlitchBurstIsAnEncoderFault) {
   r.run(6, [&](Sample &s) {
     if (s.window == 3 && s.pos >= 300 && s.pos < 303) s.theta = wrap(s.theta + 1000 * k2Pi / 4096);
   });
-  check_fault(r, "encoder glitch 1000 counts x3", 3, 3, IMEST_ST_ENCODER_FAULT, pre);
+  check_fault(r, "encoder glitch 1000 counts x3", 3, 3, IMEST_REASON_ENCODER_FAULT, pre);
 }
 
 TEST(RobustEncoder, OffsetJumpIsAnEncoderFaultThenSameEstimate) {
@@ -322,7 +322,7 @@ TEST(RobustEncoder, OffsetJumpIsAnEncoderFaultThenSameEstimate) {
   r.run(6, [&](Sample &s) {
     if (s.n >= 3L * r.window_n + 250) s.theta = wrap(s.theta + 1.0f);
   });
-  check_fault(r, "encoder offset jump 1 rad", 3, 3, IMEST_ST_ENCODER_FAULT, pre);
+  check_fault(r, "encoder offset jump 1 rad", 3, 3, IMEST_REASON_ENCODER_FAULT, pre);
 }
 
 TEST(RobustEncoder, SubThresholdGlitchInvalidatesOnlyItsWindow) {
@@ -369,7 +369,7 @@ static void expect_standstill_with_dc(double vll_v) {
   r.run(5);
   for (uint32_t k = 2; k < 5; ++k) {
     ASSERT_NE(r.window(k), nullptr);
-    EXPECT_EQ(r.window(k)->status, IMEST_ST_STANDSTILL) << r.dump();
+    EXPECT_EQ(r.window(k)->status, IMEST_REASON_STANDSTILL) << r.dump();
   }
 }
 
@@ -439,7 +439,7 @@ TEST(RobustCondition, IfocAtRestIsStandstill) {
   r.start();
   r.run(4);
   ASSERT_NE(r.window(3), nullptr);
-  EXPECT_EQ(r.window(3)->status, IMEST_ST_STANDSTILL) << r.dump();
+  EXPECT_EQ(r.window(3)->status, IMEST_REASON_STANDSTILL) << r.dump();
 }
 
 // Drive disabled for 2 s: zero voltage, the current sensors read ADC noise
@@ -462,7 +462,7 @@ TEST(RobustCondition, NoCurrentThenReenabled) {
   });
   for (uint32_t k = 4; k <= 6; ++k) {
     ASSERT_NE(r.window(k), nullptr);
-    EXPECT_EQ(r.window(k)->status, IMEST_ST_NO_CURRENT) << r.dump();
+    EXPECT_EQ(r.window(k)->status, IMEST_REASON_NO_CURRENT) << r.dump();
   }
   check_fault(r, "no current (drive off 2 s)", 3, 7, 0, pre);
 }
@@ -479,7 +479,7 @@ TEST(RobustCondition, ZeroSlipThenLoad) {
     if (n == 4L * r.window_n) imsim_set_load(&r.sim, 2.064);
   });
   // windows 0, 1: first-start warm-up
-  check_fault(r, "zero slip (no load), then rated load", 2, 3, IMEST_ST_ZERO_SLIP, pre);
+  check_fault(r, "zero slip (no load), then rated load", 2, 3, IMEST_REASON_ZERO_SLIP, pre);
 }
 
 // ---------------------------------------------------------------------------
@@ -522,7 +522,7 @@ TEST(RobustBand, NoValidResultOutsideTheTrBand) {
     for (const auto &w : r.res) {
       EXPECT_FALSE(w.valid) << r.dump();
       if (!(w.flags & IMEST_FLAG_WARMUP)) {
-        EXPECT_TRUE(w.status == IMEST_ST_NO_ROOT || w.status == IMEST_ST_POORLY_DETERMINED) << r.dump();
+        EXPECT_TRUE(w.status == IMEST_REASON_NO_ROOT || w.status == IMEST_REASON_POORLY_DETERMINED) << r.dump();
       }
     }
   }

@@ -190,7 +190,7 @@ TEST(SolveRandom, PropertyHoldsOn20000SeededCases) {
     }
   }
   std::printf("[ solve    ] %d cases: ok %d, numeric %d, no_root %d, config %d; most work %u of %u\n", kCases,
-              by_status[IMEST_OK], by_status[IMEST_ST_NUMERIC], by_status[IMEST_ST_NO_ROOT],
+              by_status[IMEST_OK], by_status[IMEST_REASON_NUMERIC], by_status[IMEST_REASON_NO_ROOT],
               by_status[IMEST_ERR_CONFIG], max_work, (unsigned)IMEST_SOLVE_WORK_BOUND);
   // the structured cases must reach the OK branch often, or the property is vacuous
   EXPECT_GT(by_status[IMEST_OK], kCases / 8);

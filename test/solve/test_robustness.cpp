@@ -22,7 +22,7 @@ void check(const imest_sums_t &s, const imest_solve_cfg_t &cfg, const char *what
   imest_solve_stats_t st;
   const int rc = imest_solve_ex(&s, &cfg, &o, &st);
   EXPECT_EQ(rc, o.status) << what;
-  EXPECT_TRUE(rc == IMEST_OK || rc == IMEST_ST_NUMERIC || rc == IMEST_ST_NO_ROOT) << what << " rc " << rc;
+  EXPECT_TRUE(rc == IMEST_OK || rc == IMEST_REASON_NUMERIC || rc == IMEST_REASON_NO_ROOT) << what << " rc " << rc;
   EXPECT_LE(o.n_roots, (unsigned)IMEST_MAX_ROOTS);
   EXPECT_LE(o.n_admissible, o.n_roots);
   EXPECT_LE(st.roots.sturm_evals, IMEST_ROOTS_BOUND_STURM) << what;
@@ -175,7 +175,7 @@ TEST(Robustness, BadArguments) {
   cfg = default_cfg();
   cfg.tr_min_s = 0.2;
   cfg.tr_max_s = 0.3;
-  EXPECT_EQ(imest_solve(&s, &cfg, &o), IMEST_ST_NO_ROOT);
+  EXPECT_EQ(imest_solve(&s, &cfg, &o), IMEST_REASON_NO_ROOT);
   EXPECT_EQ(o.n_roots, 3u);
   EXPECT_EQ(o.n_admissible, 0u);
   EXPECT_TRUE(std::isnan(o.tr_s));

@@ -405,7 +405,7 @@ static int run_job(job_t *j)
         fprintf(csv,
                 "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
                 "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g\n",
-                name, r.seq, r.t_end_s, r.tr_s, r.rs_ohm, r.valid, imest_status_name(r.status),
+                name, r.seq, r.t_end_s, r.tr_s, r.rs_ohm, r.valid, imest_reason_name(r.status),
                 t->tr, t->rs, r.e_i, r.pe_k1_rel, r.pe_k2_rel, r.slip_ratio, r.i_rms_a, r.n_roots,
                 r.n_admissible, r.used_samples, r.flags, t->speed, t->te, t->load, t->te_ref,
                 t->te_err_rms, t->psi, t->psi_ref, t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr);
@@ -457,7 +457,7 @@ static int run_job(job_t *j)
     FILE *f = open_out(j, dir, "exp1_identified.csv");
     if (f == NULL) return -1;
     fprintf(f, "seq,valid,status,T_R_s,R_S_ohm,source\n%d,%d,%s,%.9g,%.9g,%s\n", j->id_seq,
-            have_id == 2, have_id ? imest_status_name(j->id_status) : "none", j->id_tr, j->id_rs,
+            have_id == 2, have_id ? imest_reason_name(j->id_status) : "none", j->id_tr, j->id_rs,
             have_id == 2   ? "first valid window"
             : have_id == 1 ? "run-up window 0, NOT valid (no valid window)"
                            : "nominal parameters (no usable estimate)");

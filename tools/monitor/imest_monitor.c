@@ -81,7 +81,7 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t) {
   fmt_or_empty(pk1, sizeof pk1, h_q, "%.5f", w->pe_k1_rel);
   if (h_q) {
     snprintf(valid, sizeof valid, "%d", w->valid);
-    snprintf(status, sizeof status, "%s", imest_status_name(w->status));
+    snprintf(status, sizeof status, "%s", imest_reason_name(w->status));
     snprintf(nr, sizeof nr, "%u", w->n_roots);
     snprintf(na, sizeof na, "%u", w->n_admissible);
     snprintf(flags, sizeof flags, "0x%04X", w->flags);

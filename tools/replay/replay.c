@@ -91,7 +91,7 @@ static float *float_option(imest_config_t *cfg, const char *opt)
 static void print_row(double t0, const imest_result_t *r)
 {
   printf("%.6f,%.9g,%.9g,%.6g,%d,%s,%u,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%u,%u,%.4g,%.6g,%u,0x%x\n",
-         t0 + r->t_end_s, r->tr_s, r->rs_ohm, r->e_i, r->valid, imest_status_name(r->status),
+         t0 + r->t_end_s, r->tr_s, r->rs_ohm, r->e_i, r->valid, imest_reason_name(r->status),
          r->seq, r->k1, r->k2, r->pe_k1_rel, r->pe_k2_rel, r->hessian[0][0], r->hessian[0][1],
          r->hessian[1][1], (r->flags & IMEST_FLAG_HESSIAN_PD) ? 1 : 0, r->n_roots,
          r->n_admissible, r->slip_ratio, r->i_rms_a, r->used_samples, r->flags);
@@ -410,7 +410,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "imest-replay: %ld samples at %.6g Hz, %ld windows (%ld valid)", n, fs,
             windows, valid);
     for (int k = 1; k < 32; ++k)
-      if (by_status[k]) fprintf(stderr, ", %ld %s", by_status[k], imest_status_name(k));
+      if (by_status[k]) fprintf(stderr, ", %ld %s", by_status[k], imest_reason_name(k));
     if (rest && !flush)
       fprintf(stderr, "; last %ld samples (under half a window) not used", rest);
     else if (rest)
