@@ -89,7 +89,7 @@ TEST(Resultant, StructuredDegree18) {
   }
 }
 
-// Weighted cost (bg_bounds.h): r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0 with
+// Weighted cost (bg_tables.h): r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0 with
 // bw_t = kappa b_t + cw t'. For this regressor r_w[21] and r_w[20] vanish for
 // any cw (the K2^19 coefficient of the cw part is 8 e2[6] (4 e2[6] e0[8] -
 // e1[7]^2) = 32 R44 (R33 R44 - R34^2) = 0) and r_w[19] = r[18] (cw-free).
