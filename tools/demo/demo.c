@@ -358,7 +358,8 @@ static int run_job(job_t *j)
           "experiment,seq,t_end_s,T_R_s,R_S_ohm,valid,status,T_R_true_s,R_S_true_ohm,E_I,"
           "pe_k1_rel,pe_k2_rel,slip_ratio,i_rms_a,n_roots,n_admissible,used_samples,flags,"
           "speed_rad_s,torque_nm,load_nm,torque_ref_nm,torque_err_rms_nm,psi_r_wb,psi_ref_wb,"
-          "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s\n");
+          "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s,"
+          "tr_valid,tr_reason,rs_valid,rs_reason\n");
 
   const uint32_t wn = (uint32_t)lround((double)cfg.window_s * (double)cfg.fs_hz);
   const unsigned long long total = (unsigned long long)llround(j->duration_s * c.fs_hz);
@@ -404,11 +405,13 @@ static int run_job(job_t *j)
         if (t == NULL || r.seq >= win) t = &nan_t;
         fprintf(csv,
                 "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
-                "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g\n",
+                "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s\n",
                 name, r.seq, r.t_end_s, r.tr_s, r.rs_ohm, r.valid, imest_reason_name(r.status),
                 t->tr, t->rs, r.e_i, r.pe_k1_rel, r.pe_k2_rel, r.slip_ratio, r.i_rms_a, r.n_roots,
                 r.n_admissible, r.used_samples, r.flags, t->speed, t->te, t->load, t->te_ref,
-                t->te_err_rms, t->psi, t->psi_ref, t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr);
+                t->te_err_rms, t->psi, t->psi_ref, t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr,
+                r.tr_valid, imest_reason_name(r.tr_reason), r.rs_valid,
+                imest_reason_name(r.rs_reason));
         j->windows++;
         if (r.valid) {
           j->valid++;
