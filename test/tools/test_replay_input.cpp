@@ -120,6 +120,19 @@ TEST(ReplayInput, MissingSampleIsRefusedDespiteRounding) {
   EXPECT_TRUE(has(o, "give --fs HZ")) << o.err;
 }
 
+// t with fewer decimals than the sample period needs repeats itself: named,
+// and --fs reads the file.
+TEST(ReplayInput, TooCoarseTimeAsksForFs) {
+  const std::string p = with_t("d3.csv", [](double t, long) { return fmt("%.3f", t); });
+  Out o = replay(p);
+  EXPECT_EQ(o.code, 1);
+  EXPECT_TRUE(has(o, "t is printed with 3 decimals, too few for its mean step of 0.00025 s")) << o.err;
+  EXPECT_TRUE(has(o, "give --fs HZ")) << o.err;
+  o = replay(p, "--fs 4000");
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(o.out, replay(base()).out);
+}
+
 // A recording cut off mid-write: the last line is left out with a warning.
 TEST(ReplayInput, TruncatedLastLineIsLeftOut) {
   std::string text = slurp(base());
@@ -167,6 +180,12 @@ TEST(ReplayInput, ExitCodes) {
   o = replay(tmpdir() + "/no-such-file.csv");
   EXPECT_EQ(o.code, 1);
   EXPECT_TRUE(has(o, "cannot open")) << o.err;
+  o = replay(tmpdir());
+  EXPECT_EQ(o.code, 1);
+  EXPECT_TRUE(has(o, "cannot read: Is a directory")) << o.err;
+  o = replay("- < /dev/null");
+  EXPECT_EQ(o.code, 1);
+  EXPECT_TRUE(has(o, "stdin: empty file")) << o.err;
   o = run(std::string(REPLAY_BIN) + " --help");
   EXPECT_EQ(o.code, 0);
   EXPECT_EQ(replay(base()).code, 0);

@@ -66,9 +66,13 @@ int csv_open(csv_reader_t *r, const char *path)
     return -1;
   }
   for (int k = 0; k < CSV_NEED; ++k) r->col[k] = -1;
+  errno = 0;
   long len = read_line(r);
   if (len < 0) {
-    snprintf(r->err, sizeof r->err, "%s: empty file (no header row)", path);
+    if (ferror(r->f))
+      snprintf(r->err, sizeof r->err, "%s: cannot read: %s", path, strerror(errno));
+    else
+      snprintf(r->err, sizeof r->err, "%s: empty file (no header row)", path);
     return -1;
   }
   /* strip a UTF-8 byte order mark */

@@ -44,7 +44,7 @@ typedef struct {
   long line_lo, line_hi;
   long repeats, line_repeat; /* steps of exactly 0 */
   double t_repeat;
-  double q_max;              /* the coarsest rounding of t */
+  double q_repeat, q_worst;  /* rounding of t at the first repeat, at the widest step */
   int all_unit_steps;        /* every step exactly 1 (a sample index) */
   double p_sum, s_sum;       /* sum of u.i, sum of |u||i| */
   double field_rad, mech_rad;/* net rotation of the current vector, of theta */
@@ -71,9 +71,11 @@ static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const
     if (dt > y->dt_max) { y->dt_max = dt; y->line_max = r->line; }
     if (dt + q < y->lo) { y->lo = dt + q; y->line_lo = r->line; }
     if (dt - q > y->hi) { y->hi = dt - q; y->line_hi = r->line; }
+    if (dt == y->dt_max) y->q_worst = r->t_round;
     if (dt == 0.0 && y->repeats++ == 0) {
       y->line_repeat = r->line;
       y->t_repeat = v[0];
+      y->q_repeat = r->t_round;
     }
     if (dt != 1.0) y->all_unit_steps = 0;
     const double dth = v[7] - y->th_prev;
@@ -94,7 +96,6 @@ static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const
   y->th_prev = v[7];
   y->tprev = v[0];
   y->qprev = r->t_round;
-  y->q_max = fmax(y->q_max, r->t_round);
   s->n++;
 }
 
@@ -131,11 +132,18 @@ static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s
 {
   const double step = (s->t_last - s->t0) / (double)(s->n - 1);
   if (y->repeats) {
-    fprintf(stderr,
-            "%s: %s:%ld: t = %.9g repeats the previous row's t (%ld such rows): a duplicated row, "
-            "or t printed with too few decimals for the sample rate. Write t with more decimals, "
-            "or give --fs HZ (t then only orders the rows).\n",
-            k_prog, name, y->line_repeat, y->t_repeat, y->repeats);
+    if (2.0 * y->q_repeat >= 0.5 * step)
+      fprintf(stderr,
+              "%s: %s:%ld: t = %.9g repeats the previous row's t: t is printed with %d decimals, "
+              "too few for its mean step of %.6g s (%.6g Hz). Write t with more decimals, or give "
+              "--fs HZ (t then only orders the rows).\n",
+              k_prog, name, y->line_repeat, y->t_repeat, decimals(y->q_repeat), step, 1.0 / step);
+    else
+      fprintf(stderr,
+              "%s: %s:%ld: t = %.9g repeats the previous row's t (%ld times in the file): a duplicated "
+              "row? If the drive did sample at a fixed rate, give --fs HZ (t then only orders "
+              "the rows).\n",
+              k_prog, name, y->line_repeat, y->t_repeat, y->repeats);
     return TOOL_EXIT_DATA;
   }
   if (1.0 / step < FS_IMPLAUSIBLE_HZ || y->all_unit_steps) return bad_unit(name, y, step);
@@ -163,7 +171,7 @@ static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s
     fprintf(stderr,
             "%s: note: t is printed with %d decimals; its steps (%.6g .. %.6g s) are read as the "
             "rounding of a fixed %.6g s step (%.6g Hz from the record's span)\n",
-            k_prog, decimals(y->q_max), y->dt_min, y->dt_max, step, s->fs);
+            k_prog, decimals(y->q_worst), y->dt_min, y->dt_max, step, s->fs);
   return -1;
 }
 
