@@ -182,6 +182,7 @@ bad:
       r->err[0] = '\0';
       return 0;
     }
+    r->line = line; /* the peek read on: the error is the bad line's */
   }
   return -1;
 }
