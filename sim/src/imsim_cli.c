@@ -21,38 +21,67 @@ const char *imsim_cli_header(void) { return HEADER; }
 
 static const char USAGE[] =
     "usage: imest-sim [options]\n"
-    "Simulates the induction motor of Wang et al. (IEEE TCST 2007) and writes CSV:\n"
-    "  t,u_a,u_b,u_c,i_a,i_b,i_c,theta (measured) followed by truth columns.\n"
+    "Simulates an induction motor (by default the one of Wang et al., IEEE TCST 2007) fed by an\n"
+    "ideal source, a PWM inverter or an IFOC drive, and writes CSV: t,u_a,u_b,u_c,i_a,i_b,i_c,theta\n"
+    "(measured), then truth columns. Every flag is optional: the defaults are the preset's (exp1\n"
+    "when none is given); a flag given overrides the preset. --opt value and --opt=value both work.\n"
     "\n"
-    "  --preset exp1|exp2    experiment preset (applied before every other flag)\n"
-    "  --duration S          simulated time (rows t = 0 .. S)\n"
-    "  --fs HZ               sampling frequency (default 4000)\n"
-    "  --out FILE            output file, '-' = stdout (default -)\n"
-    "  --decimate N          write every N-th sample (default 1)\n"
-    "motor:\n"
-    "  --pole-pairs N --ls H --lr H --sigma X --rs OHM --tr S --j KGM2 --b NMS\n"
+    "run:\n"
+    "  --preset exp1|exp2    exp1: 60 Hz, 230 V applied at standstill, no load, 2 s;\n"
+    "                        exp2: 30 Hz V/f (115 V) at rated load 2.064 N m, 3600 s\n"
+    "  --duration S          simulated time, rows t = 0 .. S (exp1 2, exp2 3600)\n"
+    "  --fs HZ               sample rate (4000)\n"
+    "  --out FILE            output file, '-' = stdout (-)\n"
+    "  --decimate N          write every N-th sample (1)\n"
+    "  --progress, --no-progress   bar on stderr (default: when stderr is a terminal)\n"
+    "  --help                this text\n"
+    "motor (default: the paper's motor; resistances cold, at --t-amb):\n"
+    "  --pole-pairs N (2)  --ls H (0.2908)  --lr H (0.2908)  --sigma X (0.096)\n"
+    "  --rs OHM (5.04)  --tr S (0.12)  --j KGM2 (1.2e-3)  --b NMS (1e-4, viscous friction)\n"
     "supply:\n"
-    "  --supply sine|vf|pwm|ifoc   --vll V (line-line rms)   --freq HZ\n"
-    "  --vf-ramp S --vf-boost V    --carrier-hz HZ --vdc V --dead-time S\n"
-    "  --pwm-segments        integrate piecewise between PWM switching instants (reference accuracy,\n"
-    "                        ~2.3x slower; default: one step per half carrier period, see README)\n"
-    "  --start rest|steady   (steady: begin in the sinusoidal steady state, full load)\n"
-    "load:\n"
-    "  --load-nm NM --load-on S --load-ramp S\n"
-    "IFOC:\n"
-    "  --ifoc-tr S --ifoc-flux WB --ifoc-mode speed|torque --speed-ref RPM --speed-ramp S\n"
-    "  --torque-ref NM --torque-limit NM --ifoc-ideal-stage\n"
+    "  --supply sine|vf|pwm|ifoc   ideal sine applied at once | ideal V/f ramp | PWM inverter on\n"
+    "                        the V/f reference | IFOC driving the PWM inverter (exp1 sine, exp2 vf)\n"
+    "  --vll V               line-to-line rms voltage (exp1 230, exp2 115)\n"
+    "  --freq HZ             electrical frequency (exp1 60, exp2 30)\n"
+    "  --vf-ramp S           V/f ramp from 0 to --freq (exp1 0 = at once, exp2 1)\n"
+    "  --vf-boost V          V/f voltage at 0 Hz (0)\n"
+    "  --start rest|steady   rest: standstill, zero flux; steady: the sinusoidal steady state at\n"
+    "                        full load from t = 0 (rest)\n"
+    "PWM inverter (--supply pwm|ifoc):\n"
+    "  --carrier-hz HZ (10000)  --vdc V (400)  --dead-time S (0)\n"
+    "  --pwm-segments        integrate piecewise between switching instants (reference accuracy,\n"
+    "                        about 2.3x slower; default: one step per half carrier period)\n"
+    "load (opposes rotation):\n"
+    "  --load-nm NM (exp1 0, exp2 2.064)  --load-on S (exp2 1.5)  --load-ramp S (exp2 1)\n"
+    "IFOC (--supply ifoc):\n"
+    "  --ifoc-mode speed|torque (speed)\n"
+    "  --speed-ref RPM (exp1 1750, exp2 850)  --speed-ramp S (exp1 0.5, exp2 1)\n"
+    "  --torque-ref NM (0)  --torque-limit NM (4)\n"
+    "  --ifoc-tr S           the controller's T_R (default: the motor's cold T_R)\n"
+    "  --ifoc-flux WB        rotor-flux reference (default: the steady-state flux at --vll/--freq)\n"
+    "  --ifoc-ideal-stage    ideal voltage source instead of the PWM inverter\n"
     "sensors:\n"
-    "  --ideal-sensors (exact samples: no quantisation, noise, clipping, AA, encoder)\n"
-    "  --seed N --adc-bits N --i-range A --u-range V --noise-lsb X --encoder-counts N\n"
-    "  --i-offset A,A,A --u-offset V,V,V --i-gain-err X,X,X   per-phase sensor offsets and\n"
-    "                        relative gain errors (default 0)\n"
-    "  --aa-hz HZ (0 = off) --vmeas auto|avg|aa|inst\n"
+    "  --ideal-sensors       exact samples: no quantisation, noise, clipping, AA filter, encoder\n"
+    "  --adc-bits N (12)  --i-range A (20)  --u-range V (400): ADC full scale is +-range\n"
+    "  --noise-lsb X (1)     white Gaussian noise before the ADC, rms in LSB\n"
+    "  --seed N (1)          noise seed\n"
+    "  --encoder-counts N    counts per mechanical revolution (4096)\n"
+    "  --i-offset A,A,A  --u-offset V,V,V  --i-gain-err X,X,X   per-phase (a,b,c) sensor offsets\n"
+    "                        and relative gain errors, 0.01 = reads 1 % high (0,0,0)\n"
+    "  --aa-hz HZ            2nd-order Butterworth anti-alias filter on every electrical\n"
+    "                        channel (0 = off)\n"
+    "  --vmeas auto|avg|aa|inst   voltage channel: avg = phase voltage from the commanded duties\n"
+    "                        and Vdc (PWM only); aa = through the AA filter; inst = instantaneous\n"
+    "                        (ideal supplies only); auto = avg with PWM, inst otherwise (auto)\n"
     "thermal:\n"
-    "  --no-thermal --t-amb C --thermal-speedup X\n"
+    "  --no-thermal          freeze R_S and R_R\n"
+    "  --t-amb C (22)  --thermal-speedup X (1; multiplies both thermal rates)\n"
     "integrator:\n"
-    "  --integrator fast|rk4 --rk4-substeps N --steps-per-sample N\n"
-    "  --progress / --no-progress (default: bar on stderr when it is a terminal)\n";
+    "  --integrator fast|rk4 (fast; rk4 = slow reference)  --rk4-substeps N (8)\n"
+    "  --steps-per-sample N  steps per sample for the ideal supplies (0 = auto: 5; PWM: fixed)\n"
+    "\n"
+    "Exit status: 0 done (a warning on stderr says when the PWM modulation was clipped),\n"
+    "1 the output cannot be written, 2 a bad flag or an impossible configuration.\n";
 
 /* ---- parse ------------------------------------------------------------------------------ */
 
@@ -182,6 +211,30 @@ static const phase_flag PHASE_FLAGS[] = {
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 
 static void *field(imsim_config *c, size_t off) { return (char *)c + off; }
+
+/* Flags without a value, and the valued flags handled one by one in parse_valued. */
+static const char *const SWITCH_FLAGS[] = {"--help", "--ideal-sensors", "--no-thermal", "--ifoc-ideal-stage",
+                                           "--progress", "--no-progress", "--pwm-segments"};
+static const char *const OTHER_FLAGS[] = {"--preset", "--out", "--decimate", "--seed"};
+
+size_t imsim_cli_flags(const char **names, size_t max) {
+  size_t n = 0;
+#define ADD(x)                  \
+  do {                          \
+    if (n < max) names[n] = (x); \
+    ++n;                        \
+  } while (0)
+  for (size_t k = 0; k < COUNT(SWITCH_FLAGS); ++k) ADD(SWITCH_FLAGS[k]);
+  for (size_t k = 0; k < COUNT(OTHER_FLAGS); ++k) ADD(OTHER_FLAGS[k]);
+  for (size_t k = 0; k < COUNT(PHASE_FLAGS); ++k) ADD(PHASE_FLAGS[k].flag);
+  for (size_t k = 0; k < COUNT(CHOICE_FLAGS); ++k) ADD(CHOICE_FLAGS[k].flag);
+  for (size_t k = 0; k < COUNT(REAL_FLAGS); ++k) ADD(REAL_FLAGS[k].flag);
+  for (size_t k = 0; k < COUNT(INT_FLAGS); ++k) ADD(INT_FLAGS[k].flag);
+#undef ADD
+  return n;
+}
+
+const char *imsim_cli_usage(void) { return USAGE; }
 
 /* Flags without a value. Returns 1 if name is one (and applies it), 0 otherwise. */
 static int parse_switch(const char *name, imsim_config *c, imsim_cli_opts *o) {
@@ -388,6 +441,21 @@ static FILE *open_output(const char *path) {
   return f;
 }
 
+/* A bus too low for the reference saturates the inverter, as in a real drive: the run is
+   valid, but the voltage is not the commanded one, so say so with the numbers. */
+static void report_clipping(const imsim *sim, const imsim_config *c) {
+  imsim_pwm_stats st;
+  imsim_get_pwm_stats(sim, &st);
+  if (st.clipped_half_periods == 0u) return;
+  fprintf(stderr,
+          "imest-sim: warning: the PWM reference exceeded the DC bus in %.3g %% of the half carrier periods "
+          "(%llu of %llu) and was clipped: it needs Vdc >= %.1f V, given --vdc %.1f V. The applied voltage is "
+          "not the commanded sine; raise --vdc or lower --vll.\n",
+          100.0 * (double)st.clipped_half_periods / (double)st.half_periods,
+          (unsigned long long)st.clipped_half_periods, (unsigned long long)st.half_periods, st.vdc_needed_v,
+          c->vdc_v);
+}
+
 /* Simulates c and writes the CSV. Returns the exit status. */
 static int run(const imsim_config *c, const imsim_cli_opts *o) {
   static imsim sim;
@@ -409,6 +477,7 @@ static int run(const imsim_config *c, const imsim_cli_opts *o) {
     progress_update(&bar, n, smp.t);
   }
   if (bar.on) fprintf(stderr, "\n");
+  report_clipping(&sim, c);
   int rc = 0;
   if (fflush(f) != 0 || ferror(f)) {
     fprintf(stderr, "imest-sim: write error\n");

@@ -47,8 +47,12 @@ void ims_pwm_build(imsim *s, uint64_t g, cpx vref, step_input *in, pwm_half *ph,
   ph->rising = rising;
   ph->vdc = vdc;
   double end_re = 0.0, end_im = 0.0;
+  bool clipped = false;
   for (int k = 0; k < 3; ++k) {
     double m = vabc[k] / (0.5 * vdc);
+    const double need = 2.0 * fabs(vabc[k]); /* sine-triangle: the bus must span +-peak */
+    if (need > s->pwm_vdc_needed) s->pwm_vdc_needed = need;
+    if (m > 1.0 || m < -1.0) clipped = true;
     if (m > 1.0) m = 1.0;
     if (m < -1.0) m = -1.0;
     /* rising: high on [0, e); falling: low on [0, e), high after */
@@ -69,6 +73,8 @@ void ims_pwm_build(imsim *s, uint64_t g, cpx vref, step_input *in, pwm_half *ph,
       end_im += IMS_AK_IM[k];
     }
   }
+  s->pwm_half_periods++;
+  if (clipped) s->pwm_clipped_half_periods++;
   const double sg = rising ? -1.0 : 1.0;
   const double kc = sg * SQ23 * vdc;
   double p[3] = {tau_act[0], tau_act[1], tau_act[2]};

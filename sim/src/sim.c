@@ -11,6 +11,12 @@ static int fail(imsim *s, const char *msg) {
 
 const char *imsim_error(const imsim *sim) { return sim->err; }
 
+void imsim_get_pwm_stats(const imsim *s, imsim_pwm_stats *out) {
+  out->half_periods = s->pwm_half_periods;
+  out->clipped_half_periods = s->pwm_clipped_half_periods;
+  out->vdc_needed_v = s->pwm_vdc_needed;
+}
+
 int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
   memset(s, 0, sizeof *s);
   s->c = *cfg;
@@ -38,6 +44,10 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
   if (c->rk4_substeps < 1) return fail(s, "rk4 substeps must be >= 1");
   const imsim_vmeas vm = ims_vmeas_of(c);
   if (vm == IMSIM_VMEAS_AVG && !ims_is_pwm_stage(c)) return fail(s, "voltage measurement 'avg' needs a PWM stage");
+  if (vm == IMSIM_VMEAS_INST && ims_is_pwm_stage(c))
+    return fail(s, "voltage measurement 'inst' with a PWM stage would record 0 V: every sample instant is a "
+                   "carrier extreme, where all legs sit in a zero vector. Use 'avg' (phase voltage from the "
+                   "commanded duties and Vdc, what a drive knows) or 'aa' with an AA filter (measured voltage)");
   if (vm == IMSIM_VMEAS_AA && (c->ideal_sensors || !(c->aa_hz > 0.0)))
     return fail(s, "voltage measurement 'aa' needs an AA filter (aa_hz > 0, sensors not ideal)");
   s->ts_s = 1.0 / c->fs_hz;

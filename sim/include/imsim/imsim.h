@@ -42,7 +42,8 @@ typedef enum {
   IMSIM_VMEAS_AVG = 1,  /* phase-to-neutral volt-seconds of the carrier period that just ended,
                            from commanded duties and Vdc (what a drive knows); delay 1/(2 f_c) */
   IMSIM_VMEAS_AA = 2,   /* measured phase-to-neutral voltage through the AA filter            */
-  IMSIM_VMEAS_INST = 3  /* raw instantaneous sample (PWM: zero vector, i.e. 0 V)              */
+  IMSIM_VMEAS_INST = 3  /* raw instantaneous sample; ideal supplies only (with PWM every sample
+                           falls in a zero vector, so imsim_init refuses it)                    */
 } imsim_vmeas;
 
 typedef enum { IMSIM_START_REST = 0, IMSIM_START_STEADY = 1 } imsim_start;
@@ -160,7 +161,7 @@ typedef struct {
 typedef struct { double re, im; } imsim_cpx_;
 typedef struct {
   imsim_config c;
-  char err[160];
+  char err[320];
   /* derived constants */
   double m_h, rr0_ohm, ts_s, h_s;
   int k_steps;
@@ -188,7 +189,18 @@ typedef struct {
   double i_meas_ab[2]; double th_meas;
   /* Taylor coefficients h^k/k! */
   double hk[32];
+  /* modulation statistics (imsim_get_pwm_stats) */
+  uint64_t pwm_half_periods, pwm_clipped_half_periods;
+  double pwm_vdc_needed;
 } imsim;
+
+/* What the PWM modulator was asked for: a reference beyond the bus is clipped (the inverter
+   saturates, as a real one does); these numbers let the caller say so. */
+typedef struct {
+  uint64_t half_periods;         /* PWM half carrier periods simulated so far                  */
+  uint64_t clipped_half_periods; /* of which at least one leg's reference exceeded the bus     */
+  double vdc_needed_v;           /* bus voltage that the largest reference so far would need  */
+} imsim_pwm_stats;
 
 /* Fills c with the paper's motor and the exp1 experiment (same as preset "exp1"). */
 void imsim_config_default(imsim_config *c);
@@ -202,6 +214,9 @@ const char *imsim_error(const imsim *sim);
 
 /* Advances exactly one sample period 1/fs and fills *out with the sample at the new time. */
 void imsim_step(imsim *sim, imsim_sample *out);
+
+/* Modulation statistics since imsim_init (all zero without a PWM stage). */
+void imsim_get_pwm_stats(const imsim *sim, imsim_pwm_stats *out);
 
 /* Run-time controls. */
 void imsim_set_ifoc_tr(imsim *sim, double tr_s);   /* controller's T_R, takes effect at the next step */
