@@ -1,4 +1,5 @@
-/* Configuration: defaults (the paper's motor) and the experiment presets. */
+/* Configuration: defaults (the paper's motor), the paper's experiments, and the dispatch to the
+ * industrial motor presets (motors.c). */
 #include <string.h>
 
 #include "imsim_internal.h"
@@ -59,6 +60,7 @@ void imsim_config_default(imsim_config *c) {
   c->adc_bits = 12;
   c->i_range_a = 20.0;
   c->u_range_v = 400.0;
+  c->vdc_range_v = 800.0;
   c->noise_lsb = 1.0;
   c->encoder_counts = 4096;
   c->aa_hz = 0.0;
@@ -91,5 +93,9 @@ int imsim_config_preset(imsim_config *c, const char *name) {
     c->duration_s = 3600.0;
     return 0;
   }
+  if (name != NULL && ims_motor_preset(c, name) == 0) return 0;
+  imsim_config_default(c);
   return -1;
 }
+
+const char *imsim_preset_names(void) { return "exp1|exp2|" IMS_MOTOR_PRESET_NAMES; }

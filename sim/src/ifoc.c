@@ -43,7 +43,9 @@ void ims_ifoc_update(imsim *s) {
   const double ed = id_ref - idq.re, eq = iq_ref - idq.im;
   double vd = kp * ed + s->integ_d - we * sl * iq_ref;
   double vq = kp * eq + s->integ_q + we * (sl * id_ref + m / c->lr_h * psi_ref);
-  const double vmax = sqrt(1.5) * 0.5 * c->vdc_v;
+  /* linear-modulation limit of |u| (= V_ll rms): V_dc/2 phase peak without zero sequence,
+     V_dc/sqrt(3) with it */
+  const double vmax = c->modulation == IMSIM_MOD_SVPWM ? c->vdc_v / SQRT2 : sqrt(1.5) * 0.5 * c->vdc_v;
   const double vm = sqrt(vd * vd + vq * vq);
   if (vm > vmax) {
     vd *= vmax / vm;

@@ -15,7 +15,8 @@ static const char HEADER[] =
     "t,u_a,u_b,u_c,i_a,i_b,i_c,theta,"
     "T_R_true_s,R_S_true_ohm,speed_rad_s,torque_nm,load_nm,psi_r_wb,temp_stator_c,temp_rotor_c,"
     "i_a_true,i_b_true,i_c_true,theta_true,u_a_true,u_b_true,u_c_true,"
-    "ifoc_torque_ref_nm,ifoc_flux_ref_wb,ifoc_tr_s,ifoc_speed_ref_rad_s";
+    "ifoc_torque_ref_nm,ifoc_flux_ref_wb,ifoc_tr_s,ifoc_speed_ref_rad_s,"
+    "d_a,d_b,d_c,v_dc";
 
 const char *imsim_cli_header(void) { return HEADER; }
 
@@ -23,12 +24,17 @@ static const char USAGE[] =
     "usage: imest-sim [options]\n"
     "Simulates an induction motor (by default the one of Wang et al., IEEE TCST 2007) fed by an\n"
     "ideal source, a PWM inverter or an IFOC drive, and writes CSV: t,u_a,u_b,u_c,i_a,i_b,i_c,theta\n"
-    "(measured), then truth columns. Every flag is optional: the defaults are the preset's (exp1\n"
-    "when none is given); a flag given overrides the preset. --opt value and --opt=value both work.\n"
+    "(measured), truth columns, then the drive's d_a,d_b,d_c (duties applied from this row to the\n"
+    "next, firmware timing) and v_dc (bus sample). Every flag is optional: the defaults are the\n"
+    "preset's (exp1 when none is given); a flag given overrides the preset. --opt value and\n"
+    "--opt=value both work.\n"
     "\n"
     "run:\n"
-    "  --preset exp1|exp2    exp1: 60 Hz, 230 V applied at standstill, no load, 2 s;\n"
-    "                        exp2: 30 Hz V/f (115 V) at rated load 2.064 N m, 3600 s\n"
+    "  --preset NAME         exp1: the paper's motor, 60 Hz, 230 V applied at standstill, no load,\n"
+    "                        2 s; exp2: the paper's motor, 30 Hz V/f (115 V) at rated load\n"
+    "                        2.064 N m, 3600 s; 4kw|11kw|15kw|37kw|75kw: a 400 V 50 Hz motor on a\n"
+    "                        560 V 8 kHz drive (svpwm, firmware timing, fs 8 kHz), steady at\n"
+    "                        rated load, 390 V 50 Hz, 10 s (see sim/README.md, Presets)\n"
     "  --duration S          simulated time, rows t = 0 .. S (exp1 2, exp2 3600)\n"
     "  --fs HZ               sample rate (4000)\n"
     "  --out FILE            output file, '-' = stdout (-)\n"
@@ -48,7 +54,14 @@ static const char USAGE[] =
     "  --start rest|steady   rest: standstill, zero flux; steady: the sinusoidal steady state at\n"
     "                        full load from t = 0 (rest)\n"
     "PWM inverter (--supply pwm|ifoc):\n"
-    "  --carrier-hz HZ (10000)  --vdc V (400)  --dead-time S (0)\n"
+    "  --carrier-hz HZ (10000)  --vdc V (400)\n"
+    "  --modulation spwm|svpwm   sine-triangle | min-max zero sequence (spwm)\n"
+    "  --timing ideal|firmware   ideal: reference at every half period's centre; firmware:\n"
+    "                        sample at a carrier valley every N = f_c/fs periods, duties from\n"
+    "                        sample k applied during [t_k+1, t_k+2) (ideal)\n"
+    "  --dead-time S         dead time incl. switching delays (0)\n"
+    "  --v-switch V  --r-switch OHM  --v-diode V  --r-diode OHM   device drops, threshold +\n"
+    "                        slope: switch V_sw + r_sw |i|, diode V_d + r_d |i| (0: ideal)\n"
     "  --pwm-segments        integrate piecewise between switching instants (reference accuracy,\n"
     "                        about 2.3x slower; default: one step per half carrier period)\n"
     "load (opposes rotation):\n"
@@ -63,6 +76,7 @@ static const char USAGE[] =
     "sensors:\n"
     "  --ideal-sensors       exact samples: no quantisation, noise, clipping, AA filter, encoder\n"
     "  --adc-bits N (12)  --i-range A (20)  --u-range V (400): ADC full scale is +-range\n"
+    "  --vdc-range V         DC-bus ADC full scale, 0 .. V (800)\n"
     "  --noise-lsb X (1)     white Gaussian noise before the ADC, rms in LSB\n"
     "  --seed N (1)          noise seed\n"
     "  --encoder-counts N    counts per mechanical revolution (4096)\n"
@@ -143,6 +157,11 @@ static const real_flag REAL_FLAGS[] = {
     {"--carrier-hz", CFG(carrier_hz), 0.0, NONE_HI, true, true, "> 0 Hz"},
     {"--vdc", CFG(vdc_v), 0.0, NONE_HI, true, true, "> 0 V"},
     {"--dead-time", CFG(dead_time_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--v-switch", CFG(v_switch_v), 0.0, NONE_HI, false, true, ">= 0 V"},
+    {"--r-switch", CFG(r_switch_ohm), 0.0, NONE_HI, false, true, ">= 0 ohm"},
+    {"--v-diode", CFG(v_diode_v), 0.0, NONE_HI, false, true, ">= 0 V"},
+    {"--r-diode", CFG(r_diode_ohm), 0.0, NONE_HI, false, true, ">= 0 ohm"},
+    {"--vdc-range", CFG(vdc_range_v), 0.0, NONE_HI, true, true, "> 0 V"},
     {"--ifoc-tr", CFG(ifoc_tr_s), 0.0, NONE_HI, true, true, "> 0 s"},
     {"--ifoc-flux", CFG(ifoc_flux_wb), 0.0, NONE_HI, true, true, "> 0 Wb"},
     {"--speed-ref", CFG(speed_ref_rpm), NONE_LO, NONE_HI, true, true, "rpm"},
@@ -175,7 +194,8 @@ static const int_flag INT_FLAGS[] = {
 /* Flags that name one of a few choices (enum fields, stored as int). */
 _Static_assert(sizeof(imsim_supply) == sizeof(int) && sizeof(imsim_vmeas) == sizeof(int) &&
                    sizeof(imsim_start) == sizeof(int) && sizeof(imsim_ifoc_mode) == sizeof(int) &&
-                   sizeof(imsim_integrator) == sizeof(int),
+                   sizeof(imsim_integrator) == sizeof(int) && sizeof(imsim_timing) == sizeof(int) &&
+                   sizeof(imsim_modulation) == sizeof(int),
                "choice flags store enums as int");
 typedef struct {
   const char *flag;
@@ -194,6 +214,9 @@ static const choice_flag CHOICE_FLAGS[] = {
      {IMSIM_IFOC_SPEED, IMSIM_IFOC_TORQUE, 0, 0, 0}},
     {"--integrator", CFG(integrator), {"fast", "rk4", NULL, NULL, NULL},
      {IMSIM_INTEGRATOR_FAST, IMSIM_INTEGRATOR_RK4, 0, 0, 0}},
+    {"--timing", CFG(timing), {"ideal", "firmware", NULL, NULL, NULL},
+     {IMSIM_TIMING_IDEAL, IMSIM_TIMING_FIRMWARE, 0, 0, 0}},
+    {"--modulation", CFG(modulation), {"spwm", "svpwm", NULL, NULL, NULL}, {IMSIM_MOD_SPWM, IMSIM_MOD_SVPWM, 0, 0, 0}},
 };
 
 /* Per-phase flags: three comma-separated numbers for phases a, b, c. */
@@ -338,8 +361,10 @@ static int parse_preset(int argc, char **argv, imsim_config *c, char *err, size_
       if (a + 1 >= argc) return perr(err, errlen, "missing value for ", arg);
       val = argv[a + 1];
     }
-    if (val != NULL && imsim_config_preset(c, val) != 0)
-      return perr(err, errlen, "unknown preset (exp1|exp2): ", val);
+    if (val != NULL && imsim_config_preset(c, val) != 0) {
+      snprintf(err, errlen, "unknown preset (%s): %s", imsim_preset_names(), val);
+      return -1;
+    }
   }
   return 0;
 }
@@ -383,12 +408,12 @@ int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, c
 void imsim_cli_write_row(FILE *f, const imsim_sample *s) {
   fprintf(f,
           "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
-          "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+          "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
           s->t, s->u_abc[0], s->u_abc[1], s->u_abc[2], s->i_abc[0], s->i_abc[1], s->i_abc[2], s->theta,
           s->tr_s, s->rs_ohm, s->speed_rad_s, s->torque_nm, s->load_nm, s->psi_r_wb, s->temp_stator_c,
           s->temp_rotor_c, s->i_abc_true[0], s->i_abc_true[1], s->i_abc_true[2], s->theta_true,
           s->u_abc_true[0], s->u_abc_true[1], s->u_abc_true[2], s->ifoc_torque_ref_nm, s->ifoc_flux_ref_wb,
-          s->ifoc_tr_s, s->ifoc_speed_ref_rad_s);
+          s->ifoc_tr_s, s->ifoc_speed_ref_rad_s, s->duty[0], s->duty[1], s->duty[2], s->vdc_v);
 }
 
 static double now_s(void) {

@@ -52,13 +52,23 @@ static void fast_piece(imsim *s, double h, const double *hkv, const step_input *
   s->acc = acc1;
 }
 
-void ims_advance(imsim *s, const step_input *in, const pwm_half *ph, double tl) {
+/* Phase currents at the start of a piece (only needed by a non-ideal inverter). */
+static void piece_currents(const imsim_config *c, cpx i, double i_abc[3]) {
+  if (ims_inverter_is_ideal(c)) {
+    i_abc[0] = i_abc[1] = i_abc[2] = 0.0;
+    return;
+  }
+  const double iab[2] = {i.re, i.im};
+  imsim_ab_to_abc(iab, i_abc);
+}
+
+void ims_advance(imsim *s, const step_input *in, pwm_half *ph, double tl) {
   const imsim_config *c = &s->c;
   const double h = s->h_s;
   if (c->integrator == IMSIM_INTEGRATOR_FAST) {
     if (!in->pwm) {
       fast_piece(s, h, s->hk, in, tl, s->x[6], s->x[6], NULL);
-    } else if (c->pwm_moments) {
+    } else if (!in->piecewise) {
       /* whole half period at once; the PWM input enters through its exact moments, the
          current ripple through its integrals (mom_k = int (h-s)^k/k! u ds) */
       const double bi = 1.0 / (c->sigma * c->ls_h);
@@ -69,20 +79,27 @@ void ims_advance(imsim *s, const step_input *in, const pwm_half *ph, double tl) 
       fast_piece(s, h, s->hk, in, tl, ubar, ubar, rip);
     } else {
       /* piecewise between the switching instants (constant input on each piece) */
-      double b[5];
-      ims_pwm_breaks(ph, h, b);
+      double b[8];
+      const int nb = ims_pwm_breaks(ph, h, b);
+      const bool exact_act = !ims_inverter_is_ideal(c);
+      double vs[2] = {0.0, 0.0};
       step_input lin;
       lin.pwm = false;
       lin.src = true;
       lin.aa = in->aa;
       lin.we = 0.0;
+      lin.piecewise = false;
       const double norm = ims_a_norm(s, s->w, &lin);
-      for (int piece = 0; piece < 4; ++piece) {
+      for (int piece = 0; piece < nb - 1; ++piece) {
         const double len = b[piece + 1] - b[piece];
         /* Pieces shorter than 1e-14 s (coincident edges up to rounding) are dropped: their
            volt-seconds (< 4e-12 V s) are negligible, and their h^k/k! would be denormal. */
         if (len < 1e-14) continue;
-        const cpx u = ims_pwm_voltage_at(ph, 0.5 * (b[piece] + b[piece + 1]));
+        double iabc[3];
+        piece_currents(c, s->x[0], iabc);
+        const cpx u = ims_pwm_piece_voltage(s, ph, 0.5 * (b[piece] + b[piece + 1]), iabc);
+        vs[0] += u.re * len;
+        vs[1] += u.im * len;
         double hkv[32];
         lin.p = ims_taylor_order_rho(norm * len);
         const int kmax = lin.p > 3 ? lin.p : 3;
@@ -92,6 +109,10 @@ void ims_advance(imsim *s, const step_input *in, const pwm_half *ph, double tl) 
         fast_piece(s, len, hkv, &lin, tl, u, u, NULL);
       }
       s->x[6] = cx(0.0, 0.0);
+      if (exact_act) {
+        ph->act_avg[0] = vs[0] / h;
+        ph->act_avg[1] = vs[1] / h;
+      }
     }
     return;
   }
@@ -103,13 +124,21 @@ void ims_advance(imsim *s, const step_input *in, const pwm_half *ph, double tl) 
   if (!in->pwm) {
     ims_rk4_piece(s, &X, h, cx(0.0, 0.0), in, tl);
   } else {
-    double b[5];
-    ims_pwm_breaks(ph, h, b);
-    for (int piece = 0; piece < 4; ++piece) {
+    double b[8], vs[2] = {0.0, 0.0};
+    const int nb = ims_pwm_breaks(ph, h, b);
+    for (int piece = 0; piece < nb - 1; ++piece) {
       const double t0 = b[piece], t1 = b[piece + 1];
       if (t1 <= t0) continue;
-      const cpx u = ims_pwm_voltage_at(ph, 0.5 * (t0 + t1));
+      double iabc[3];
+      piece_currents(c, X.x[0], iabc);
+      const cpx u = ims_pwm_piece_voltage(s, ph, 0.5 * (t0 + t1), iabc);
+      vs[0] += u.re * (t1 - t0);
+      vs[1] += u.im * (t1 - t0);
       ims_rk4_piece(s, &X, t1 - t0, u, in, tl);
+    }
+    if (!ims_inverter_is_ideal(c)) {
+      ph->act_avg[0] = vs[0] / h;
+      ph->act_avg[1] = vs[1] / h;
     }
   }
   for (int q = 0; q < 7; ++q) s->x[q] = X.x[q];

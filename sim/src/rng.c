@@ -24,24 +24,27 @@ static double rng_uniform(uint64_t s[4]) { /* (-1, 1) */
   return (double)(rng_next(s) >> 11) * (2.0 / 9007199254740992.0) - 1.0;
 }
 
-void ims_rng_seed(imsim *s, uint64_t seed) {
-  uint64_t sm = seed;
-  for (int k = 0; k < 4; ++k) s->rng[k] = splitmix64(&sm);
+/* Seeds r from the splitmix64 sequence at *sm (which advances), so that successive calls
+   give independent streams from one seed. */
+void ims_rng_seed(imsim_rng_ *r, uint64_t *sm) {
+  for (int k = 0; k < 4; ++k) r->s[k] = splitmix64(sm);
+  r->has_spare = false;
+  r->spare = 0.0;
 }
 
-double ims_rng_gauss(imsim *s) {
-  if (s->has_spare) {
-    s->has_spare = false;
-    return s->gauss_spare;
+double ims_rng_gauss(imsim_rng_ *r) {
+  if (r->has_spare) {
+    r->has_spare = false;
+    return r->spare;
   }
   double u, v, q;
   do {
-    u = rng_uniform(s->rng);
-    v = rng_uniform(s->rng);
+    u = rng_uniform(r->s);
+    v = rng_uniform(r->s);
     q = u * u + v * v;
   } while (q >= 1.0 || q == 0.0);
   const double f = sqrt(-2.0 * log(q) / q);
-  s->gauss_spare = v * f;
-  s->has_spare = true;
+  r->spare = v * f;
+  r->has_spare = true;
   return u * f;
 }

@@ -6,7 +6,7 @@
 static double adc(imsim *s, double x, double range) {
   const imsim_config *c = &s->c;
   const double lsb = 2.0 * range / ldexp(1.0, c->adc_bits);
-  if (c->noise_lsb > 0.0) x += c->noise_lsb * lsb * ims_rng_gauss(s);
+  if (c->noise_lsb > 0.0) x += c->noise_lsb * lsb * ims_rng_gauss(&s->rng);
   double code = floor(x / lsb + 0.5);
   const double top = ldexp(1.0, c->adc_bits - 1);
   if (code > top - 1.0) code = top - 1.0;
@@ -15,7 +15,34 @@ static double adc(imsim *s, double x, double range) {
 }
 
 bool ims_is_pwm_stage(const imsim_config *c) {
-  return c->supply == IMSIM_SUPPLY_PWM || (c->supply == IMSIM_SUPPLY_IFOC && !c->ifoc_ideal_stage);
+  return c->supply == IMSIM_SUPPLY_PWM || c->supply == IMSIM_SUPPLY_EXT ||
+         (c->supply == IMSIM_SUPPLY_IFOC && !c->ifoc_ideal_stage);
+}
+
+bool ims_firmware_timing(const imsim_config *c) {
+  return ims_is_pwm_stage(c) && (c->timing == IMSIM_TIMING_FIRMWARE || c->supply == IMSIM_SUPPLY_EXT);
+}
+
+/* The DC bus through a unipolar ADC (0 .. vdc_range_v, same bits and noise as the others, its
+   own noise stream). The bus itself is stiff: V_dc is constant. */
+void ims_sample_vdc(imsim *s) {
+  const imsim_config *c = &s->c;
+  if (!ims_is_pwm_stage(c)) {
+    s->vdc_meas = NAN_D;
+    return;
+  }
+  double x = c->vdc_v;
+  if (c->ideal_sensors) {
+    s->vdc_meas = x;
+    return;
+  }
+  const double lsb = c->vdc_range_v / ldexp(1.0, c->adc_bits);
+  if (c->noise_lsb > 0.0) x += c->noise_lsb * lsb * ims_rng_gauss(&s->rng_vdc);
+  double code = floor(x / lsb + 0.5);
+  const double top = ldexp(1.0, c->adc_bits);
+  if (code > top - 1.0) code = top - 1.0;
+  if (code < 0.0) code = 0.0;
+  s->vdc_meas = code * lsb;
 }
 
 imsim_vmeas ims_vmeas_of(const imsim_config *c) {
@@ -49,7 +76,12 @@ void ims_fill_sample(imsim *s, imsim_sample *o) {
   o->p_cu_stator_w = s->rs * cabs2(s->x[0]);
   o->p_cu_rotor_w = s->rr * cabs2(ir);
   double utrue[2];
-  if (ims_is_pwm_stage(c)) {
+  const bool fw = ims_firmware_timing(c);
+  if (fw) {
+    /* the sample period that just ended (duties constant over it) */
+    utrue[0] = s->u_sp_act[0] / (double)s->k_steps;
+    utrue[1] = s->u_sp_act[1] / (double)s->k_steps;
+  } else if (ims_is_pwm_stage(c)) {
     utrue[0] = 0.5 * (s->u_hp_act[0][0] + s->u_hp_act[1][0]);
     utrue[1] = 0.5 * (s->u_hp_act[0][1] + s->u_hp_act[1][1]);
   } else {
@@ -67,13 +99,21 @@ void ims_fill_sample(imsim *s, imsim_sample *o) {
   } else {
     o->ifoc_torque_ref_nm = o->ifoc_flux_ref_wb = o->ifoc_tr_s = o->ifoc_speed_ref_rad_s = NAN_D;
   }
+  for (int k = 0; k < 3; ++k) o->duty[k] = fw ? s->duty[k] : NAN_D;
+  o->vdc_v = s->vdc_meas;
+  o->vdc_true_v = ims_is_pwm_stage(c) ? c->vdc_v : NAN_D;
 
   /* measured voltage (alpha-beta, before the ADC) */
   double um[2];
   switch (ims_vmeas_of(c)) {
     case IMSIM_VMEAS_AVG:
-      um[0] = 0.5 * (s->u_hp_cmd[0][0] + s->u_hp_cmd[1][0]);
-      um[1] = 0.5 * (s->u_hp_cmd[0][1] + s->u_hp_cmd[1][1]);
+      if (fw) {
+        um[0] = s->u_sp_cmd[0] / (double)s->k_steps;
+        um[1] = s->u_sp_cmd[1] / (double)s->k_steps;
+      } else {
+        um[0] = 0.5 * (s->u_hp_cmd[0][0] + s->u_hp_cmd[1][0]);
+        um[1] = 0.5 * (s->u_hp_cmd[0][1] + s->u_hp_cmd[1][1]);
+      }
       break;
     case IMSIM_VMEAS_AA:
       um[0] = s->x[4].re;

@@ -51,14 +51,25 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
   if (vm == IMSIM_VMEAS_AA && (c->ideal_sensors || !(c->aa_hz > 0.0)))
     return fail(s, "voltage measurement 'aa' needs an AA filter (aa_hz > 0, sensors not ideal)");
   s->ts_s = 1.0 / c->fs_hz;
+  if (c->timing == IMSIM_TIMING_FIRMWARE && !ims_is_pwm_stage(c))
+    return fail(s, "firmware timing needs the PWM inverter (supply pwm, ifoc without the ideal stage, or ext)");
+  if (c->supply == IMSIM_SUPPLY_EXT && c->start == IMSIM_START_STEADY)
+    return fail(s, "start 'steady' is not available with external commands (the motor starts at rest)");
   if (ims_is_pwm_stage(c)) {
     if (!(c->carrier_hz > 0.0) || !(c->vdc_v > 0.0)) return fail(s, "carrier and vdc must be > 0");
     const double ratio = 2.0 * c->carrier_hz / c->fs_hz;
     const double k = floor(ratio + 0.5);
     if (k < 1.0 || fabs(ratio - k) > 1e-9 * ratio) return fail(s, "2 * carrier_hz must be an integer multiple of fs_hz (PWM-synchronous sampling)");
+    if (ims_firmware_timing(c) && fmod(k, 2.0) != 0.0)
+      return fail(s, "firmware timing samples at a carrier valley once every N carrier periods: carrier_hz "
+                     "must be an integer multiple of fs_hz (fs = f_c / N)");
     if (c->steps_per_sample != 0 && c->steps_per_sample != (int)k) return fail(s, "with PWM, steps per sample is fixed to 2 f_c / fs");
     s->k_steps = (int)k;
     if (!(c->dead_time_s >= 0.0) || c->dead_time_s >= 0.5 / c->carrier_hz) return fail(s, "dead time must be in [0, 1/(2 f_c))");
+    if (!(c->v_switch_v >= 0.0) || !(c->r_switch_ohm >= 0.0) || !(c->v_diode_v >= 0.0) || !(c->r_diode_ohm >= 0.0) ||
+        !isfinite(c->v_switch_v + c->r_switch_ohm + c->v_diode_v + c->r_diode_ohm))
+      return fail(s, "switch and diode drops must be finite and >= 0");
+    if (!c->ideal_sensors && !(c->vdc_range_v > 0.0)) return fail(s, "the DC-bus ADC range must be > 0");
   } else {
     if (c->steps_per_sample < 0) return fail(s, "steps per sample must be >= 0");
     s->k_steps = c->steps_per_sample > 0 ? c->steps_per_sample : 5;
@@ -72,7 +83,9 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
   s->temp_s = s->temp_r = c->t_amb_c;
   ims_update_params(s);
 
-  ims_rng_seed(s, c->seed);
+  uint64_t sm = c->seed;
+  ims_rng_seed(&s->rng, &sm);     /* phase channels: the same stream as ever */
+  ims_rng_seed(&s->rng_vdc, &sm); /* DC bus: its own, so the other channels do not change */
 
   /* IFOC */
   s->ifoc_tr = c->ifoc_tr_s > 0.0 ? c->ifoc_tr_s : c->tr_s;
@@ -121,6 +134,8 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
     s->u_inst[0] = amp * cos(ph);
     s->u_inst[1] = amp * sin(ph);
   }
+  ims_sample_vdc(s);
+  ims_drive_init(s);
   imsim_sample tmp;
   ims_fill_sample(s, first != NULL ? first : &tmp);
   s->th_meas_prev = s->th_meas;
@@ -134,8 +149,10 @@ void imsim_step(imsim *s, imsim_sample *out) {
   if (c->thermal) ims_thermal_step(s);
   /* 2. load torque, held over the sample period (value at its centre) */
   const double tl = ims_load_at(s, s->t + 0.5 * ts);
-  /* 3. controller */
+  /* 3. controller; with firmware timing it computes the duties of the next sample period */
   if (c->supply == IMSIM_SUPPLY_IFOC) ims_ifoc_update(s);
+  const bool fw = ims_firmware_timing(c);
+  if (fw) ims_drive_update(s);
 
   const bool aa = !c->ideal_sensors && c->aa_hz > 0.0;
   const bool pwm = ims_is_pwm_stage(c);
@@ -145,32 +162,34 @@ void imsim_step(imsim *s, imsim_sample *out) {
   in.src = !pwm;
   in.we = 0.0;
   in.p = 0;
+  in.piecewise = false;
   pwm_half ph;
   memset(&ph, 0, sizeof ph);
   for (int k = 0; k < s->k_steps; ++k) {
     const double t0 = s->t + (double)k * h;
     if (pwm) {
       in.p = ims_taylor_order(s, s->w, &in);
-      const double tc = t0 + 0.5 * h;
-      cpx vref;
-      if (c->supply == IMSIM_SUPPLY_IFOC) {
-        vref = ims_ifoc_vref(s, tc);
+      double m[3];
+      if (fw) {
+        for (int q = 0; q < 3; ++q) m[q] = 2.0 * s->duty[q] - 1.0;
       } else {
-        double amp, phs, f;
-        ims_vf_ref(s, tc, &amp, &phs, &f);
-        vref = cscale(cexpj(phs), amp);
+        /* the reference at the half period's centre, modulated at once */
+        const double tc = t0 + 0.5 * h;
+        cpx vref;
+        if (c->supply == IMSIM_SUPPLY_IFOC) {
+          vref = ims_ifoc_vref(s, tc);
+        } else {
+          double amp, phs, f;
+          ims_vf_ref(s, tc, &amp, &phs, &f);
+          vref = cscale(cexpj(phs), amp);
+        }
+        if (ims_pwm_modulate(s, vref, c->vdc_v, m)) s->pwm_clipped_half_periods++;
       }
+      s->pwm_half_periods++;
       const uint64_t g = s->n * (uint64_t)s->k_steps + (uint64_t)k;
-      double cmd[2], act[2], uend[2];
-      ims_pwm_build(s, g, vref, &in, &ph, cmd, act, uend);
-      const int slot = s->hp_count & 1;
-      s->u_hp_cmd[slot][0] = cmd[0];
-      s->u_hp_cmd[slot][1] = cmd[1];
-      s->u_hp_act[slot][0] = act[0];
-      s->u_hp_act[slot][1] = act[1];
-      s->hp_count++;
-      s->u_inst[0] = uend[0];
-      s->u_inst[1] = uend[1];
+      ims_pwm_build(s, g, m, &in, &ph);
+      /* moments path: exact while no phase current changes sign in the half period */
+      in.piecewise = !c->pwm_moments || ims_pwm_may_cross_zero(s, &ph);
     } else if (c->supply == IMSIM_SUPPLY_IFOC) {
       /* ideal stage: the controller's synchronous-frame voltage, rotating at its we */
       s->x[6] = ims_ifoc_vref(s, t0);
@@ -185,7 +204,23 @@ void imsim_step(imsim *s, imsim_sample *out) {
       in.p = ims_taylor_order(s, s->w, &in);
     }
     ims_advance(s, &in, &ph, tl);
+    if (pwm) {
+      const int slot = s->hp_count & 1;
+      s->u_hp_cmd[slot][0] = ph.cmd_avg[0];
+      s->u_hp_cmd[slot][1] = ph.cmd_avg[1];
+      s->u_hp_act[slot][0] = ph.act_avg[0];
+      s->u_hp_act[slot][1] = ph.act_avg[1];
+      s->hp_count++;
+      if (fw) {
+        if (k == 0) s->u_sp_cmd[0] = s->u_sp_cmd[1] = s->u_sp_act[0] = s->u_sp_act[1] = 0.0;
+        s->u_sp_cmd[0] += ph.cmd_avg[0];
+        s->u_sp_cmd[1] += ph.cmd_avg[1];
+        s->u_sp_act[0] += ph.act_avg[0];
+        s->u_sp_act[1] += ph.act_avg[1];
+      }
+    }
   }
+  if (fw) ims_drive_advance(s);
   s->n += 1;
   s->t = (double)s->n / c->fs_hz;
   if (!pwm) {
@@ -199,5 +234,6 @@ void imsim_step(imsim *s, imsim_sample *out) {
       s->u_inst[1] = amp * sin(phs);
     }
   }
+  ims_sample_vdc(s);
   ims_fill_sample(s, out);
 }

@@ -53,6 +53,24 @@ TEST(SimCli, FlagsSetTheConfig) {
   EXPECT_EQ(c.freq_hz, 50);
   EXPECT_EQ(c.load_nm, 1.5);
   EXPECT_TRUE(c.ideal_sensors);
+  ASSERT_EQ(parse({"--modulation", "svpwm", "--timing=firmware", "--dead-time", "2e-6", "--v-switch", "1.1",
+                   "--r-switch", "0.01", "--v-diode", "0.8", "--r-diode", "0.02", "--vdc-range", "900"},
+                  c, o),
+            0);
+  EXPECT_EQ(c.modulation, IMSIM_MOD_SVPWM);
+  EXPECT_EQ(c.timing, IMSIM_TIMING_FIRMWARE);
+  EXPECT_EQ(c.dead_time_s, 2e-6);
+  EXPECT_EQ(c.v_switch_v, 1.1);
+  EXPECT_EQ(c.r_switch_ohm, 0.01);
+  EXPECT_EQ(c.v_diode_v, 0.8);
+  EXPECT_EQ(c.r_diode_ohm, 0.02);
+  EXPECT_EQ(c.vdc_range_v, 900);
+  std::string e;
+  EXPECT_NE(parse({"--v-diode", "-1"}, c, o, &e), 0);
+  EXPECT_NE(parse({"--timing", "late"}, c, o, &e), 0);
+  EXPECT_NE(e.find("ideal|firmware"), std::string::npos) << e;
+  EXPECT_NE(parse({"--preset", "55kw"}, c, o, &e), 0);
+  EXPECT_NE(e.find("exp1|exp2|4kw|11kw|15kw|37kw|75kw"), std::string::npos) << e;
 }
 
 TEST(SimCli, PresetAppliesFirstWhateverItsPosition) {
@@ -186,5 +204,37 @@ TEST(SimCli, SaysWhatIsWrong) {
   EXPECT_EQ(run_capture("--duration 0.01 --out /nonexistent-dir/x.csv", e), 1);
   EXPECT_NE(e.find("cannot open"), std::string::npos) << e;
   EXPECT_EQ(run_capture("--fs nope", e), 2);
+}
+#endif
+
+#ifdef IMEST_SIM_EXE
+// A drive preset writes the duty and bus columns: duties in [0, 1] from this row to the next,
+// the bus through its 12-bit ADC.
+TEST(SimCli, DrivePresetWritesDutyAndBusColumns) {
+  const std::string out = ::testing::TempDir() + "imsim_cli_drive.csv";
+  std::string e;
+  ASSERT_EQ(run_capture("--preset 4kw --duration 0.01 --out " + out, e), 0) << e;
+  std::ifstream f(out);
+  std::string header, row;
+  std::getline(f, header);
+  EXPECT_EQ(header.substr(header.size() - 17), ",d_a,d_b,d_c,v_dc");
+  int rows = 0;
+  while (std::getline(f, row)) {
+    std::vector<double> v;
+    std::stringstream ss(row);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) v.push_back(std::strtod(cell.c_str(), nullptr));
+    ASSERT_EQ(v.size(), 31u);
+    for (int k = 27; k < 30; ++k) {
+      EXPECT_GE(v[k], 0.0);
+      EXPECT_LE(v[k], 1.0);
+    }
+    EXPECT_NEAR(v[30], 560.0, 2.0);
+    ++rows;
+  }
+  EXPECT_EQ(rows, 81);  // 8 kHz
+  std::remove(out.c_str());
+  EXPECT_EQ(run_capture("--supply pwm --timing firmware --duration 0.01 --out -", e), 2);
+  EXPECT_NE(e.find("integer multiple"), std::string::npos) << e;
 }
 #endif
