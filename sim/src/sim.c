@@ -21,6 +21,9 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
   memset(s, 0, sizeof *s);
   s->c = *cfg;
   imsim_config *c = &s->c;
+  if ((unsigned)c->supply > (unsigned)IMSIM_SUPPLY_EXT || (unsigned)c->timing > (unsigned)IMSIM_TIMING_FIRMWARE ||
+      (unsigned)c->modulation > (unsigned)IMSIM_MOD_SVPWM)
+    return fail(s, "unknown supply, timing or modulation");
   if (c->pole_pairs < 1) return fail(s, "pole_pairs must be >= 1");
   if (!(c->ls_h > 0.0) || !(c->lr_h > 0.0)) return fail(s, "ls and lr must be > 0");
   if (!(c->sigma > 0.0 && c->sigma < 1.0)) return fail(s, "sigma must be in (0, 1)");
@@ -54,7 +57,7 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
   if (c->timing == IMSIM_TIMING_FIRMWARE && !ims_is_pwm_stage(c))
     return fail(s, "firmware timing needs the PWM inverter (supply pwm, ifoc without the ideal stage, or ext)");
   if (c->supply == IMSIM_SUPPLY_EXT && c->start == IMSIM_START_STEADY)
-    return fail(s, "start 'steady' is not available with external commands (the motor starts at rest)");
+    return fail(s, "start 'steady' is not available with external commands: the motor starts at rest (--start rest)");
   if (ims_is_pwm_stage(c)) {
     if (!(c->carrier_hz > 0.0) || !(c->vdc_v > 0.0)) return fail(s, "carrier and vdc must be > 0");
     const double ratio = 2.0 * c->carrier_hz / c->fs_hz;
@@ -91,7 +94,8 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
   s->ifoc_tr = c->ifoc_tr_s > 0.0 ? c->ifoc_tr_s : c->tr_s;
   s->speed_ref = c->speed_ref_rpm * 2.0 * PI / 60.0;
   if (c->supply == IMSIM_SUPPLY_IFOC) {
-    if (c->start == IMSIM_START_STEADY) return fail(s, "start 'steady' is not available with IFOC (it starts from rest)");
+    if (c->start == IMSIM_START_STEADY)
+      return fail(s, "start 'steady' is not available with IFOC, which starts from rest (--start rest)");
     if (c->ifoc_flux_wb > 0.0) {
       s->ifoc_flux = c->ifoc_flux_wb;
     } else {
