@@ -10,6 +10,7 @@
 #include <sstream>
 #include <sys/wait.h>
 #include <string>
+#include <unistd.h>
 #include <vector>
 
 #include "imsim_cli.h"
@@ -178,7 +179,10 @@ TEST(SimCli, HelpAndReadmeListEveryFlag) {
 #ifdef IMEST_SIM_EXE
 namespace {
 int run_capture(const std::string &args, std::string &err_text) {
-  const std::string errf = ::testing::TempDir() + "imsim_cli_stderr.txt";
+  // one file per process and call: CTest runs the cases of this file in parallel
+  static int calls = 0;
+  const std::string errf = ::testing::TempDir() + "imsim_cli_stderr_" + std::to_string(getpid()) + "_" +
+                           std::to_string(++calls) + ".txt";
   const int st = std::system((std::string(IMEST_SIM_EXE) + " " + args + " > /dev/null 2> " + errf).c_str());
   std::ifstream f(errf);
   std::stringstream ss;
