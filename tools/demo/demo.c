@@ -6,8 +6,9 @@
  * 4096-count encoder, thermal drift) produces one sample per 1/fs; each sample
  * goes through imest_isr_abc() as float32 with the encoder angle wrapped to
  * [0, 2pi); when the ISR call reports a finished window, imest_background()
- * solves it and publishes it over the CAN port (a candump -L log, and a live
- * SocketCAN interface if asked). Alongside, the simulator's truth is averaged
+ * solves it and the run publishes the result over the CAN port
+ * (imest_can_publish: a candump -L log, and a live SocketCAN interface if
+ * asked). Alongside, the simulator's truth is averaged
  * over the same window's samples so every estimate can be compared with it.
  *
  * Experiments (run in parallel threads):
@@ -342,8 +343,9 @@ static int run_job(job_t *j)
   j->live = tee.live;
   tee.port.send = tee_send;
   tee.port.ctx = &tee;
-  if (imest_attach_can(&est, &tee.port, IMEST_CAN_DEFAULT_BASE_ID) != IMEST_OK) {
-    snprintf(j->err, sizeof j->err, "%s: imest_attach_can failed", name);
+  static _Thread_local imest_can_pub_t pub;
+  if (imest_can_pub_init(&pub, &tee.port, IMEST_CAN_DEFAULT_BASE_ID) != IMEST_OK) {
+    snprintf(j->err, sizeof j->err, "%s: imest_can_pub_init failed", name);
     fclose(log);
     return -1;
   }
@@ -399,6 +401,7 @@ static int run_job(job_t *j)
       /* background task: runs when woken, publishes over CAN */
       imest_candump_port_set_time(&tee.log, s.t);
       while (imest_background(&est, &r) == 1) {
+        (void)imest_can_publish(&pub, &r);
         const truth_t *t = (r.seq < nwin) ? &truth[r.seq] : NULL;
         const truth_t nan_t = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
         if (t == NULL || r.seq >= win) t = &nan_t;

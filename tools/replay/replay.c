@@ -13,6 +13,7 @@
 #include "imest/imest.h"
 #include "imest/imest_can.h"
 #ifdef IMEST_HAVE_CANDUMP
+#include "imest_can_id.h"
 #include "imest_candump.h"
 #endif
 
@@ -48,7 +49,8 @@ static void usage(FILE *o)
           "                      auto = current ~0 and rotor still at the first samples\n"
           "  --candump FILE      also write the published CAN frames (candump -L format)\n"
           "  --can-iface NAME    interface name in that log (default vcan0)\n"
-          "  --can-id ID         base CAN identifier (default 0x6A0)\n"
+          "  --can-id ID         base CAN identifier (default 0x6A0; above 0x7FF: 29-bit)\n"
+          "  --can-ext           the base CAN identifier is 29-bit even if it is small\n"
           "  --quiet             no summary on stderr\n");
 }
 
@@ -132,7 +134,8 @@ int main(int argc, char **argv)
   int have_np = 0, have_ls = 0, have_sigma = 0, quiet = 0;
   double i_limit = -1.0, u_limit = -1.0; /* -1 = auto */
   int from_rest = -1;                     /* -1 = auto */
-  unsigned long can_id = IMEST_CAN_DEFAULT_BASE_ID;
+  const char *can_id = NULL;
+  int can_ext = 0;
 
   for (int a = 1; a < argc; ++a) {
     const char *o = argv[a];
@@ -193,12 +196,9 @@ int main(int argc, char **argv)
       can_iface = v;
     } else if (!strcmp(o, "--can-id")) {
       NEED_VALUE;
-      char *end = NULL;
-      can_id = strtoul(v, &end, 0);
-      if (end == v || *end) {
-        fprintf(stderr, "imest-replay: --can-id: '%s' is not an identifier\n", v);
-        return 2;
-      }
+      can_id = v;
+    } else if (!strcmp(o, "--can-ext")) {
+      can_ext = 1;
     } else if (!strcmp(o, "--quiet")) {
       quiet = 1;
     } else if (o[0] == '-' && o[1] != '\0') {
@@ -219,6 +219,14 @@ int main(int argc, char **argv)
     fprintf(stderr, "imest-replay: no input file (see --help)\n");
     return 2;
   }
+#ifdef IMEST_HAVE_CANDUMP
+  uint32_t can_base = IMEST_CAN_DEFAULT_BASE_ID | (can_ext ? IMEST_CAN_ID_EXT : 0u);
+  char can_err[256];
+  if (can_id != NULL && imest_can_id_parse(can_id, can_ext, "--can-ext", &can_base, can_err, sizeof can_err)) {
+    fprintf(stderr, "imest-replay: --can-id %s\n", can_err);
+    return 2;
+  }
+#endif
 
   /* Pass 1: time base, clipping, start at rest. */
   csv_reader_t r;
@@ -331,6 +339,7 @@ int main(int argc, char **argv)
   FILE *canlog = NULL;
 #ifdef IMEST_HAVE_CANDUMP
   struct imest_candump_port cport;
+  imest_can_pub_t can_pub; /* the application publishes what the background returns */
   if (candump_path) {
     canlog = strcmp(candump_path, "-") ? fopen(candump_path, "w") : stdout;
     if (canlog == NULL) {
@@ -341,14 +350,12 @@ int main(int argc, char **argv)
       fprintf(stderr, "imest-replay: --can-iface '%s' is not a valid interface name\n", can_iface);
       return 2;
     }
-    if (imest_attach_can(&est, &cport.port, (uint32_t)can_id) != 0) {
-      fprintf(stderr, "imest-replay: --can-id 0x%lx is not a valid CAN identifier\n", can_id);
-      return 2;
-    }
+    (void)imest_can_pub_init(&can_pub, &cport.port, can_base); /* can_base was checked */
   }
 #else
   (void)can_iface;
   (void)can_id;
+  (void)can_ext;
   if (candump_path) {
     fprintf(stderr, "imest-replay: built without the candump port\n");
     return 2;
@@ -376,6 +383,9 @@ int main(int argc, char **argv)
       if (canlog) imest_candump_port_set_time(&cport, v[0]); /* log time = window end */
 #endif
       while (imest_background(&est, &res) == 1) {
+#ifdef IMEST_HAVE_CANDUMP
+        if (canlog) (void)imest_can_publish(&can_pub, &res);
+#endif
         print_row(t0, &res);
         windows++;
         valid += res.valid;
@@ -398,6 +408,9 @@ int main(int argc, char **argv)
     if (canlog) imest_candump_port_set_time(&cport, tprev);
 #endif
     while (imest_background(&est, &res) == 1) {
+#ifdef IMEST_HAVE_CANDUMP
+      if (canlog) (void)imest_can_publish(&can_pub, &res);
+#endif
       print_row(t0, &res);
       windows++;
       valid += res.valid;
