@@ -46,7 +46,7 @@ static void put_bits(unsigned char *d, unsigned int start, unsigned int len, uin
     const unsigned int bit = 1u << (k & 7u);
     unsigned int cur = (unsigned int)d[k >> 3] & 0xFFu;
     cur = ((v >> i) & 1u) ? (cur | bit) : (cur & ~bit & 0xFFu);
-    d[k >> 3] = (unsigned char)cur;
+    d[k >> 3] = (unsigned char)(cur & 0xFFu);
   }
 }
 
@@ -163,7 +163,8 @@ static uint32_t encode(const imest_can_signal_t *s, const imest_result_t *r, uin
     return clamp_u(*(const uint32_t *)field_of(r, s), ones);
   case IMEST_CAN_ENUM: {
     const int v = *(const int *)field_of(r, s);
-    return (v >= 0 && (uint32_t)v < ones) ? (uint32_t)v : ones;
+    if (v < 0) return ones;
+    return clamp_u((uint32_t)v, ones); /* out of range: all ones */
   }
   case IMEST_CAN_BOOL:
     return *(const int *)field_of(r, s) != 0 ? 1u : 0u;
