@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -707,6 +708,53 @@ TEST(CanReader, LateFrameIsNotLost) {
   EXPECT_EQ(o.rx.st.lost, 0u);
   EXPECT_EQ(o.rx.st.incomplete, 1u);
   EXPECT_EQ(o.windows[2].have, kAll) << "the window after it is not disturbed";
+}
+
+// Random drops and corruptions (and a sender restart) over many streams: the
+// totals are exact, every corrupted frame is counted once as corrupted and
+// never also as lost. The first and last windows stay intact (what is missing
+// before the first or after the last frame received is not loss by design).
+TEST(CanReader, RandomLossAndCorruptionAreCountedExactly) {
+  std::mt19937 rng(12345u);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int run = 0; run < 300; run++) {
+    const unsigned windows = 30;
+    const unsigned restart_at = (run % 3 == 0) ? 15u : 0u;  // the node reboots before window 15
+    std::vector<imest_can_frame> sent;
+    for (unsigned k = 0; k < windows; k++) {
+      const bool after = restart_at != 0 && k >= restart_at;
+      auto w = stream(1, after ? k - restart_at : 100u + k, after ? k - restart_at : 40u + k);
+      sent.insert(sent.end(), w.begin(), w.end());
+    }
+    std::vector<imest_can_frame> rx_frames;
+    unsigned dropped = 0, corrupted = 0;
+    for (size_t i = 0; i < sent.size(); i++) {
+      const unsigned k = static_cast<unsigned>(i / N);
+      const bool keep = k == 0 || k == windows - 1 ||
+                        (k == restart_at && i % N == IMEST_CAN_FRAME_STAT);  // the restart is seen
+      const double x = u(rng);
+      if (!keep && x < 0.12) {
+        dropped++;
+      } else if (!keep && x < 0.18) {
+        imest_can_frame f = sent[i];
+        if (x < 0.15) {
+          f.data[static_cast<unsigned>(x * 1e4) % 8u] ^= 0x24u;
+        } else {
+          f.dlc = 6u;
+        }
+        rx_frames.push_back(f);
+        corrupted++;
+      } else {
+        rx_frames.push_back(sent[i]);
+      }
+    }
+    Fed o = feed(rx_frames);
+    ASSERT_EQ(o.rx.st.corrupt, corrupted) << "run " << run;
+    ASSERT_EQ(o.rx.st.lost, dropped) << "run " << run;
+    ASSERT_EQ(o.rx.st.restarts, restart_at ? 1u : 0u) << "run " << run;
+    ASSERT_EQ(o.rx.st.repeated + o.rx.st.late + o.rx.st.seq_gaps, 0u) << "run " << run;
+    ASSERT_EQ(o.rx.st.frames, rx_frames.size());
+  }
 }
 
 // ---------------------------------------------------------------- identifiers (tools)
