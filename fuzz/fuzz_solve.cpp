@@ -1,4 +1,4 @@
-// Fuzz the background solve (internal imest_solve) with arbitrary window sums:
+// Fuzz the background solve (internal bg_solve) with arbitrary window sums:
 // the input bytes are the 73 doubles of R_W, R_Wy, R_y (NaN, Inf, huge,
 // denormal ...), optionally followed by the 5 doubles of the solve config.
 // Property (test/robustness/solve_property.h): it returns within the
@@ -12,7 +12,7 @@ extern "C" {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   fuzz::Reader in{data, size};
-  imest_sums_t s;
+  bg_sums_t s;
   std::memset(&s, 0, sizeof s);
   // the first byte chooses the layout: full 8x8 as given, or symmetric with
   // the solve's structure (row/column 2 = -m x row/column 3), which reaches
@@ -30,8 +30,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     s.rw[2][2] = m * m * s.rw[3][3];
     s.rwy[2] = -m * s.rwy[3];
   }
-  imest_solve_cfg_t cfg{};
-  cfg.weight_c = (mode & 4) ? imest_solve_weight_c(&s) : 0.0;
+  bg_solve_cfg_t cfg{};
+  cfg.weight_c = (mode & 4) ? bg_solve_weight_c(&s) : 0.0;
   cfg.sigma = 0.096;
   cfg.ls_h = 0.2908;
   cfg.tr_nominal_s = 0.1;
@@ -45,9 +45,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     cfg.tr_max_s = in.get<double>(cfg.tr_max_s);
     cfg.weight_c = in.get<double>(cfg.weight_c);
   }
-  imest_solve_out_t out;
+  bg_solve_out_t out;
   std::memset(&out, 0xA5, sizeof out);
-  const int rc = imest_solve(&s, &cfg, &out);
-  if (const char *bad = imest_solve_property(rc, &cfg, &out)) fuzz::fail(bad);
+  const int rc = bg_solve(&s, &cfg, &out);
+  if (const char *bad = solve_property(rc, &cfg, &out)) fuzz::fail(bad);
   return 0;
 }

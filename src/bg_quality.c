@@ -10,45 +10,45 @@
  *    -4/kappa^5, 20/kappa^6); H = c diag(1/g, 1/s) H~ diag(1/g, 1/s).
  *    PD: H11 > 0 and det > 0.
  *  - Quadratic indices sqrt(0.5 E_w (H^-1)_ii); if H is not PD they are set to
- *    IMEST_PE_UNBOUNDED (1e30, finite even in float32) and IMEST_PE_FLAG_NOT_PD.
+ *    BG_PE_UNBOUNDED (1e30, finite even in float32) and BG_PE_FLAG_NOT_PD.
  *  - Exact indices with L = 1.25 E_w*:
  *    PE_K2: crossings of the profile E_w,red(kappa) = (e0 - e1^2/(4 e2)) F
  *    with L on both sides of kappa*, found as the zeros of the division-free
  *    g(kappa) = 4 e2 (e0 - L D^2) - e1^2 (same sign as E_w,red - L where
  *    e2 > 0). Probes at d0, 1.5 d0, 2.25 d0 ... from kappa* (d0 = quadratic
- *    index, or 1 % of kappa* if H is not PD), at most IMEST_PE_MAX_PROBE, never
+ *    index, or 1 % of kappa* if H is not PD), at most BG_PE_MAX_PROBE, never
  *    beyond the T_R band; then Illinois on the bracket until it is narrower
  *    than 2^-12 of the crossing's distance from kappa* (PE_K2 to ~1e-4
- *    relative; <= IMEST_PE_MAX_ROOT steps). A profile that dips below L again
+ *    relative; <= BG_PE_MAX_ROOT steps). A profile that dips below L again
  *    between two probes is not seen. If no crossing lies inside the band on a
  *    side, that side's distance to the band edge is used and
- *    IMEST_PE_FLAG_K2_{LO,HI}_EDGE is set (a lower bound, large relative to
+ *    BG_PE_FLAG_K2_{LO,HI}_EDGE is set (a lower bound, large relative to
  *    K2: the caller flags the window as poorly determined); never NaN.
  *    PE_K1: on [kappa_lo, kappa_hi], max of k+(kappa) and min of k-(kappa),
  *    k+- = (-e1 +- sqrt(-g))/(2 e2) (where g > 0, k+- = the profile's k), each
  *    by successive parabolic interpolation started at the extreme of the
  *    quadratic model (three points a quarter of the quadratic K2 index apart),
  *    stepping outwards while the extreme is not bracketed, until the vertex
- *    moves by less than 2^-10 of that spacing (<= IMEST_PE_MAX_MIN steps). The
+ *    moves by less than 2^-10 of that spacing (<= BG_PE_MAX_MIN steps). The
  *    extreme value is stationary, so it is then exact to ~1e-6 relative.
- *  - E_w* <= 0 (exact fit): all indices 0, IMEST_PE_FLAG_DEGENERATE.
+ *  - E_w* <= 0 (exact fit): all indices 0, BG_PE_FLAG_DEGENERATE.
  * Cost: typically ~20 evaluations of the three tables (21 multiply-adds). */
 #include <float.h>
 #include <math.h>
 
-#include "bg_poly.h"
+#include "bg_quality.h"
 
 typedef struct {
-  const imest_tables_t *t;
+  const bg_tables_t *t;
   double lt;       /* L~ (scaled level) */
   double kprof;    /* fallback k where the tables are not usable */
   unsigned int nev;
 } pe_ctx_t;
 
 /* g(x) = 4 e2 (e0 - L D^2) - e1^2 (< 0 inside the level set); v = tables. */
-IMEST_NOINLINE static double level_g(pe_ctx_t *c, double x, double v[3]) {
+BG_NOINLINE static double level_g(pe_ctx_t *c, double x, double v[3]) {
   ++c->nev;
-  imest_tables_values(c->t, x, v);
+  bg_tables_values(c->t, x, v);
   const double dd = x * x + c->t->cw;
   return 4.0 * v[0] * (v[2] - c->lt * dd * dd) - v[1] * v[1];
 }
@@ -57,28 +57,28 @@ IMEST_NOINLINE static double level_g(pe_ctx_t *c, double x, double v[3]) {
 static double level_fn(pe_ctx_t *c, double x) {
   double v[3];
   const double g = level_g(c, x, v);
-  return (v[0] > 0.0 && imest_finite(g)) ? g : DBL_MAX;
+  return (v[0] > 0.0 && bg_finite(g)) ? g : DBL_MAX;
 }
 
 /* sign = +1: k+(x); sign = -1: -k-(x) (both to be maximised). */
-IMEST_NOINLINE static double kbound(pe_ctx_t *c, double x, int sign) {
+BG_NOINLINE static double kbound(pe_ctx_t *c, double x, int sign) {
   double v[3];
   const double g = level_g(c, x, v);
   double k;
-  if (!(v[0] > 0.0) || !imest_finite(g)) {
+  if (!(v[0] > 0.0) || !bg_finite(g)) {
     k = (double)sign * c->kprof;
   } else {
     const double root = (g < 0.0) ? sqrt(-g) : 0.0;
     k = ((double)(-sign) * v[1] + root) / (2.0 * v[0]);
   }
-  return imest_finite(k) ? k : (double)sign * c->kprof;
+  return bg_finite(k) ? k : (double)sign * c->kprof;
 }
 
 /* Illinois on [x0, x1] with f0 < 0 <= f1 (either order); xs = kappa*. */
-IMEST_NOINLINE static double illinois(pe_ctx_t *c, double xs, double x0, double f0, double x1, double f1) {
+BG_NOINLINE static double illinois(pe_ctx_t *c, double xs, double x0, double f0, double x1, double f1) {
   int retained = 0; /* +1: x0 kept last time, -1: x1 kept last time */
   double x = x1;
-  for (int it = 0; it < IMEST_PE_MAX_ROOT; ++it) {
+  for (int it = 0; it < BG_PE_MAX_ROOT; ++it) {
     x = x1 - f1 * (x1 - x0) / (f1 - f0);
     const double lo = (x0 < x1) ? x0 : x1, hi = (x0 < x1) ? x1 : x0;
     if (!(x > lo && x < hi)) x = 0.5 * (x0 + x1);
@@ -102,9 +102,9 @@ IMEST_NOINLINE static double illinois(pe_ctx_t *c, double xs, double x0, double 
 
 /* First crossing of the profile with L on one side of xs; 1 if found (in *xc),
  * 0 if the band edge is reached first (*xc = edge). */
-IMEST_NOINLINE static int crossing(pe_ctx_t *c, double xs, double fs, double d0, double edge, int dir, double *xc) {
+BG_NOINLINE static int crossing(pe_ctx_t *c, double xs, double fs, double d0, double edge, int dir, double *xc) {
   double xprev = xs, fprev = fs, step = d0;
-  for (int j = 0; j < IMEST_PE_MAX_PROBE; ++j) {
+  for (int j = 0; j < BG_PE_MAX_PROBE; ++j) {
     double x = xs + (double)dir * step;
     int last = 0;
     if ((dir > 0) ? (x >= edge) : (x <= edge)) {
@@ -127,7 +127,7 @@ IMEST_NOINLINE static int crossing(pe_ctx_t *c, double xs, double fs, double d0,
 
 /* Maximum of kbound(., sign) on [a, b] by successive parabolic interpolation
  * from x0 with spacing h (see the file comment). */
-IMEST_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, double x0, double h) {
+BG_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, double x0, double h) {
   if (!(b > a)) return kbound(c, a, sign);
   if (!(h > 0.0) || h > 0.25 * (b - a)) h = 0.25 * (b - a);
   if (x0 < a + h) x0 = a + h;
@@ -135,7 +135,7 @@ IMEST_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, d
   const double tol = 9.765625e-4 * h; /* 2^-10 */
   double xa = x0 - h, xb = x0, xc = x0 + h;
   double fa = kbound(c, xa, sign), fb = kbound(c, xb, sign), fc = kbound(c, xc, sign);
-  for (int it = 0; it < IMEST_PE_MAX_MIN; ++it) {
+  for (int it = 0; it < BG_PE_MAX_MIN; ++it) {
     double u;
     if (fa > fb || fc > fb) {
       /* not bracketed: step outwards on the higher side (golden ratio growth) */
@@ -176,14 +176,14 @@ IMEST_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, d
 }
 
 static double finite_or_unbounded(double v) {
-  return (imest_finite(v) && v >= 0.0 && v < IMEST_PE_UNBOUNDED) ? v : IMEST_PE_UNBOUNDED;
+  return (bg_finite(v) && v >= 0.0 && v < BG_PE_UNBOUNDED) ? v : BG_PE_UNBOUNDED;
 }
 
-unsigned int imest_quality(const imest_tables_t *t, const imest_solve_cfg_t *cfg, const imest_cand_t *best,
-                           imest_solve_out_t *out) {
+unsigned int bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, const bg_cand_t *best,
+                           bg_solve_out_t *out) {
   const double x = best->kappa, k = best->k;
-  imest_tabval_t v;
-  imest_tables_eval(t, x, &v);
+  bg_tabval_t v;
+  bg_tables_eval(t, x, &v);
   const double dd = x * x + t->cw, idd = 1.0 / dd, f = idd * idd;
   const double f1 = -4.0 * x * f * idd, f2 = (20.0 * x * x - 4.0 * t->cw) * f * f;
   const double p = (v.e2 * k + v.e1) * k + v.e0;
@@ -194,22 +194,22 @@ unsigned int imest_quality(const imest_tables_t *t, const imest_solve_cfg_t *cfg
   const double h12 = (2.0 * v.d2 * k + v.d1) * f + pk * f1;
   const double h22 = pxx * f + 2.0 * px * f1 + p * f2;
   const double det = h11 * h22 - h12 * h12;
-  out->hessian[0][0] = h11 * imest_pow2(t->cexp - 2 * t->gexp);
-  out->hessian[0][1] = h12 * imest_pow2(t->cexp - t->gexp - t->sexp);
+  out->hessian[0][0] = h11 * bg_pow2(t->cexp - 2 * t->gexp);
+  out->hessian[0][1] = h12 * bg_pow2(t->cexp - t->gexp - t->sexp);
   out->hessian[1][0] = out->hessian[0][1];
-  out->hessian[1][1] = h22 * imest_pow2(t->cexp - 2 * t->sexp);
-  out->hessian_pd = (h11 > 0.0 && det > 0.0 && imest_finite(det)) ? 1 : 0;
+  out->hessian[1][1] = h22 * bg_pow2(t->cexp - 2 * t->sexp);
+  out->hessian_pd = (h11 > 0.0 && det > 0.0 && bg_finite(det)) ? 1 : 0;
   out->pe_flags = 0;
 
   const double es = p * f; /* E_w~* */
   if (!(es > 0.0)) {
     out->pe_k1 = out->pe_k2 = 0.0;
     out->pe_quad[0] = out->pe_quad[1] = 0.0;
-    out->pe_flags |= IMEST_PE_FLAG_DEGENERATE;
+    out->pe_flags |= BG_PE_FLAG_DEGENERATE;
     return 1;
   }
 
-  double dk_q = IMEST_PE_UNBOUNDED, dx_q = IMEST_PE_UNBOUNDED;
+  double dk_q = BG_PE_UNBOUNDED, dx_q = BG_PE_UNBOUNDED;
   if (out->hessian_pd) {
     const double hh = 0.5 * es / det;
     dk_q = sqrt(hh * h22);
@@ -217,8 +217,8 @@ unsigned int imest_quality(const imest_tables_t *t, const imest_solve_cfg_t *cfg
     out->pe_quad[0] = finite_or_unbounded(dk_q * t->g);
     out->pe_quad[1] = finite_or_unbounded(dx_q * t->s);
   } else {
-    out->pe_quad[0] = out->pe_quad[1] = IMEST_PE_UNBOUNDED;
-    out->pe_flags |= IMEST_PE_FLAG_NOT_PD;
+    out->pe_quad[0] = out->pe_quad[1] = BG_PE_UNBOUNDED;
+    out->pe_flags |= BG_PE_FLAG_NOT_PD;
   }
 
   pe_ctx_t c;
@@ -228,21 +228,21 @@ unsigned int imest_quality(const imest_tables_t *t, const imest_solve_cfg_t *cfg
   c.nev = 0;
   /* g at kappa*: 4 e2 D^2 (E_w* - L) < 0 */
   const double fs = 4.0 * v.e2 * (v.e0 - c.lt * dd * dd) - v.e1 * v.e1;
-  double d0 = (out->hessian_pd && imest_finite(dx_q)) ? dx_q : 0.01 * x;
+  double d0 = (out->hessian_pd && bg_finite(dx_q)) ? dx_q : 0.01 * x;
   if (!(d0 >= 1e-9 * x)) d0 = 1e-9 * x;
   if (d0 > x) d0 = 0.5 * x;
   /* band in kappa */
   const double x_lo_edge = 1.0 / (cfg->tr_max_s * t->s);
   const double x_hi_edge = 1.0 / (cfg->tr_min_s * t->s);
   double xlo, xhi;
-  if (!crossing(&c, x, fs, d0, (x_lo_edge < x) ? x_lo_edge : x, -1, &xlo)) out->pe_flags |= IMEST_PE_FLAG_K2_LO_EDGE;
-  if (!crossing(&c, x, fs, d0, (x_hi_edge > x) ? x_hi_edge : x, +1, &xhi)) out->pe_flags |= IMEST_PE_FLAG_K2_HI_EDGE;
+  if (!crossing(&c, x, fs, d0, (x_lo_edge < x) ? x_lo_edge : x, -1, &xlo)) out->pe_flags |= BG_PE_FLAG_K2_LO_EDGE;
+  if (!crossing(&c, x, fs, d0, (x_hi_edge > x) ? x_hi_edge : x, +1, &xhi)) out->pe_flags |= BG_PE_FLAG_K2_HI_EDGE;
   const double dxm = (xhi - x > x - xlo) ? xhi - x : x - xlo;
   out->pe_k2 = finite_or_unbounded(dxm * t->s);
 
   /* K1 extremes, started at the quadratic model's: dkappa = -(H12/H22) dk */
   double xe_hi = x, xe_lo = x, h = 0.125 * (xhi - xlo);
-  if (out->hessian_pd && imest_finite(dk_q) && imest_finite(dx_q)) {
+  if (out->hessian_pd && bg_finite(dk_q) && bg_finite(dx_q)) {
     const double shift = (h12 / h22) * dk_q;
     xe_hi = x - shift;
     xe_lo = x + shift;

@@ -1,10 +1,10 @@
 /* Stage 2 of the background solve: the resultant r_w(kappa) of p1 and p2w with
- * respect to k (docs/METHOD.md §4, eq. 27, with the weighted p2w of bg_poly.h), float64:
+ * respect to k (docs/METHOD.md §4, eq. 27, with the weighted p2w of bg_tables.h), float64:
  *   r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0 = a0 (a0 bw2 - a1 bw1) + (a1 a1) bw0,
  * five convolutions, about 405 multiply-adds (the three-term form takes 545).
  * With cw = 0, r_w = kappa r: r_w[0] = 0 exactly and r_w[k+1] = r[k] up to
  * round-off (the paper's degree-18 r, one trailing zero). */
-#include "bg_poly.h"
+#include "bg_resultant.h"
 
 /* out[0..na+nb-2] (+)= conv(a[0..na-1], b[0..nb-1]), sign = +1 or -1 */
 static void conv_acc(const double *a, int na, const double *b, int nb, double *out, int clear, double sign) {
@@ -16,7 +16,7 @@ static void conv_acc(const double *a, int na, const double *b, int nb, double *o
   }
 }
 
-void imest_resultant(const imest_tables_t *t, double r[22], int generic) {
+void bg_resultant(const bg_tables_t *t, double r[22], int generic) {
   double u[15];  /* a0 bw2 - a1 bw1 */
   double sq[13]; /* a1 a1 */
   conv_acc(t->a0, 8, t->bw2, 8, u, 1, 1.0);

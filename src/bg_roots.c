@@ -6,7 +6,7 @@
  *  - Normalise: strip exact-zero leading and trailing coefficients (a root at 0
  *    is not positive), scale by a power of two so that max|c| is in
  *    [2^-1/2, 2^1/2). All power-of-two scalings are multiplications by exact
- *    powers of two (imest_pow2), no ldexp/frexp.
+ *    powers of two (bg_pow2), no ldexp/frexp.
  *  - Four domains, each searched on (lo, 1 + 2^-8] so that neighbouring
  *    domains overlap (a root at a domain boundary, where the sign of p is
  *    round-off, lies inside one of them): kappa in (0,1] on p(y); (1,16] on
@@ -29,18 +29,18 @@
  *    roots) or at degree 0. V(x) = sign changes of the chain (zeros ignored);
  *    distinct roots in (a,b] = V(a) - V(b).
  *  - Isolation: depth-first halving of the domain while the count is >= 2, at most
- *    IMEST_ROOTS_MAX_DEPTH halvings deep and IMEST_ROOTS_MAX_SPLITS halvings per
+ *    BG_ROOTS_MAX_DEPTH halvings deep and BG_ROOTS_MAX_SPLITS halvings per
  *    domain; an interval that cannot be split further (depth, split budget, or
  *    its midpoint not representable) is refined as one root ("unresolved").
  *  - Refinement in chain precision down to a relative width of 2^-20: sign
  *    bisection when p changes sign on the interval, else (even multiplicity, or
- *    float32 sign noise) bisection on the Sturm count; <= IMEST_ROOTS_MAX_BISECT.
+ *    float32 sign noise) bisection on the Sturm count; <= BG_ROOTS_MAX_BISECT.
  *  - Polish in float64 on the full (untruncated) polynomial: find a float64
  *    sign change (values only) on the refined bracket, widening it by 4x up to
- *    IMEST_ROOTS_MAX_EXPAND times (limited to the isolating interval plus 1/16
+ *    BG_ROOTS_MAX_EXPAND times (limited to the isolating interval plus 1/16
  *    of its width), then safeguarded Newton (a Newton step that leaves the
  *    bracket becomes a bisection; each step evaluates p and p' only),
- *    <= IMEST_ROOTS_MAX_POLISH evaluations, until
+ *    <= BG_ROOTS_MAX_POLISH evaluations, until
  *    a Newton step is <= 2^-30 |x| (then the error is ~ |x p''/(2p')| 2^-60 |x|:
  *    full double accuracy for simple roots) or the bracket is 4 ulp wide. If
  *    float64 sees no sign change (even multiplicity), the same is done on p'
@@ -49,15 +49,15 @@
  *    (counted in stats.rejected).
  *  - Safety net in float64 (parity_rescue): if the odd-multiplicity roots
  *    found in a domain do not match the parity of the float64 sign change of p
- *    over the domain, p is sampled on a fixed 19-point grid and cells with a
+ *    over the domain, p is sampled on a fixed grid (bg_bounds.h) and cells with a
  *    sign change but no root are solved in float64 (stats.rescues). Every
  *    reported root is a float64 root (sign change or |p| at round-off level):
  *    a chain that lost accuracy can miss roots but never invent one.
  *
- * Bounds, per call: IMEST_ROOTS_BOUND_STURM (7944) V(x) evaluations,
- * IMEST_ROOTS_BOUND_BISECT (3840) chain-precision bisection steps,
- * IMEST_ROOTS_BOUND_POLISH (12320) float64 polish evaluations (bg_poly.h). Typical (testvector, n = 18): see test/solve (about 30
- * V evaluations, 60 bisection steps and 20 float64 evaluations).
+ * Bounds, per call: BG_ROOTS_BOUND_STURM V(x) evaluations,
+ * BG_ROOTS_BOUND_BISECT chain-precision bisection steps and
+ * BG_ROOTS_BOUND_POLISH float64 polish evaluations (bg_bounds.h). The counts
+ * of a typical window are printed by imest-bench-solve (test/solve).
  *
  * Typical cost per root: 2 float64 value evaluations at the bracket ends and
  * 2 Newton steps (p, p'), i.e. 6 Horner passes: the float32 bracket of 2^-20
@@ -72,9 +72,9 @@
 #include <float.h>
 #include <math.h>
 
-#include "bg_poly.h"
+#include "bg_roots.h"
 
-#ifdef IMEST_ROOTS_DOUBLE
+#ifdef BG_ROOTS_DOUBLE
 typedef double sreal_t;
 #define SR_TOL (64.0 * DBL_EPSILON)
 #define SR_ABS(x) fabs(x)
@@ -84,13 +84,13 @@ typedef float sreal_t;
 #define SR_ABS(x) fabsf(x)
 #endif
 
-#define NMAX IMEST_POLY_MAXDEG
+#define NMAX BG_POLY_MAXDEG
 #define REFINE_REL ((sreal_t)9.5367431640625e-07) /* 2^-20 */
 #define NEWTON_STOP 9.313225746154785e-10          /* 2^-30 */
 #define DOMAIN_TOP ((sreal_t)1.00390625)           /* 1 + 2^-8: the domains overlap */
 /* Domains in kappa: (0,1] on p, (1,16] on p(16y), (16,256] on p(256y), each
  * y in (1/16 - 2^-12, 1 + 2^-8], and (256, inf) on q(z/256), q the reversed p. */
-#define DOMAINS ((int)IMEST_ROOTS_DOMAINS)
+#define DOMAINS ((int)BG_ROOTS_DOMAINS)
 static const int DOMAIN_EXP[DOMAINS] = {0, 4, 8, 8};
 static const int DOMAIN_REV[DOMAINS] = {0, 0, 0, 1};
 static const double DOMAIN_LO[DOMAINS] = {0.0, 0.062255859375, 0.062255859375, 0.0};
@@ -119,14 +119,14 @@ static sreal_t horner_s(const sreal_t *c, int n, sreal_t x) {
   return p;
 }
 
-double imest_poly_eval(const double *c, int deg, double x) {
+double bg_poly_eval(const double *c, int deg, double x) {
   double p = c[deg];
   for (int k = deg - 1; k >= 0; --k) p = p * x + c[k];
   return p;
 }
 
 /* f = p^(order)(x), df = p^(order+1)(x), order 0 (two Horner passes) or 1 (three). */
-IMEST_NOINLINE static void eval_d(const double *c, int n, int order, double x, double *f, double *df) {
+BG_NOINLINE static void eval_d(const double *c, int n, int order, double x, double *f, double *df) {
   double p = c[n], p1 = 0.0, p2 = 0.0;
   if (order == 0) {
     for (int k = n - 1; k >= 0; --k) {
@@ -147,21 +147,21 @@ IMEST_NOINLINE static void eval_d(const double *c, int n, int order, double x, d
 }
 
 /* p^(order)(x) alone (order 0: one Horner pass). */
-IMEST_NOINLINE static double eval_v(const double *c, int n, int order, double x) {
-  if (order == 0) return imest_poly_eval(c, n, x);
+BG_NOINLINE static double eval_v(const double *c, int n, int order, double x) {
+  if (order == 0) return bg_poly_eval(c, n, x);
   double f, df;
   eval_d(c, n, 1, x, &f, &df);
   return f;
 }
 
-IMEST_NOINLINE static double abs_sum_d(const double *c, int n, double x) {
+BG_NOINLINE static double abs_sum_d(const double *c, int n, double x) {
   double p = 0.0;
   for (int k = n; k >= 0; --k) p = p * fabs(x) + fabs(c[k]);
   return p;
 }
 
 /* Normalise P_k to max|c| = 1 (optionally negated) and drop small leading terms. */
-IMEST_NOINLINE static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
+BG_NOINLINE static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
   sreal_t *c = CH(ch, k);
   int d = ch->deg[k];
   sreal_t mx = 0;
@@ -175,7 +175,7 @@ IMEST_NOINLINE static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
   ch->deg[k] = (short)d;
 }
 
-IMEST_NOINLINE static void chain_build(chain_t *ch, const double *pd, int n) {
+BG_NOINLINE static void chain_build(chain_t *ch, const double *pd, int n) {
   for (int k = 0, o = 0; k <= n; ++k) { /* P_k has degree <= n - k */
     ch->off[k] = (short)o;
     o += n - k + 1;
@@ -214,7 +214,7 @@ IMEST_NOINLINE static void chain_build(chain_t *ch, const double *pd, int n) {
   }
 }
 
-static int sign_changes(const chain_t *ch, sreal_t x, imest_roots_stats_t *st) {
+static int sign_changes(const chain_t *ch, sreal_t x, bg_roots_stats_t *st) {
   int v = 0, last = 0;
   ++st->sturm_evals;
   for (int k = 0; k < ch->len; ++k) {
@@ -229,11 +229,11 @@ static int sign_changes(const chain_t *ch, sreal_t x, imest_roots_stats_t *st) {
 
 /* Safeguarded Newton on p^(order) in [a,b], where the signs at a and b differ
  * (fa is the value at a). */
-IMEST_NOINLINE static double newton_bracketed(const double *c, int n, int order, double a, double b, double fa,
-                               imest_roots_stats_t *st) {
+BG_NOINLINE static double newton_bracketed(const double *c, int n, int order, double a, double b, double fa,
+                               bg_roots_stats_t *st) {
   double x = 0.5 * (a + b);
   int prev_newton = 0;
-  for (int it = 0; it < IMEST_ROOTS_MAX_POLISH; ++it) {
+  for (int it = 0; it < BG_ROOTS_MAX_POLISH; ++it) {
     double f, df;
     eval_d(c, n, order, x, &f, &df);
     ++st->polish_evals;
@@ -258,8 +258,8 @@ IMEST_NOINLINE static double newton_bracketed(const double *c, int n, int order,
 
 /* Find a float64 sign change of p^(order) on [a,b] or a widening of it within
  * [lo,hi]; then polish. Returns 1 and *root on success. */
-IMEST_NOINLINE static int polish_order(const double *c, int n, int order, double a, double b, double lo, double hi,
-                        double *root, imest_roots_stats_t *st) {
+BG_NOINLINE static int polish_order(const double *c, int n, int order, double a, double b, double lo, double hi,
+                        double *root, bg_roots_stats_t *st) {
   double fa = eval_v(c, n, order, a), fb = eval_v(c, n, order, b);
   st->polish_evals += 2;
   if (fa == 0.0) {
@@ -272,7 +272,7 @@ IMEST_NOINLINE static int polish_order(const double *c, int n, int order, double
   }
   double w = b - a;
   if (!(w > 0.0)) w = fabs(b) * 1e-6 + DBL_MIN;
-  for (int j = 0; sgn_d(fa) == sgn_d(fb) && j < IMEST_ROOTS_MAX_EXPAND; ++j) {
+  for (int j = 0; sgn_d(fa) == sgn_d(fb) && j < BG_ROOTS_MAX_EXPAND; ++j) {
     w *= 4.0;
     const double a2 = (a - w > lo) ? a - w : lo, b2 = (b + w < hi) ? b + w : hi;
     double fa2 = fa, fb2 = fb;
@@ -318,7 +318,7 @@ IMEST_NOINLINE static int polish_order(const double *c, int n, int order, double
 }
 
 static int polish(const double *c, int n, double a, double b, double lo, double hi, double *root,
-                  imest_roots_stats_t *st) {
+                  bg_roots_stats_t *st) {
   const double ext = (hi - lo) * 0.0625;
   lo = (lo - ext > 0.0) ? lo - ext : 0.0;
   hi = hi + ext;
@@ -326,7 +326,7 @@ static int polish(const double *c, int n, double a, double b, double lo, double 
   /* no float64 sign change: even multiplicity? polish the root of p' */
   double x;
   if (!polish_order(c, n, 1, a, b, lo, hi, &x, st)) return 0;
-  const double px = imest_poly_eval(c, n, x);
+  const double px = bg_poly_eval(c, n, x);
   ++st->polish_evals;
   if (fabs(px) <= 32.0 * (double)(n + 1) * DBL_EPSILON * abs_sum_d(c, n, x)) {
     *root = x;
@@ -337,14 +337,14 @@ static int polish(const double *c, int n, double a, double b, double lo, double 
 
 /* Refine one interval (count >= 1) in chain precision and polish it in float64.
  * Returns 0 (rejected), 1 (float64 sign change: odd multiplicity) or 2 (even). */
-IMEST_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root, imest_roots_stats_t *st) {
+BG_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root, bg_roots_stats_t *st) {
   const double lo = (double)iv.a, hi = (double)iv.b;
   sreal_t a = iv.a, b = iv.b;
   const sreal_t *p0 = CH(ch, 0);
   const int d0 = ch->deg[0];
   sreal_t fa = horner_s(p0, d0, a), fb = horner_s(p0, d0, b);
   if (sgn_s(fa) * sgn_s(fb) < 0) {
-    for (int it = 0; it < IMEST_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
+    for (int it = 0; it < BG_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
       const sreal_t m = a + (b - a) * (sreal_t)0.5;
       if (!(m > a && m < b)) break;
       ++st->bisect_steps;
@@ -363,7 +363,7 @@ IMEST_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, iva
     }
   } else if (fb != 0) {
     int va = iv.va;
-    for (int it = 0; it < IMEST_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
+    for (int it = 0; it < BG_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
       const sreal_t m = a + (b - a) * (sreal_t)0.5;
       if (!(m > a && m < b)) break;
       ++st->bisect_steps;
@@ -389,15 +389,15 @@ IMEST_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, iva
 /* float64 safety net for a chain that lost accuracy: the number of odd-
  * multiplicity roots in (0, TOP] must have the parity of the sign change of p
  * between 0+ and TOP. If not, p is sampled in float64 at a fixed grid
- * (0, 2^-16 .. 2^-1, 0.75, TOP; 19 points) and every grid cell with a sign
+ * (0, 2^-16 .. 2^-1, 0.75, TOP: BG_ROOTS_RESCUE_CELLS cells) and every grid cell with a sign
  * change and no root yet is solved by the bracketed float64 Newton. */
-IMEST_NOINLINE static int parity_rescue(const double *pd, int n, double ylo, double *out, int *odd, int nout,
-                         imest_roots_stats_t *st) {
+BG_NOINLINE static int parity_rescue(const double *pd, int n, double ylo, double *out, int *odd, int nout,
+                         bg_roots_stats_t *st) {
   const double top = (double)DOMAIN_TOP;
-  const double ftop = imest_poly_eval(pd, n, top);
+  const double ftop = bg_poly_eval(pd, n, top);
   double flo = pd[0];
   if (ylo > 0.0) {
-    flo = imest_poly_eval(pd, n, ylo);
+    flo = bg_poly_eval(pd, n, ylo);
     ++st->polish_evals;
   }
   ++st->polish_evals;
@@ -406,10 +406,11 @@ IMEST_NOINLINE static int parity_rescue(const double *pd, int n, double ylo, dou
   if (sgn_d(ftop) == 0 || sgn_d(flo) == 0 || ((sgn_d(flo) != sgn_d(ftop)) == ((nodd & 1) == 1))) return nout;
   ++st->rescues;
   double glo = ylo;
-  for (int k = 1; k <= 18; ++k) {
-    const double ghi = (k <= 16) ? imest_pow2(k - 17) : (k == 17) ? 0.75 : top;
+  for (int k = 1; k <= (int)BG_ROOTS_RESCUE_CELLS; ++k) {
+    const int p2 = (int)BG_ROOTS_RESCUE_POW2_CELLS;
+    const double ghi = (k <= p2) ? bg_pow2(k - p2 - 1) : (k == p2 + 1) ? 0.75 : top;
     if (ghi <= glo) continue;
-    const double fhi = imest_poly_eval(pd, n, ghi);
+    const double fhi = bg_poly_eval(pd, n, ghi);
     ++st->polish_evals;
     if (sgn_d(flo) * sgn_d(fhi) < 0) {
       int inside = 0;
@@ -426,8 +427,8 @@ IMEST_NOINLINE static int parity_rescue(const double *pd, int n, double ylo, dou
 }
 
 /* Roots of pd (float64, normalised, degree n >= 1, pd[0] != 0) in (ylo, 1 + 2^-8]. */
-static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double *out, imest_roots_stats_t *st) {
-  ival_t stack[IMEST_ROOTS_MAX_DEPTH + 2];
+static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double *out, bg_roots_stats_t *st) {
+  ival_t stack[BG_ROOTS_MAX_DEPTH + 2];
   int odd[NMAX];
   int top = 0, nout = 0, splits = 0;
   chain_build(ch, pd, n);
@@ -446,8 +447,8 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double
     if (cnt <= 0) continue;
     if (cnt >= 2) {
       const sreal_t m = iv.a + (iv.b - iv.a) * (sreal_t)0.5;
-      if (iv.depth < IMEST_ROOTS_MAX_DEPTH && splits < IMEST_ROOTS_MAX_SPLITS && m > iv.a && m < iv.b &&
-          top + 2 <= IMEST_ROOTS_MAX_DEPTH + 2) {
+      if (iv.depth < BG_ROOTS_MAX_DEPTH && splits < BG_ROOTS_MAX_SPLITS && m > iv.a && m < iv.b &&
+          top + 2 <= BG_ROOTS_MAX_DEPTH + 2) {
         const short vm = (short)sign_changes(ch, m, st);
         ++splits;
         /* right half first so that the left half is processed first */
@@ -481,8 +482,8 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double
 
 /* Insert x into the ascending roots[0..*nr-1] (at most max), dropping it if a
  * root within MERGE_REL lies next to it; when full, the largest is dropped. */
-IMEST_NOINLINE static void merge_root(double x, double *roots, int *nr, int max, imest_roots_stats_t *st) {
-  if (!(x > 0.0) || !imest_finite(x)) {
+BG_NOINLINE static void merge_root(double x, double *roots, int *nr, int max, bg_roots_stats_t *st) {
+  if (!(x > 0.0) || !bg_finite(x)) {
     ++st->rejected;
     return;
   }
@@ -499,8 +500,8 @@ IMEST_NOINLINE static void merge_root(double x, double *roots, int *nr, int max,
   if (*nr < max) ++*nr;
 }
 
-int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int max, imest_roots_stats_t *st) {
-  imest_roots_stats_t dummy;
+int bg_roots_positive_ex(const double *c, int deg, double *roots, int max, bg_roots_stats_t *st) {
+  bg_roots_stats_t dummy;
   if (st == 0) st = &dummy;
   st->sturm_evals = st->bisect_steps = st->polish_evals = st->chain_len = 0;
   st->unresolved = st->rejected = st->merged = st->rescues = 0;
@@ -509,7 +510,7 @@ int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int ma
   int hi = -1, lo = -1;
   double mx = 0.0;
   for (int k = 0; k <= deg; ++k) {
-    if (!imest_finite(c[k])) return -1;
+    if (!bg_finite(c[k])) return -1;
     if (c[k] != 0.0) {
       if (lo < 0) lo = k;
       hi = k;
@@ -520,7 +521,7 @@ int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int ma
   const int n = hi - lo;
   if (n == 0) return 0;
   double p[NMAX + 1], d[NMAX + 1];
-  const double pn = imest_pow2(-imest_round_log2(mx));
+  const double pn = bg_pow2(-bg_round_log2(mx));
   for (int k = 0; k <= n; ++k) p[k] = c[lo + k] * pn;
 
   chain_t ch;
@@ -530,23 +531,23 @@ int imest_poly_positive_roots_ex(const double *c, int deg, double *roots, int ma
     /* domain polynomial: p(2^e y) or q(2^-e z) with q[k] = p[n-k] (the
      * reversed p), exactly scaled by powers of two, renormalised */
     const int ex = DOMAIN_EXP[dom], rev = DOMAIN_REV[dom];
-    const double step = imest_pow2(rev ? -ex : ex);
+    const double step = bg_pow2(rev ? -ex : ex);
     double f = 1.0, dmax = 0.0;
     for (int k = 0; k <= n; ++k) {
       d[k] = (rev ? p[n - k] : p[k]) * f;
       f *= step;
       if (fabs(d[k]) > dmax) dmax = fabs(d[k]);
     }
-    const double dn = imest_pow2(-imest_round_log2(dmax));
+    const double dn = bg_pow2(-bg_round_log2(dmax));
     for (int k = 0; k <= n; ++k) d[k] *= dn;
     const double ylo = DOMAIN_LO[dom];
     const int nd = domain_roots(&ch, d, n, ylo, xd, st);
-    const double back = imest_pow2(ex);
+    const double back = bg_pow2(ex);
     for (int i = 0; i < nd; ++i) merge_root(rev ? back / xd[i] : xd[i] * back, roots, &nr, max, st);
   }
   return nr;
 }
 
-int imest_poly_positive_roots(const double *c, int deg, double *roots, int max) {
-  return imest_poly_positive_roots_ex(c, deg, roots, max, 0);
+int bg_roots_positive(const double *c, int deg, double *roots, int max) {
+  return bg_roots_positive_ex(c, deg, roots, max, 0);
 }

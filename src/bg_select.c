@@ -6,22 +6,22 @@
  * E_p^2 is formed by cancellation. From the tables (R_y - 2 R_Wy'K + K'R_W K)
  * its floor is about 1e-5 R_y with float32-accumulated sums (measured: noise-
  * free data gave -1.2e-5 R_y at the true root). When the sums carry their
- * centred form (imest_sums_t.centred), E_p^2 of every candidate that passes
+ * centred form (bg_sums_t.centred), E_p^2 of every candidate that passes
  * the other checks is recomputed as R_ee - 2 R_We'd + d'R_W d, d = K - c0,
  * which is small near the centring and has no such floor.
  * Admissible: everything finite, a1(kappa) > 0, K1 > 0, T_R in
  * [tr_min, tr_max], and E_p^2 >= -1e-4 R_y (a clearly negative E is garbage).
  * The admissible candidate with the least E_w is selected (first one on a tie). */
-#include "bg_poly.h"
+#include "bg_select.h"
 
-static int centred_ok(const imest_sums_t *in) {
-  if (!in->centred || !imest_finite(in->ree)) return 0;
+static int centred_ok(const bg_sums_t *in) {
+  if (!in->centred || !bg_finite(in->ree)) return 0;
   for (int i = 0; i < 8; ++i)
-    if (!imest_finite(in->c0[i]) || !imest_finite(in->rwe[i])) return 0;
+    if (!bg_finite(in->c0[i]) || !bg_finite(in->rwe[i])) return 0;
   return 1;
 }
 
-double imest_e_centred(const imest_sums_t *in, double k1, double k2) {
+double bg_e_centred(const bg_sums_t *in, double k1, double k2) {
   const double ik = 1.0 / k2, ik2 = ik * ik;
   const double K[8] = {k1, k2, k2 * k2, k1 * k2, ik, k1 * ik, k1 * ik2, ik2};
   double d[8];
@@ -36,18 +36,18 @@ double imest_e_centred(const imest_sums_t *in, double k1, double k2) {
   return e;
 }
 
-int imest_select(const imest_tables_t *t, const double *kappa, int n, const imest_solve_cfg_t *cfg,
-                 const imest_sums_t *in, imest_cand_t *best, imest_cand_t *cand, unsigned int *n_admissible) {
+int bg_select(const bg_tables_t *t, const double *kappa, int n, const bg_solve_cfg_t *cfg,
+                 const bg_sums_t *in, bg_cand_t *best, bg_cand_t *cand, unsigned int *n_admissible) {
   int ib = -1;
   unsigned int nad = 0;
   const int centred = centred_ok(in);
   const double floor_e = -1e-4 * in->ry;
   for (int i = 0; i < n; ++i) {
-    imest_cand_t cv;
-    imest_cand_t *c = &cv;
+    bg_cand_t cv;
+    bg_cand_t *c = &cv;
     double v[3];
     const double x = kappa[i];
-    imest_tables_values(t, x, v);
+    bg_tables_values(t, x, v);
     const double a1 = 2.0 * v[0], a0 = v[1];
     c->kappa = x;
     c->k = -a0 / a1;
@@ -63,12 +63,12 @@ int imest_select(const imest_tables_t *t, const double *kappa, int n, const imes
     c->k2 = x * t->s;
     c->tr_s = 1.0 / c->k2;
     c->rs_ohm = cfg->sigma * cfg->ls_h * c->k1 - (1.0 - cfg->sigma) * cfg->ls_h * c->k2;
-    c->admissible = imest_finite(c->k1) && imest_finite(c->k2) && imest_finite(c->tr_s) &&
-                    imest_finite(c->rs_ohm) && a1 > 0.0 && c->k1 > 0.0 && c->k2 > 0.0 &&
+    c->admissible = bg_finite(c->k1) && bg_finite(c->k2) && bg_finite(c->tr_s) &&
+                    bg_finite(c->rs_ohm) && a1 > 0.0 && c->k1 > 0.0 && c->k2 > 0.0 &&
                     c->tr_s >= cfg->tr_min_s && c->tr_s <= cfg->tr_max_s;
-    if (c->admissible && centred) c->e = imest_e_centred(in, c->k1, c->k2);
+    if (c->admissible && centred) c->e = bg_e_centred(in, c->k1, c->k2);
     c->ew = c->e * w;
-    c->admissible = c->admissible && imest_finite(c->e) && imest_finite(c->ew) && c->e >= floor_e;
+    c->admissible = c->admissible && bg_finite(c->e) && bg_finite(c->ew) && c->e >= floor_e;
     if (c->admissible) {
       ++nad;
       if (ib < 0 || c->ew < best->ew) {

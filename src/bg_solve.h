@@ -6,6 +6,8 @@
 #define IMEST_BG_SOLVE_H
 
 #include "imest/imest.h"
+#include "bg_bounds.h"
+#include "bg_roots.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -26,7 +28,7 @@ typedef struct {
   double c0[8];
   double rwe[8];
   double ree;
-} imest_sums_t;
+} bg_sums_t;
 
 typedef struct {
   double sigma;        /* total leakage factor */
@@ -39,11 +41,11 @@ typedef struct {
    * eliminated equation was multiplied by (1 + n_p^2 w^2 T_R^2) (docs/METHOD.md §2),
    * which weights the residual ~(1 + n_p^2 w^2 T_R^2)^2 and lets any noise
    * floor pull the minimum to the spurious K2 ~ n_p w; with c = n_p^2 w^2
-   * that weight is divided out. Use imest_solve_weight_c() (current-weighted
+   * that weight is divided out. Use bg_solve_weight_c() (current-weighted
    * n_p^2 w^2 of the window). 0 = the paper's cost (exactly); negative or
    * non-finite: IMEST_ERR_CONFIG. */
   double weight_c;
-} imest_solve_cfg_t;
+} bg_solve_cfg_t;
 
 typedef struct {
   int status;                 /* IMEST_OK, IMEST_REASON_NUMERIC or IMEST_REASON_NO_ROOT */
@@ -60,22 +62,32 @@ typedef struct {
   double pe_k1, pe_k2;        /* parametric error indices (absolute), docs/METHOD.md §7, of E_w */
   double pe_quad[2];          /* quadratic approximations sqrt(0.5 E (H^-1)_ii) */
   double scale_s, scale_g, scale_c; /* the power-of-two scalings used */
-  unsigned int pe_flags;      /* IMEST_PE_FLAG_* (bg_poly.h): how the PE indices were obtained */
+  unsigned int pe_flags;      /* BG_PE_FLAG_* (bg_quality.h): how the PE indices were obtained */
   unsigned int work;          /* iterations used (Sturm evaluations + bisection + polish +
                                  quality evaluations); bounded, see bg_solve.c */
-} imest_solve_out_t;
+} bg_solve_out_t;
 
 /* Solve one window. Always terminates within fixed iteration bounds; never
  * returns a non-finite value with status IMEST_OK. */
-int imest_solve(const imest_sums_t *in, const imest_solve_cfg_t *cfg, imest_solve_out_t *out);
+int bg_solve(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *out);
 
 /* The cost weight c = sqrt(R66/R44) (1-based: |W6|^2 ~ (n_p w)^4 |i|^2 per
  * |i|^2 = |W4|^2), i.e. the current-weighted n_p^2 w^2 of the window; 0 if
  * undefined (no current, non-finite sums). */
-double imest_solve_weight_c(const imest_sums_t *in);
+double bg_solve_weight_c(const bg_sums_t *in);
+
+typedef struct {
+  bg_roots_stats_t roots;
+  unsigned int quality_evals;
+} bg_solve_stats_t;
+
+/* bg_solve with optional instrumentation (stats may be NULL). */
+int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *out,
+                bg_solve_stats_t *stats);
 
 #ifdef __cplusplus
 }
 #endif
+
 
 #endif /* IMEST_BG_SOLVE_H */

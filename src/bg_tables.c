@@ -1,56 +1,25 @@
 /* Stage 1 of the background solve: power-of-two scaling (docs/METHOD.md §5), the
  * scaled cost tables e2, e1, e0 (§3) and the p1/p2w coefficients (§4, with the
- * speed-normalised cost of bg_poly.h). float64 throughout. Every scaling is a
+ * speed-normalised cost of bg_tables.h). float64 throughout. Every scaling is a
  * multiplication by an exact power of two, so the scaled tables equal the
  * unscaled ones times powers of two, bit for bit (barring under/overflow of
  * garbage input). No libm: ldexp/frexp/isfinite cost ~70 instructions per call
  * on a soft-double core, a bit test a few. */
 #include <stdint.h>
 
-#include "bg_poly.h"
+#include "bg_tables.h"
 
 /* Exponents of K_i = K1^EXP_E[i] * K2^EXP_F[i] (docs/METHOD.md §3). */
 static const int EXP_E[8] = {1, 0, 0, 1, 0, 1, 1, 0};
 static const int EXP_F[8] = {0, 1, 2, 1, -1, -1, -2, -2};
 
-typedef union {
-  double d;
-  uint64_t u;
-} bits64_t;
 
-double imest_pow2(int e) {
-  if (e < -1022) e = -1022;
-  if (e > 1023) e = 1023;
-  bits64_t b;
-  b.u = (uint64_t)(e + 1023) << 52;
-  return b.d;
-}
-
-int imest_finite(double x) {
-  bits64_t b;
-  b.d = x;
-  return ((unsigned int)(b.u >> 52) & 0x7FFu) != 0x7FFu;
-}
-
-int imest_round_log2(double x) {
-  bits64_t b;
-  int off = 0;
-  b.d = x;
-  if (((b.u >> 52) & 0x7FFu) == 0u) { /* subnormal: make it normal */
-    b.d = x * 18446744073709551616.0;  /* 2^64 */
-    off = 64;
-  }
-  const int ex = (int)((b.u >> 52) & 0x7FFu) - 1023;
-  /* log2 x = ex + log2(1.f): round up iff 1.f >= sqrt 2 (mantissa of sqrt 2) */
-  return ex - off + (((b.u & 0xFFFFFFFFFFFFFull) >= 0x6A09E667F3BCDull) ? 1 : 0);
-}
-
-static double *table_of(imest_tables_t *t, int order) {
+static double *table_of(bg_tables_t *t, int order) {
   return (order == 2) ? t->e2 : (order == 1) ? t->e1 : t->e0;
 }
 
 /* bw[j] = (j-5) t[j-1] + cw (j+1) t[j+1], j = 0..len (t has len entries). */
-IMEST_NOINLINE static void weighted_b(const double *tab, int len, double cw, double *bw) {
+BG_NOINLINE static void weighted_b(const double *tab, int len, double cw, double *bw) {
   for (int j = 0; j <= len; ++j) {
     double v = (j >= 1) ? (double)(j - 5) * tab[j - 1] : 0.0;
     if (cw != 0.0 && j + 1 < len) v += cw * (double)(j + 1) * tab[j + 1];
@@ -58,32 +27,32 @@ IMEST_NOINLINE static void weighted_b(const double *tab, int len, double cw, dou
   }
 }
 
-void imest_tables_weight(imest_tables_t *t, double weight_c) {
-  t->cw = weight_c * imest_pow2(-2 * t->sexp);
+void bg_tables_weight(bg_tables_t *t, double weight_c) {
+  t->cw = weight_c * bg_pow2(-2 * t->sexp);
   weighted_b(t->e2, 7, t->cw, t->bw2);
   weighted_b(t->e1, 8, t->cw, t->bw1);
   weighted_b(t->e0, 9, t->cw, t->bw0);
 }
 
-IMEST_NOINLINE static void p_coefficients(imest_tables_t *t) {
+BG_NOINLINE static void p_coefficients(bg_tables_t *t) {
   for (int m = 0; m < 7; ++m) t->a1[m] = 2.0 * t->e2[m];
   for (int m = 0; m < 8; ++m) t->a0[m] = t->e1[m];
-  imest_tables_weight(t, 0.0);
+  bg_tables_weight(t, 0.0);
 }
 
-IMEST_NOINLINE void imest_tables_scaled(const imest_sums_t *in, int sexp, int gexp, int cexp, imest_tables_t *t) {
+BG_NOINLINE void bg_tables_scaled(const bg_sums_t *in, int sexp, int gexp, int cexp, bg_tables_t *t) {
   t->sexp = sexp;
   t->gexp = gexp;
   t->cexp = cexp;
-  t->s = imest_pow2(sexp);
-  t->g = imest_pow2(gexp);
-  t->c = imest_pow2(cexp);
+  t->s = bg_pow2(sexp);
+  t->g = bg_pow2(gexp);
+  t->c = bg_pow2(cexp);
   for (int m = 0; m < 7; ++m) t->e2[m] = 0.0;
   for (int m = 0; m < 8; ++m) t->e1[m] = 0.0;
   for (int m = 0; m < 9; ++m) t->e0[m] = 0.0;
   /* every entry of table_q[f + 4] is scaled by 2^(q gexp + f sexp - cexp) */
   double fs[9];
-  for (int f = -4; f <= 4; ++f) fs[f + 4] = imest_pow2(sexp * f - cexp);
+  for (int f = -4; f <= 4; ++f) fs[f + 4] = bg_pow2(sexp * f - cexp);
 
   for (int i = 0; i < 8; ++i) {
     /* diagonal, then each unordered pair once with R_ij + R_ji (= 2 R_ij exactly
@@ -98,7 +67,7 @@ IMEST_NOINLINE void imest_tables_scaled(const imest_sums_t *in, int sexp, int ge
   }
   t->e0[4] += in->ry * fs[4];
   if (gexp != 0) {
-    const double g1 = imest_pow2(gexp), g2 = imest_pow2(2 * gexp);
+    const double g1 = bg_pow2(gexp), g2 = bg_pow2(2 * gexp);
     for (int m = 0; m < 7; ++m) t->e2[m] *= g2;
     for (int m = 0; m < 8; ++m) t->e1[m] *= g1;
   }
@@ -107,37 +76,37 @@ IMEST_NOINLINE void imest_tables_scaled(const imest_sums_t *in, int sexp, int ge
 
 static int all_finite(const double *v, int n) {
   for (int i = 0; i < n; ++i)
-    if (!imest_finite(v[i])) return 0;
+    if (!bg_finite(v[i])) return 0;
   return 1;
 }
 
-int imest_tables_build(const imest_sums_t *in, double tr_nominal_s, imest_tables_t *t) {
-  if (!all_finite(&in->rw[0][0], 64) || !all_finite(in->rwy, 8) || !imest_finite(in->ry) || !(in->ry > 0.0)) {
-    imest_tables_scaled(in, 0, 0, 0, t); /* defined content; caller reports NUMERIC */
+int bg_tables_build(const bg_sums_t *in, double tr_nominal_s, bg_tables_t *t) {
+  if (!all_finite(&in->rw[0][0], 64) || !all_finite(in->rwy, 8) || !bg_finite(in->ry) || !(in->ry > 0.0)) {
+    bg_tables_scaled(in, 0, 0, 0, t); /* defined content; caller reports NUMERIC */
     return IMEST_REASON_NUMERIC;
   }
   /* s = 2^round(log2(1/T_R0)); a bad nominal falls back to 0.1 s (s = 8). */
-  const double trn = (imest_finite(tr_nominal_s) && tr_nominal_s > 1e-9 && tr_nominal_s < 1e9) ? tr_nominal_s : 0.1;
-  const int sx = imest_round_log2(1.0 / trn);
-  const int cexp = imest_round_log2(in->ry);
+  const double trn = (bg_finite(tr_nominal_s) && tr_nominal_s > 1e-9 && tr_nominal_s < 1e9) ? tr_nominal_s : 0.1;
+  const int sx = bg_round_log2(1.0 / trn);
+  const int cexp = bg_round_log2(in->ry);
 
   /* g from k^ = -sum(e1)/(2 sum(e2)) at kappa = 1 with g = 1; the g scaling
    * is then applied to e2 (g^2) and e1 (g) exactly, without a second pass. */
-  imest_tables_scaled(in, sx, 0, cexp, t);
+  bg_tables_scaled(in, sx, 0, cexp, t);
   double se1 = 0.0, se2 = 0.0;
   for (int m = 0; m < 7; ++m) se2 += t->e2[m];
   for (int m = 0; m < 8; ++m) se1 += t->e1[m];
   const double khat = -se1 / (2.0 * se2);
   int gexp = 0;
-  if (imest_finite(khat) && khat != 0.0) {
-    gexp = imest_round_log2(khat < 0.0 ? -khat : khat);
+  if (bg_finite(khat) && khat != 0.0) {
+    gexp = bg_round_log2(khat < 0.0 ? -khat : khat);
     if (gexp > 200) gexp = 200;
     if (gexp < -200) gexp = -200;
   }
   if (gexp != 0) {
     t->gexp = gexp;
-    t->g = imest_pow2(gexp);
-    const double g1 = t->g, g2 = imest_pow2(2 * gexp);
+    t->g = bg_pow2(gexp);
+    const double g1 = t->g, g2 = bg_pow2(2 * gexp);
     for (int m = 0; m < 7; ++m) t->e2[m] *= g2;
     for (int m = 0; m < 8; ++m) t->e1[m] *= g1;
     p_coefficients(t);
@@ -147,7 +116,7 @@ int imest_tables_build(const imest_sums_t *in, double tr_nominal_s, imest_tables
   return IMEST_OK;
 }
 
-void imest_tables_values(const imest_tables_t *t, double x, double v[3]) {
+void bg_tables_values(const bg_tables_t *t, double x, double v[3]) {
   double p2 = t->e2[6], p1 = t->e1[7], p0 = t->e0[8];
   p1 = p1 * x + t->e1[6];
   p0 = p0 * x + t->e0[7];
@@ -162,7 +131,7 @@ void imest_tables_values(const imest_tables_t *t, double x, double v[3]) {
   v[2] = p0;
 }
 
-void imest_tables_eval(const imest_tables_t *t, double kappa, imest_tabval_t *v) {
+void bg_tables_eval(const bg_tables_t *t, double kappa, bg_tabval_t *v) {
   /* Horner with first and second derivatives, one pass per table. */
   const double *tab[3] = {t->e2, t->e1, t->e0};
   static const int len[3] = {7, 8, 9};

@@ -4,7 +4,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "bg_internal.h"
+#include "bg_validity.h"
 
 static void result_clear(imest_result_t *r)
 {
@@ -33,22 +33,22 @@ int imest_background(imest_t *s, imest_result_t *out)
   out->rs_bound_rel = NAN;
 
   const double m = (double)s->m;
-  imest_sums_t sums;
-  imest_window_stats_t st;
-  imest_window_sums(w, m, (double)s->fs, &sums, &st);
+  bg_sums_t sums;
+  bg_window_stats_t st;
+  bg_window_sums(w, m, (double)s->fs, &sums, &st);
 
-  imest_solve_out_t so = {0};
+  bg_solve_out_t so = {0};
   so.status = IMEST_REASON_NUMERIC;
   so.tr_s = NAN;
   if (w->used >= 16u) {
-    imest_solve_cfg_t cfg = {0}; /* fields added later default to 0 */
+    bg_solve_cfg_t cfg = {0}; /* fields added later default to 0 */
     cfg.sigma = (double)s->sigma;
     cfg.ls_h = (double)s->ls_h;
     cfg.tr_nominal_s = (double)s->tr_nominal_s;
     cfg.tr_min_s = (double)s->tr_min_s;
     cfg.tr_max_s = (double)s->tr_max_s;
-    cfg.weight_c = imest_solve_weight_c(&sums); /* speed-normalised cost (bg_solve.h) */
-    (void)imest_solve(&sums, &cfg, &so);
+    cfg.weight_c = bg_solve_weight_c(&sums); /* speed-normalised cost (bg_solve.h) */
+    (void)bg_solve(&sums, &cfg, &so);
   }
 
   if (so.status == IMEST_OK) {
@@ -84,14 +84,14 @@ int imest_background(imest_t *s, imest_result_t *out)
   for (unsigned int k = 0; k < out->n_roots && k < IMEST_MAX_ROOTS; ++k) {
     out->roots_k2[k] = so.roots_k2[k];
   }
-  imest_judge(s, &st, &so, out);
+  bg_judge(s, &st, &so, out);
 
   /* centre later windows on the latest trusted estimate */
   if (out->valid) {
     s->last_k1 = (float)out->k1;
     s->last_k2 = (float)out->k2;
   }
-  if (s->last_k2 > 0.0f) imest_centre_from_k(w->c0, (double)s->last_k1, (double)s->last_k2, m);
+  if (s->last_k2 > 0.0f) bg_centre_from_k(w->c0, (double)s->last_k1, (double)s->last_k2, m);
   for (unsigned int p = 0; p < IMEST_NACC; ++p) {
     w->sum[p] = 0;
     w->blk[p] = 0;

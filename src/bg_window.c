@@ -5,14 +5,14 @@
  * R_ee) is passed on too, for E without cancellation (bg_select.c). */
 #include <math.h>
 
-#include "bg_internal.h"
+#include "bg_window.h"
 #include "isr_accumulate.h"
 
 /* 7-column index -> 8-column (K) index */
 static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
 
-void imest_window_sums(const imest_window_t *w, double m, double fs, imest_sums_t *out,
-                       imest_window_stats_t *st)
+void bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out,
+                       bg_window_stats_t *st)
 {
   double z[8][8];
   for (unsigned int i = 0; i < 8u; ++i) {
@@ -64,4 +64,16 @@ void imest_window_sums(const imest_window_t *w, double m, double fs, imest_sums_
   st->w_mean = (double)w->rot * fs / n;
   const double cross = (double)w->sum[36] + (double)w->blk[36];
   st->slip_rate = (r44 > 0.0) ? cross / r44 : 0.0;
+}
+
+/* Centring vector c0 (7-column form) for a given K1, K2 (docs/METHOD.md §2, §10). */
+void bg_centre_from_k(imest_real_t c0[7], double k1, double k2, double m)
+{
+  c0[0] = (imest_real_t)k1;
+  c0[1] = (imest_real_t)k2;
+  c0[2] = (imest_real_t)(k1 * k2 - m * k2 * k2); /* K4 - m K3 (column 3 folded into 4) */
+  c0[3] = (imest_real_t)(1.0 / k2);
+  c0[4] = (imest_real_t)(k1 / k2);
+  c0[5] = (imest_real_t)(k1 / (k2 * k2));
+  c0[6] = (imest_real_t)(1.0 / (k2 * k2));
 }

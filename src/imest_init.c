@@ -3,7 +3,10 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "bg_internal.h"
+#include "bg_window.h"
+
+#define IMEST_PI_D 3.14159265358979323846
+#define IMEST_SQRT2_D 1.41421356237309504880
 
 void imest_config_default(imest_config_t *cfg)
 {
@@ -127,18 +130,6 @@ static void design_aa(imest_sos_t *f, double fc, double fs)
   f->d2 = (imest_real_t)((1.0 - IMEST_SQRT2_D * k + k * k) / a0);
 }
 
-/* Centring vector c0 (7-column form) for a given K1, K2 (docs/METHOD.md §2, §10). */
-void imest_centre_from_k(imest_real_t c0[7], double k1, double k2, double m)
-{
-  c0[0] = (imest_real_t)k1;
-  c0[1] = (imest_real_t)k2;
-  c0[2] = (imest_real_t)(k1 * k2 - m * k2 * k2); /* K4 - m K3 (column 3 folded into 4) */
-  c0[3] = (imest_real_t)(1.0 / k2);
-  c0[4] = (imest_real_t)(k1 / k2);
-  c0[5] = (imest_real_t)(k1 / (k2 * k2));
-  c0[6] = (imest_real_t)(1.0 / (k2 * k2));
-}
-
 int imest_init(imest_t *s, const imest_config_t *cfg)
 {
   if (s == NULL || cfg == NULL) return IMEST_ERR_NULL;
@@ -210,8 +201,8 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
    * a close one only improves float32 precision) */
   const double k2 = 1.0 / (double)cfg->tr_nominal_s;
   const double k1 = m * k2;
-  imest_centre_from_k(s->win[0].c0, k1, k2, m);
-  imest_centre_from_k(s->win[1].c0, k1, k2, m);
+  bg_centre_from_k(s->win[0].c0, k1, k2, m);
+  bg_centre_from_k(s->win[1].c0, k1, k2, m);
   s->win[0].flags = s->warm ? IMEST_FLAG_WARMUP : 0u;
   return IMEST_OK;
 }

@@ -7,18 +7,12 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "bg_solve.h"
+#include "bg_solve.h" /* with bg_bounds.h: BG_SOLVE_WORK_BOUND, the one definition */
 
-/* Iteration bound of one solve, from src/bg_solve.c: roots <= 2 x (2 + 1024 +
- * 20 x 48) Sturm evaluations + 2 x 20 x 48 bisection steps + 2 x 20 x 99
- * polish evaluations; quality <= 2 x 80 x 41 + 2 x 61 evaluations. */
-#define IMEST_SOLVE_WORK_BOUND (2u * (2u + 1024u + 20u * 48u) + 2u * 20u * 48u + 2u * 20u * 99u + \
-                                2u * 80u * 41u + 2u * 61u)
-
-/* NULL if out (returned as rc by imest_solve for cfg) has the property, else
+/* NULL if out (returned as rc by bg_solve for cfg) has the property, else
  * what is wrong. */
-static inline const char *imest_solve_property(int rc, const imest_solve_cfg_t *cfg,
-                                               const imest_solve_out_t *out)
+static inline const char *solve_property(int rc, const bg_solve_cfg_t *cfg,
+                                               const bg_solve_out_t *out)
 {
   if (rc != out->status) return "return value differs from out->status";
   if (!(rc == IMEST_OK || rc == IMEST_REASON_NUMERIC || rc == IMEST_REASON_NO_ROOT || rc == IMEST_ERR_CONFIG ||
@@ -26,7 +20,7 @@ static inline const char *imest_solve_property(int rc, const imest_solve_cfg_t *
     return "status is not one of OK, NUMERIC, NO_ROOT, ERR_CONFIG, ERR_NULL";
   if (out->n_roots > IMEST_MAX_ROOTS) return "n_roots > IMEST_MAX_ROOTS";
   if (out->n_admissible > out->n_roots) return "n_admissible > n_roots";
-  if (out->work > IMEST_SOLVE_WORK_BOUND) return "work beyond the documented iteration bound";
+  if (out->work > BG_SOLVE_WORK_BOUND) return "work beyond the documented iteration bound";
   for (unsigned int k = 0; k < out->n_roots; ++k) {
     if (!(isfinite(out->roots_k2[k]) && out->roots_k2[k] > 0.0)) return "a root is not finite and positive";
     if (k > 0 && !(out->roots_k2[k] >= out->roots_k2[k - 1])) return "roots not ascending";

@@ -1,4 +1,4 @@
-// The background solve (internal imest_solve) on 20 000 seeded random windows
+// The background solve (internal bg_solve) on 20 000 seeded random windows
 // of sums: raw bit patterns (NaN, Inf, denormal, huge), special values, and
 // structured sums R = sum W'W from random W (full rank, rank deficient, scaled
 // by 1e+-30, sign flips, one entry poisoned, random motor constants and
@@ -61,8 +61,8 @@ void kvec(double k1, double k2, double K[8]) {
 // R_W, R_Wy, R_y from `rows` random rows of W (column 2 = -m column 3, as the
 // solve expects), y = W K(k1, k2) + noise. rank < 8: W built from that many
 // random directions only.
-imest_sums_t structured(Gen &g, int rows, int rank, double noise, double m) {
-  imest_sums_t s{};
+bg_sums_t structured(Gen &g, int rows, int rank, double noise, double m) {
+  bg_sums_t s{};
   double colscale[8], basis[8][8];
   for (int j = 0; j < 8; ++j) colscale[j] = std::pow(10.0, g.uni(-3, 3));
   for (int r = 0; r < 8; ++r)
@@ -90,14 +90,14 @@ imest_sums_t structured(Gen &g, int rows, int rank, double noise, double m) {
   return s;
 }
 
-double *entry(imest_sums_t &s, int k) {  // 0..72
+double *entry(bg_sums_t &s, int k) {  // 0..72
   if (k < 64) return &s.rw[k / 8][k % 8];
   if (k < 72) return &s.rwy[k - 64];
   return &s.ry;
 }
 
-imest_solve_cfg_t default_cfg() {
-  imest_solve_cfg_t c{};
+bg_solve_cfg_t default_cfg() {
+  bg_solve_cfg_t c{};
   c.sigma = 0.096;
   c.ls_h = 0.2908;
   c.tr_nominal_s = 0.1;
@@ -106,7 +106,7 @@ imest_solve_cfg_t default_cfg() {
   return c;
 }
 
-std::string hexdump(const imest_sums_t &s, const imest_solve_cfg_t &c) {
+std::string hexdump(const bg_sums_t &s, const bg_solve_cfg_t &c) {
   std::string o;
   char b[64];
   const double *p = &s.rw[0][0];
@@ -130,8 +130,8 @@ TEST(SolveRandom, PropertyHoldsOn20000SeededCases) {
   int failures = 0, by_status[32] = {0};
   unsigned int max_work = 0;
   for (int n = 0; n < kCases && failures < 5; ++n) {
-    imest_sums_t s{};
-    imest_solve_cfg_t cfg = default_cfg();
+    bg_sums_t s{};
+    bg_solve_cfg_t cfg = default_cfg();
     const int kind = n % 8;
     switch (kind) {
       case 0:  // raw bit patterns
@@ -177,10 +177,10 @@ TEST(SolveRandom, PropertyHoldsOn20000SeededCases) {
         break;
       }
     }
-    imest_solve_out_t out;
+    bg_solve_out_t out;
     std::memset(&out, 0xA5, sizeof out);  // garbage in: the solve must set what it reports
-    const int rc = imest_solve(&s, &cfg, &out);
-    const char *bad = imest_solve_property(rc, &cfg, &out);
+    const int rc = bg_solve(&s, &cfg, &out);
+    const char *bad = solve_property(rc, &cfg, &out);
     if (rc >= 0 && rc < 32) by_status[rc]++;
     if (out.work > max_work) max_work = out.work;
     if (bad != nullptr) {
@@ -191,17 +191,17 @@ TEST(SolveRandom, PropertyHoldsOn20000SeededCases) {
   }
   std::printf("[ solve    ] %d cases: ok %d, numeric %d, no_root %d, config %d; most work %u of %u\n", kCases,
               by_status[IMEST_OK], by_status[IMEST_REASON_NUMERIC], by_status[IMEST_REASON_NO_ROOT],
-              by_status[IMEST_ERR_CONFIG], max_work, (unsigned)IMEST_SOLVE_WORK_BOUND);
+              by_status[IMEST_ERR_CONFIG], max_work, (unsigned)BG_SOLVE_WORK_BOUND);
   // the structured cases must reach the OK branch often, or the property is vacuous
   EXPECT_GT(by_status[IMEST_OK], kCases / 8);
 }
 
 // NULL arguments: an error status, no crash.
 TEST(SolveRandom, NullArguments) {
-  imest_sums_t s{};
-  imest_solve_cfg_t cfg = default_cfg();
-  imest_solve_out_t out;
-  EXPECT_EQ(imest_solve(nullptr, &cfg, &out), IMEST_ERR_NULL);
-  EXPECT_EQ(imest_solve(&s, nullptr, &out), IMEST_ERR_NULL);
-  EXPECT_NE(imest_solve(&s, &cfg, nullptr), IMEST_OK);
+  bg_sums_t s{};
+  bg_solve_cfg_t cfg = default_cfg();
+  bg_solve_out_t out;
+  EXPECT_EQ(bg_solve(nullptr, &cfg, &out), IMEST_ERR_NULL);
+  EXPECT_EQ(bg_solve(&s, nullptr, &out), IMEST_ERR_NULL);
+  EXPECT_NE(bg_solve(&s, &cfg, nullptr), IMEST_OK);
 }

@@ -1,4 +1,4 @@
-// imest-bench-solve: microseconds per imest_solve on the testvector (not a
+// imest-bench-solve: microseconds per bg_solve on the testvector (not a
 // test; prints figures). Usage: imest-bench-solve [repetitions]
 #include <chrono>
 #include <cstdio>
@@ -7,41 +7,45 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bg_poly.h"
+#include "bg_quality.h"
+#include "bg_resultant.h"
+#include "bg_roots.h"
+#include "bg_select.h"
+#include "bg_tables.h"
 
 int main(int argc, char **argv) {
   const long reps = (argc > 1) ? std::atol(argv[1]) : 20000;
   std::ifstream f(IMEST_TESTVECTOR);
   const auto j = nlohmann::json::parse(f);
-  imest_sums_t s{};
+  bg_sums_t s{};
   for (int i = 0; i < 8; ++i) {
     for (int k = 0; k < 8; ++k) s.rw[i][k] = j["R_W"][i][k].get<double>();
     s.rwy[i] = j["R_Wy"][i].get<double>();
   }
   s.ry = j["R_y"].get<double>();
-  imest_solve_cfg_t cfg{};
+  bg_solve_cfg_t cfg{};
   cfg.sigma = 0.096;
   cfg.ls_h = 0.2908;
   cfg.tr_nominal_s = 0.1;
   cfg.tr_min_s = 1e-3;
   cfg.tr_max_s = 10;
-  imest_solve_out_t o{};
-  imest_solve_stats_t st{};
+  bg_solve_out_t o{};
+  bg_solve_stats_t st{};
   volatile double sink = 0;
-  (void)imest_solve_ex(&s, &cfg, &o, &st);
+  (void)bg_solve_ex(&s, &cfg, &o, &st);
   const auto t0 = std::chrono::steady_clock::now();
   for (long i = 0; i < reps; ++i) {
-    (void)imest_solve(&s, &cfg, &o);
+    (void)bg_solve(&s, &cfg, &o);
     sink = sink + o.tr_s;
   }
   const auto t1 = std::chrono::steady_clock::now();
   const double us = std::chrono::duration<double, std::micro>(t1 - t0).count() / (double)reps;
-#ifdef IMEST_ROOTS_DOUBLE
+#ifdef BG_ROOTS_DOUBLE
   const char *chain = "float64";
 #else
   const char *chain = "float32";
 #endif
-  std::printf("imest_solve (%s Sturm chain): %.2f us per solve over %ld repetitions; T_R = %.9g s\n", chain, us,
+  std::printf("bg_solve (%s Sturm chain): %.2f us per solve over %ld repetitions; T_R = %.9g s\n", chain, us,
               reps, o.tr_s);
   std::printf("roots %u, work %u (Sturm %u, bisect %u, polish %u, quality %u); no allocation\n", o.n_roots, o.work,
               st.roots.sturm_evals, st.roots.bisect_steps, st.roots.polish_evals, st.quality_evals);

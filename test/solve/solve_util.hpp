@@ -11,7 +11,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "bg_poly.h"
+#include "bg_quality.h"
+#include "bg_resultant.h"
+#include "bg_roots.h"
+#include "bg_select.h"
+#include "bg_tables.h"
 
 #ifndef IMEST_TESTVECTOR
 #define IMEST_TESTVECTOR "test/data/testvector.json"
@@ -30,9 +34,9 @@ inline const nlohmann::json &testvector() {
   return j;
 }
 
-inline imest_sums_t tv_sums() {
+inline bg_sums_t tv_sums() {
   const auto &j = testvector();
-  imest_sums_t s{};
+  bg_sums_t s{};
   for (int i = 0; i < 8; ++i) {
     for (int k = 0; k < 8; ++k) s.rw[i][k] = j["R_W"][i][k].get<double>();
     s.rwy[i] = j["R_Wy"][i].get<double>();
@@ -41,8 +45,8 @@ inline imest_sums_t tv_sums() {
   return s;
 }
 
-inline imest_solve_cfg_t default_cfg(double sigma = 0.096, double ls = 0.2908) {
-  imest_solve_cfg_t c{};
+inline bg_solve_cfg_t default_cfg(double sigma = 0.096, double ls = 0.2908) {
+  bg_solve_cfg_t c{};
   c.sigma = sigma;
   c.ls_h = ls;
   c.tr_nominal_s = 0.1;
@@ -64,7 +68,7 @@ inline void kvec(long double k1, long double k2, long double K[8]) {
 }
 
 // E_p^2 = R_y - 2 R_Wy'K + K'R_W K in long double (independent of the e-tables).
-inline long double e_ref(const imest_sums_t &s, long double k1, long double k2) {
+inline long double e_ref(const bg_sums_t &s, long double k1, long double k2) {
   long double K[8];
   kvec(k1, k2, K);
   long double e = s.ry;
@@ -76,7 +80,7 @@ inline long double e_ref(const imest_sums_t &s, long double k1, long double k2) 
 }
 
 // Exact K1 minimiser of E for fixed K2: E = A K1^2 + B K1 + C.
-inline long double k1_opt_ref(const imest_sums_t &s, long double k2, long double *profile = nullptr) {
+inline long double k1_opt_ref(const bg_sums_t &s, long double k2, long double *profile = nullptr) {
   const long double u[8] = {0, k2, k2 * k2, 0, 1 / k2, 0, 0, 1 / (k2 * k2)};
   const long double v[8] = {1, 0, 0, k2, 0, 1 / k2, 1 / (k2 * k2), 0};
   long double vRv = 0, vRu = 0, gv = 0;
@@ -133,7 +137,7 @@ inline void regressor(const Motor &mo, const Sample &q, double W[2][8]) {
 // Random but realistic window: signals are sums of a few random sinusoids with
 // amplitudes typical of a 30..60 Hz drive (currents ~2 A, voltages ~150 V,
 // speed ~100..180 rad/s); y = W K_true + relative noise. Sums in float64.
-inline imest_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double noise_rel, int nsamp = 2000) {
+inline bg_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double noise_rel, int nsamp = 2000) {
   std::uniform_real_distribution<double> U(0, 1);
   const double fs = 4000.0;
   struct Sin {
@@ -157,7 +161,7 @@ inline imest_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double
   };
   long double K[8];
   kvec(mo.k1(), mo.k2(), K);
-  imest_sums_t S{};
+  bg_sums_t S{};
   std::normal_distribution<double> N(0, 1);
   for (int n = 0; n < nsamp; ++n) {
     const double t = n / fs;
@@ -195,7 +199,7 @@ inline imest_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double
 // coefficient 1 and W.8 with -n^2 w^2 (docs/METHOD.md §9: the cause of the paper's
 // spurious minimum at K2 ~ n_p w). steady: nearly constant speed and slowly
 // varying rotor-frame currents (a loaded steady state), else synthetic_sums'.
-inline imest_sums_t eiv_sums(std::mt19937_64 &rng, const Motor &mo, double d2_noise_rel, int nsamp = 2000,
+inline bg_sums_t eiv_sums(std::mt19937_64 &rng, const Motor &mo, double d2_noise_rel, int nsamp = 2000,
                              bool steady = false) {
   std::uniform_real_distribution<double> U(0, 1);
   const double fs = 4000.0;
@@ -229,7 +233,7 @@ inline imest_sums_t eiv_sums(std::mt19937_64 &rng, const Motor &mo, double d2_no
   d2rms = std::sqrt(d2rms / (2.0 * nsamp));
   long double K[8];
   kvec(mo.k1(), mo.k2(), K);
-  imest_sums_t S{};
+  bg_sums_t S{};
   std::normal_distribution<double> N(0, 1);
   for (int n = 0; n < nsamp; ++n) {
     const double t = n / fs;

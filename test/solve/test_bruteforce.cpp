@@ -32,7 +32,7 @@ long double wgt(long double k2, double c) {
   return k2 * k2 * k2 * k2 / (d * d);
 }
 
-Bf brute_force(const imest_sums_t &s, const imest_solve_cfg_t &cfg) {
+Bf brute_force(const bg_sums_t &s, const bg_solve_cfg_t &cfg) {
   const double wc = cfg.weight_c;
   const int N = 20000;
   const double lo = std::log(1 / cfg.tr_max_s), hi = std::log(1 / cfg.tr_min_s);
@@ -80,13 +80,13 @@ Bf brute_force(const imest_sums_t &s, const imest_solve_cfg_t &cfg) {
   return {true, (double)k1, (double)k2, (double)(e * wgt(k2, wc))};
 }
 
-int companion_roots_in_band(const imest_sums_t &s, const imest_solve_cfg_t &cfg) {
-  imest_tables_t t;
-  if (imest_tables_build(&s, cfg.tr_nominal_s, &t) != IMEST_OK) return -1;
-  if (cfg.weight_c > 0) imest_tables_weight(&t, cfg.weight_c);
+int companion_roots_in_band(const bg_sums_t &s, const bg_solve_cfg_t &cfg) {
+  bg_tables_t t;
+  if (bg_tables_build(&s, cfg.tr_nominal_s, &t) != IMEST_OK) return -1;
+  if (cfg.weight_c > 0) bg_tables_weight(&t, cfg.weight_c);
   double r[22];
-  imest_resultant(&t, r, 0);
-  int hi = IMEST_RES_DEG;
+  bg_resultant(&t, r, 0);
+  int hi = BG_RES_DEG;
   while (hi > 0 && r[hi] == 0) --hi;
   Eigen::VectorXd c(hi + 1);
   for (int k = 0; k <= hi; ++k) c[k] = r[k];
@@ -103,10 +103,10 @@ int companion_roots_in_band(const imest_sums_t &s, const imest_solve_cfg_t &cfg)
   return n;
 }
 
-void check_case(const imest_sums_t &s, const imest_solve_cfg_t &cfg, const char *name, int *skipped,
+void check_case(const bg_sums_t &s, const bg_solve_cfg_t &cfg, const char *name, int *skipped,
                 double *worst_k2, double *worst_e) {
-  imest_solve_out_t o;
-  const int st = imest_solve(&s, &cfg, &o);
+  bg_solve_out_t o;
+  const int st = bg_solve(&s, &cfg, &o);
   const Bf bf = brute_force(s, cfg);
   // roots in band: Sturm (float32 or float64 chain) == companion
   unsigned in_band = 0;
@@ -149,13 +149,13 @@ TEST(BruteForce, RealisticRandomSums) {
     mo.tr = 0.05 + 0.45 * U(rng);
     mo.rs = 1 + 9 * U(rng);
     const double noise = std::pow(10.0, -4 + 3 * U(rng));
-    const imest_sums_t s = synthetic_sums(rng, mo, noise, 1000);
-    const imest_solve_cfg_t cfg = default_cfg(mo.sigma, mo.ls);
+    const bg_sums_t s = synthetic_sums(rng, mo, noise, 1000);
+    const bg_solve_cfg_t cfg = default_cfg(mo.sigma, mo.ls);
     char name[64];
     std::snprintf(name, sizeof name, "case %d (T_R %.3f, noise %.1e)", it, mo.tr, noise);
     check_case(s, cfg, name, &skipped, &wk, &we);
-    imest_solve_out_t o;
-    if (imest_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
+    bg_solve_out_t o;
+    if (bg_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
     ++n;
   }
   std::printf("[brute-force] %d realistic windows: %d skipped (minimum at band edge / K1 boundary), worst K2 rel "
@@ -178,15 +178,15 @@ TEST(BruteForce, WeightedCostRealisticRandomSums) {
     mo.tr = 0.05 + 0.45 * U(rng);
     mo.rs = 1 + 9 * U(rng);
     const double noise = std::pow(10.0, -4 + 3 * U(rng));
-    const imest_sums_t s = it % 2 ? synthetic_sums(rng, mo, noise, 1000) : eiv_sums(rng, mo, 0.3 * noise, 1000);
-    imest_solve_cfg_t cfg = default_cfg(mo.sigma, mo.ls);
-    cfg.weight_c = imest_solve_weight_c(&s);
+    const bg_sums_t s = it % 2 ? synthetic_sums(rng, mo, noise, 1000) : eiv_sums(rng, mo, 0.3 * noise, 1000);
+    bg_solve_cfg_t cfg = default_cfg(mo.sigma, mo.ls);
+    cfg.weight_c = bg_solve_weight_c(&s);
     ASSERT_GT(cfg.weight_c, 0.0);
     char name[80];
     std::snprintf(name, sizeof name, "weighted case %d (T_R %.3f, noise %.1e, c %.3g)", it, mo.tr, noise, cfg.weight_c);
     check_case(s, cfg, name, &skipped, &wk, &we);
-    imest_solve_out_t o;
-    if (imest_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
+    bg_solve_out_t o;
+    if (bg_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
     ++n;
   }
   std::printf("[brute-force, weighted] %d realistic windows: %d skipped, worst K2 rel diff %.2g, worst E_w rel diff "
@@ -207,12 +207,12 @@ TEST(WeightedCost, ErrorsInVariablesPullThePapersMinimumTowardsSmallTR) {
   double worst_w = 0;
   for (int it = 0; it < 20; ++it) {
     Motor mo;
-    const imest_sums_t s = eiv_sums(rng, mo, 100.0, 2000, /*steady=*/true);
-    imest_solve_cfg_t cfg = default_cfg(mo.sigma, mo.ls);
-    imest_solve_out_t op, ow;
-    const int sp = imest_solve(&s, &cfg, &op);
-    cfg.weight_c = imest_solve_weight_c(&s);
-    const int sw = imest_solve(&s, &cfg, &ow);
+    const bg_sums_t s = eiv_sums(rng, mo, 100.0, 2000, /*steady=*/true);
+    bg_solve_cfg_t cfg = default_cfg(mo.sigma, mo.ls);
+    bg_solve_out_t op, ow;
+    const int sp = bg_solve(&s, &cfg, &op);
+    cfg.weight_c = bg_solve_weight_c(&s);
+    const int sw = bg_solve(&s, &cfg, &ow);
     if (n < 3)
       std::printf("[weighted] case %d: n_p w %.1f 1/s; paper T_R %.5f s, weighted T_R %.5f s (true %.3f)\n", it,
                   std::sqrt(cfg.weight_c), op.tr_s, ow.tr_s, mo.tr);

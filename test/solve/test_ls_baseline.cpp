@@ -10,7 +10,7 @@
 #include "solve_util.hpp"
 
 TEST(LsBaseline, ConstrainedBeatsOverParameterisedLs) {
-  const imest_sums_t s = solvetest::tv_sums();
+  const bg_sums_t s = solvetest::tv_sums();
   const int cols[7] = {0, 1, 3, 4, 5, 6, 7};
   Eigen::MatrixXd A(7, 7);
   Eigen::VectorXd b(7), d(7);
@@ -25,9 +25,9 @@ TEST(LsBaseline, ConstrainedBeatsOverParameterisedLs) {
   const Eigen::VectorXd x = z.cwiseProduct(d);  // K1, K2, K4..K8 (K3 folded into K4)
   const double tr_ls = 1 / x[1], tr_ls_k5 = x[3];
   const Eigen::VectorXd sv = svd.singularValues();
-  imest_solve_out_t o;
-  const imest_solve_cfg_t cfg = solvetest::default_cfg();
-  ASSERT_EQ(imest_solve(&s, &cfg, &o), IMEST_OK);
+  bg_solve_out_t o;
+  const bg_solve_cfg_t cfg = solvetest::default_cfg();
+  ASSERT_EQ(bg_solve(&s, &cfg, &o), IMEST_OK);
   std::printf("[ls-baseline] cond (column-scaled, 7 columns) %.3g; LS T_R = 1/K2 = %.6g s (K5 = %.6g s); "
               "constrained T_R = %.6g s; true 0.12 s\n",
               sv[0] / sv[6], tr_ls, tr_ls_k5, o.tr_s);

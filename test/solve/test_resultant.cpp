@@ -10,9 +10,9 @@
 
 namespace {
 
-double R(const imest_sums_t &s, int i, int j) { return s.rw[i - 1][j - 1]; }
+double R(const bg_sums_t &s, int i, int j) { return s.rw[i - 1][j - 1]; }
 
-imest_sums_t random_psd(std::mt19937_64 &rng, bool structured, double m) {
+bg_sums_t random_psd(std::mt19937_64 &rng, bool structured, double m) {
   std::normal_distribution<double> N(0, 1);
   double A[12][8];
   for (auto &row : A)
@@ -21,7 +21,7 @@ imest_sums_t random_psd(std::mt19937_64 &rng, bool structured, double m) {
     for (auto &row : A) row[2] = -m * row[3];
   double y[12];
   for (double &v : y) v = N(rng);
-  imest_sums_t s{};
+  bg_sums_t s{};
   for (int i = 0; i < 8; ++i) {
     for (int j = 0; j < 8; ++j)
       for (int k = 0; k < 12; ++k) s.rw[i][j] += A[k][i] * A[k][j];
@@ -36,11 +36,11 @@ imest_sums_t random_psd(std::mt19937_64 &rng, bool structured, double m) {
 TEST(Resultant, GenericDegree20) {
   std::mt19937_64 rng(7);
   for (int it = 0; it < 500; ++it) {
-    const imest_sums_t s = random_psd(rng, false, 0);
-    imest_tables_t t;
-    imest_tables_scaled(&s, 0, 0, 0, &t);
+    const bg_sums_t s = random_psd(rng, false, 0);
+    bg_tables_t t;
+    bg_tables_scaled(&s, 0, 0, 0, &t);
     double rw[22];
-    imest_resultant(&t, rw, 1);
+    bg_resultant(&t, rw, 1);
     EXPECT_EQ(rw[0], 0.0);  // weight 0: r_w = kappa r
     const double *r = rw + 1;
     double mag = 0;
@@ -53,13 +53,13 @@ TEST(Resultant, GenericDegree20) {
     EXPECT_LE(r[0], 1e-12 * mag);
     // generic flag keeps r[19], r[20]; the regressor flag zeroes them
     double r18[22];
-    imest_resultant(&t, r18, 0);
+    bg_resultant(&t, r18, 0);
     EXPECT_EQ(r18[20], 0.0);
     EXPECT_EQ(r18[21], 0.0);
     for (int k = 0; k < 20; ++k) EXPECT_EQ(r18[k], rw[k]);
     // r(0) < 0 and lead > 0 => at least one positive root, found
     double roots[20];
-    const int n = imest_poly_positive_roots(r, 20, roots, 20);
+    const int n = bg_roots_positive(r, 20, roots, 20);
     EXPECT_GE(n, 1) << it;
   }
 }
@@ -68,11 +68,11 @@ TEST(Resultant, StructuredDegree18) {
   std::mt19937_64 rng(11);
   const double m = (1 - 0.096) / 0.096;
   for (int it = 0; it < 500; ++it) {
-    const imest_sums_t s = random_psd(rng, true, m);
-    imest_tables_t t;
-    imest_tables_scaled(&s, 0, 0, 0, &t);
+    const bg_sums_t s = random_psd(rng, true, m);
+    bg_tables_t t;
+    bg_tables_scaled(&s, 0, 0, 0, &t);
     double rw[22];
-    imest_resultant(&t, rw, 1);
+    bg_resultant(&t, rw, 1);
     const double *r = rw + 1;
     double mag = 0;
     for (int k = 0; k < 21; ++k) mag = std::max(mag, std::fabs(r[k]));
@@ -89,7 +89,7 @@ TEST(Resultant, StructuredDegree18) {
   }
 }
 
-// Weighted cost (bg_poly.h): r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0 with
+// Weighted cost (bg_tables.h): r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0 with
 // bw_t = kappa b_t + cw t'. For this regressor r_w[21] and r_w[20] vanish for
 // any cw (the K2^19 coefficient of the cw part is 8 e2[6] (4 e2[6] e0[8] -
 // e1[7]^2) = 32 R44 (R33 R44 - R34^2) = 0) and r_w[19] = r[18] (cw-free).
@@ -100,16 +100,16 @@ TEST(Resultant, WeightedStructuredDegree19) {
   std::uniform_real_distribution<double> U(0, 1);
   const double m = (1 - 0.096) / 0.096;
   for (int it = 0; it < 300; ++it) {
-    const imest_sums_t s = random_psd(rng, true, m);
-    imest_tables_t t;
-    imest_tables_scaled(&s, 0, 0, 0, &t);
+    const bg_sums_t s = random_psd(rng, true, m);
+    bg_tables_t t;
+    bg_tables_scaled(&s, 0, 0, 0, &t);
     double r0[22];
-    imest_resultant(&t, r0, 1);
+    bg_resultant(&t, r0, 1);
     const double cw = std::pow(10.0, -2 + 4 * U(rng));
-    imest_tables_weight(&t, cw);
+    bg_tables_weight(&t, cw);
     EXPECT_EQ(t.cw, cw);
     double r[22];
-    imest_resultant(&t, r, 1);
+    bg_resultant(&t, r, 1);
     double mag = 0;
     for (double v : r) mag = std::max(mag, std::fabs(v));
     EXPECT_LE(std::fabs(r[21]), 1e-12 * mag) << it;

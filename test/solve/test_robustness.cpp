@@ -1,8 +1,8 @@
-// Robustness of imest_solve: random and garbage sums (zeros, NaN, Inf, huge,
+// Robustness of bg_solve: random and garbage sums (zeros, NaN, Inf, huge,
 // tiny, negative definite, rank 1, indefinite, unstructured), bad configs.
-// imest_solve must always return, with a known status, and never report a
+// bg_solve must always return, with a known status, and never report a
 // non-finite or out-of-band estimate with IMEST_OK. The iteration bound
-// (out->work <= IMEST_SOLVE_WORK_BOUND and the per-stage bounds) is asserted
+// (out->work <= BG_SOLVE_WORK_BOUND and the per-stage bounds) is asserted
 // on every case, and on realistic synthetic windows.
 #include <gtest/gtest.h>
 
@@ -17,19 +17,19 @@ namespace {
 
 unsigned max_work = 0;
 
-void check(const imest_sums_t &s, const imest_solve_cfg_t &cfg, const char *what, int *n_ok) {
-  imest_solve_out_t o;
-  imest_solve_stats_t st;
-  const int rc = imest_solve_ex(&s, &cfg, &o, &st);
+void check(const bg_sums_t &s, const bg_solve_cfg_t &cfg, const char *what, int *n_ok) {
+  bg_solve_out_t o;
+  bg_solve_stats_t st;
+  const int rc = bg_solve_ex(&s, &cfg, &o, &st);
   EXPECT_EQ(rc, o.status) << what;
   EXPECT_TRUE(rc == IMEST_OK || rc == IMEST_REASON_NUMERIC || rc == IMEST_REASON_NO_ROOT) << what << " rc " << rc;
   EXPECT_LE(o.n_roots, (unsigned)IMEST_MAX_ROOTS);
   EXPECT_LE(o.n_admissible, o.n_roots);
-  EXPECT_LE(st.roots.sturm_evals, IMEST_ROOTS_BOUND_STURM) << what;
-  EXPECT_LE(st.roots.bisect_steps, IMEST_ROOTS_BOUND_BISECT) << what;
-  EXPECT_LE(st.roots.polish_evals, IMEST_ROOTS_BOUND_POLISH) << what;
-  EXPECT_LE(st.quality_evals, IMEST_QUALITY_BOUND) << what;
-  EXPECT_LE(o.work, IMEST_SOLVE_WORK_BOUND) << what;
+  EXPECT_LE(st.roots.sturm_evals, BG_ROOTS_BOUND_STURM) << what;
+  EXPECT_LE(st.roots.bisect_steps, BG_ROOTS_BOUND_BISECT) << what;
+  EXPECT_LE(st.roots.polish_evals, BG_ROOTS_BOUND_POLISH) << what;
+  EXPECT_LE(st.quality_evals, BG_QUALITY_BOUND) << what;
+  EXPECT_LE(o.work, BG_SOLVE_WORK_BOUND) << what;
   max_work = std::max(max_work, o.work);
   if (rc != IMEST_OK) return;
   ++*n_ok;
@@ -49,8 +49,8 @@ void check(const imest_sums_t &s, const imest_solve_cfg_t &cfg, const char *what
   }
 }
 
-imest_sums_t fill(double v) {
-  imest_sums_t s;
+bg_sums_t fill(double v) {
+  bg_sums_t s;
   for (auto &r : s.rw)
     for (double &x : r) x = v;
   for (double &x : s.rwy) x = v;
@@ -61,7 +61,7 @@ imest_sums_t fill(double v) {
 }  // namespace
 
 TEST(Robustness, GarbageSums) {
-  const imest_solve_cfg_t cfg = default_cfg();
+  const bg_solve_cfg_t cfg = default_cfg();
   std::mt19937_64 rng(99);
   std::normal_distribution<double> N(0, 1);
   std::uniform_real_distribution<double> U(0, 1);
@@ -72,9 +72,9 @@ TEST(Robustness, GarbageSums) {
     check(fill(v), cfg, "constant", &n_ok);
     ++n;
   }
-  const imest_sums_t tv = tv_sums();
+  const bg_sums_t tv = tv_sums();
   for (int it = 0; it < 3000; ++it) {
-    imest_sums_t s = tv;
+    bg_sums_t s = tv;
     const int kind = it % 10;
     char what[64];
     std::snprintf(what, sizeof what, "kind %d case %d", kind, it);
@@ -137,7 +137,7 @@ TEST(Robustness, GarbageSums) {
     ++n;
   }
   std::printf("[robustness] %d garbage cases: %d returned IMEST_OK (all finite, in band); max work %u (bound %u)\n", n,
-              n_ok, max_work, IMEST_SOLVE_WORK_BOUND);
+              n_ok, max_work, BG_SOLVE_WORK_BOUND);
 }
 
 TEST(Robustness, RealisticWindowsAndBounds) {
@@ -147,7 +147,7 @@ TEST(Robustness, RealisticWindowsAndBounds) {
   for (int it = 0; it < 200; ++it) {
     Motor mo;
     mo.tr = 0.03 + 0.7 * U(rng);
-    const imest_sums_t s = synthetic_sums(rng, mo, std::pow(10.0, -5 + 4 * U(rng)), 400);
+    const bg_sums_t s = synthetic_sums(rng, mo, std::pow(10.0, -5 + 4 * U(rng)), 400);
     check(s, default_cfg(mo.sigma, mo.ls), "synthetic", &n_ok);
   }
   EXPECT_GE(n_ok, 150);
@@ -155,27 +155,27 @@ TEST(Robustness, RealisticWindowsAndBounds) {
 }
 
 TEST(Robustness, BadArguments) {
-  const imest_sums_t s = tv_sums();
-  imest_solve_cfg_t cfg = default_cfg();
-  imest_solve_out_t o;
-  EXPECT_EQ(imest_solve(nullptr, &cfg, &o), IMEST_ERR_NULL);
-  EXPECT_EQ(imest_solve(&s, nullptr, &o), IMEST_ERR_NULL);
-  EXPECT_EQ(imest_solve(&s, &cfg, nullptr), IMEST_ERR_NULL);
+  const bg_sums_t s = tv_sums();
+  bg_solve_cfg_t cfg = default_cfg();
+  bg_solve_out_t o;
+  EXPECT_EQ(bg_solve(nullptr, &cfg, &o), IMEST_ERR_NULL);
+  EXPECT_EQ(bg_solve(&s, nullptr, &o), IMEST_ERR_NULL);
+  EXPECT_EQ(bg_solve(&s, &cfg, nullptr), IMEST_ERR_NULL);
   cfg.tr_min_s = 1;
   cfg.tr_max_s = 0.5;
-  EXPECT_EQ(imest_solve(&s, &cfg, &o), IMEST_ERR_CONFIG);
+  EXPECT_EQ(bg_solve(&s, &cfg, &o), IMEST_ERR_CONFIG);
   cfg = default_cfg();
   cfg.sigma = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(imest_solve(&s, &cfg, &o), IMEST_ERR_CONFIG);
+  EXPECT_EQ(bg_solve(&s, &cfg, &o), IMEST_ERR_CONFIG);
   cfg = default_cfg();
   cfg.tr_nominal_s = -1;  // falls back to 0.1 s: still solves
-  EXPECT_EQ(imest_solve(&s, &cfg, &o), IMEST_OK);
+  EXPECT_EQ(bg_solve(&s, &cfg, &o), IMEST_OK);
   EXPECT_EQ(o.scale_s, 8.0);
   // a band that excludes every root: NO_ROOT, outputs NaN, no crash
   cfg = default_cfg();
   cfg.tr_min_s = 0.2;
   cfg.tr_max_s = 0.3;
-  EXPECT_EQ(imest_solve(&s, &cfg, &o), IMEST_REASON_NO_ROOT);
+  EXPECT_EQ(bg_solve(&s, &cfg, &o), IMEST_REASON_NO_ROOT);
   EXPECT_EQ(o.n_roots, 3u);
   EXPECT_EQ(o.n_admissible, 0u);
   EXPECT_TRUE(std::isnan(o.tr_s));

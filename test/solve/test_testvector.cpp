@@ -13,7 +13,7 @@
 // With weight_c = 0 the solve minimises the paper's cost: the weighted
 // p2w = kappa p2 (bw_t[m+1] = b_t[m]) and r_w = kappa r, checked here.
 // The same test runs for the float32-chain build and the float64-chain build
-// (IMEST_ROOTS_DOUBLE); both polish in float64, so both must meet these.
+// (BG_ROOTS_DOUBLE); both polish in float64, so both must meet these.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -33,13 +33,13 @@ void abs_conv(const double *a, int na, const double *b, int nb, double *out) {
 }
 
 // Tables built from |R|, |g|, R_y: the magnitude of the terms of each entry.
-imest_tables_t abs_tables(const imest_tables_t &t) {
-  imest_sums_t s = tv_sums();
+bg_tables_t abs_tables(const bg_tables_t &t) {
+  bg_sums_t s = tv_sums();
   for (auto &row : s.rw)
     for (double &v : row) v = std::fabs(v);
   for (double &v : s.rwy) v = -std::fabs(v);  // the builder adds -2 g
-  imest_tables_t a;
-  imest_tables_scaled(&s, t.sexp, t.gexp, t.cexp, &a);
+  bg_tables_t a;
+  bg_tables_scaled(&s, t.sexp, t.gexp, t.cexp, &a);
   for (int m = 0; m < 8; ++m) a.bw2[m] = std::fabs(a.bw2[m]);
   for (int m = 0; m < 9; ++m) a.bw1[m] = std::fabs(a.bw1[m]);
   for (int m = 0; m < 10; ++m) a.bw0[m] = std::fabs(a.bw0[m]);
@@ -50,13 +50,13 @@ imest_tables_t abs_tables(const imest_tables_t &t) {
 
 TEST(Testvector, ScalingsAndTables) {
   const auto &j = testvector();
-  const imest_sums_t s = tv_sums();
-  imest_tables_t t;
-  ASSERT_EQ(imest_tables_build(&s, 0.1, &t), IMEST_OK);
+  const bg_sums_t s = tv_sums();
+  bg_tables_t t;
+  ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);
   EXPECT_EQ(t.s, j["scale"]["s_K2"].get<double>());
   EXPECT_EQ(t.g, j["scale"]["g_K1"].get<double>());
   EXPECT_EQ(t.c, j["scale"]["c_norm"].get<double>());
-  const imest_tables_t a = abs_tables(t);
+  const bg_tables_t a = abs_tables(t);
   double worst = 0;
   auto cmp = [&](const char *name, const double *v, const double *mag, int n) {
     for (int m = 0; m < n; ++m) {
@@ -88,14 +88,14 @@ TEST(Testvector, ScalingsAndTables) {
 
 TEST(Testvector, Resultant) {
   const auto &j = testvector();
-  const imest_sums_t s = tv_sums();
-  imest_tables_t t;
-  ASSERT_EQ(imest_tables_build(&s, 0.1, &t), IMEST_OK);
+  const bg_sums_t s = tv_sums();
+  bg_tables_t t;
+  ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);
   double rw[22];
-  imest_resultant(&t, rw, 0);
+  bg_resultant(&t, rw, 0);
   EXPECT_EQ(rw[0], 0.0);  // c = 0: r_w = kappa r
   const double *r = rw + 1;
-  const imest_tables_t a = abs_tables(t);
+  const bg_tables_t a = abs_tables(t);
   double mag[21] = {0}, tmp[15], term[21];
   abs_conv(a.a0, 8, a.a0, 8, tmp);
   abs_conv(tmp, 15, a.bw2 + 1, 7, term);
@@ -119,11 +119,11 @@ TEST(Testvector, Resultant) {
 
 TEST(Testvector, SolveEndToEnd) {
   const auto &j = testvector();
-  const imest_sums_t s = tv_sums();
-  const imest_solve_cfg_t cfg = default_cfg(j["params"]["sigma"].get<double>(), j["params"]["L_S"].get<double>());
-  imest_solve_out_t o;
-  imest_solve_stats_t st;
-  ASSERT_EQ(imest_solve_ex(&s, &cfg, &o, &st), IMEST_OK);
+  const bg_sums_t s = tv_sums();
+  const bg_solve_cfg_t cfg = default_cfg(j["params"]["sigma"].get<double>(), j["params"]["L_S"].get<double>());
+  bg_solve_out_t o;
+  bg_solve_stats_t st;
+  ASSERT_EQ(bg_solve_ex(&s, &cfg, &o, &st), IMEST_OK);
   EXPECT_EQ(o.status, IMEST_OK);
   ASSERT_EQ(o.n_roots, 3u);
   EXPECT_EQ(o.n_admissible, 3u);
@@ -133,13 +133,13 @@ TEST(Testvector, SolveEndToEnd) {
                 j["positive_roots_K2"][i].get<double>(), rel(o.roots_k2[i], j["positive_roots_K2"][i].get<double>()));
   }
   // candidates through the stage function
-  imest_tables_t t;
-  ASSERT_EQ(imest_tables_build(&s, 0.1, &t), IMEST_OK);
+  bg_tables_t t;
+  ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);
   double kap[3];
   for (int i = 0; i < 3; ++i) kap[i] = o.roots_k2[i] / t.s;
-  imest_cand_t cand[3], best;
+  bg_cand_t cand[3], best;
   unsigned nad = 0;
-  EXPECT_EQ(imest_select(&t, kap, 3, &cfg, &s, &best, cand, &nad), 0);
+  EXPECT_EQ(bg_select(&t, kap, 3, &cfg, &s, &best, cand, &nad), 0);
   EXPECT_EQ(best.k2, cand[0].k2);
   EXPECT_EQ(nad, 3u);
   for (int i = 0; i < 3; ++i) {
@@ -184,12 +184,12 @@ TEST(Testvector, SolveEndToEnd) {
 
 // The float32 chain and the float64 chain must give the same polished roots.
 TEST(Testvector, ChainPrecisionDoesNotMatterAfterPolish) {
-  const imest_sums_t s = tv_sums();
-  imest_tables_t t;
-  ASSERT_EQ(imest_tables_build(&s, 0.1, &t), IMEST_OK);
+  const bg_sums_t s = tv_sums();
+  bg_tables_t t;
+  ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);
   double rw[22], x[20];
-  imest_resultant(&t, rw, 0);
-  const int n = imest_poly_positive_roots(rw, IMEST_RES_DEG, x, 20);
+  bg_resultant(&t, rw, 0);
+  const int n = bg_roots_positive(rw, BG_RES_DEG, x, 20);
   const double *r = rw + 1;
   ASSERT_EQ(n, 3);
   const auto &j = testvector();
@@ -199,6 +199,6 @@ TEST(Testvector, ChainPrecisionDoesNotMatterAfterPolish) {
     EXPECT_LE(rel(x[i], ref), 2e-14) << i;
     double mag = 0;
     for (int k = 18; k >= 0; --k) mag = mag * x[i] + std::fabs(r[k]);
-    EXPECT_LE(std::fabs(imest_poly_eval(r, 18, x[i])), 1e-13 * mag) << i;
+    EXPECT_LE(std::fabs(bg_poly_eval(r, 18, x[i])), 1e-13 * mag) << i;
   }
 }

@@ -1,84 +1,14 @@
 // imest-replay as a user runs it: bad input, column order, float32 vs float64.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <algorithm>
-#include <cstdio>
+#include <cmath>
 #include <cstdlib>
-#include <fstream>
-#include <map>
-#include <sstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
-#include <vector>
 
-namespace {
-struct Out {
-  int code;
-  std::string out, err;
-};
+#include "tool_run.hpp"
 
-std::string tmpdir() {
-  static std::string d;
-  if (d.empty()) {
-    char tmpl[] = "/tmp/imest-replay-test-XXXXXX";
-    d = mkdtemp(tmpl);
-    std::atexit([] { std::system(("rm -rf " + tmpdir()).c_str()); });
-  }
-  return d;
-}
-
-std::string slurp(const std::string &p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
-Out run(const std::string &cmd) {
-  const std::string o = tmpdir() + "/out.txt", e = tmpdir() + "/err.txt";
-  const int rc = std::system((cmd + " >" + o + " 2>" + e).c_str());
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(o), slurp(e)};
-}
-
-std::string write(const std::string &name, const std::string &text) {
-  const std::string p = tmpdir() + "/" + name;
-  std::ofstream(p) << text;
-  return p;
-}
-
-const std::string kMotor = " --pole-pairs 2 --ls 0.2908 --sigma 0.096 ";
-
-Out replay(const std::string &file, const std::string &extra = "") {
-  return run(std::string(REPLAY_BIN) + kMotor + extra + " " + file);
-}
-
-// A recording from the simulator, made once per test binary.
-const std::string &sim_csv(const std::string &name, const std::string &args) {
-  static std::map<std::string, std::string> made;
-  auto it = made.find(name);
-  if (it != made.end()) return it->second;
-  const std::string p = tmpdir() + "/" + name;
-  const Out o = run(std::string(SIM_BIN) + " " + args + " --out " + p);
-  EXPECT_EQ(o.code, 0) << o.err;
-  return made[name] = p;
-}
-
-std::vector<std::vector<std::string>> rows(const std::string &csv) {
-  std::vector<std::vector<std::string>> r;
-  std::stringstream s(csv);
-  std::string line;
-  while (std::getline(s, line)) {
-    std::vector<std::string> f;
-    std::stringstream ls(line);
-    std::string x;
-    while (std::getline(ls, x, ',')) f.push_back(x);
-    r.push_back(f);
-  }
-  return r;
-}
-}  // namespace
+using namespace tool_run;
 
 TEST(Replay, MissingColumnIsNamed) {
   const Out o = replay(write("m.csv", "t,u_a,u_b,u_c,i_a,i_b,i_c\n0,1,2,3,4,5,6\n"));
@@ -117,7 +47,8 @@ TEST(Replay, EmptyFileAndHeaderOnly) {
 }
 
 TEST(Replay, WrongFieldCountNamesTheLine) {
-  const Out o = replay(write("f.csv", "t,u_a,u_b,u_c,i_a,i_b,i_c,theta\n0,1,2,3,4,5,6,0\n0.00025,1,2\n"));
+  const Out o = replay(write("f.csv", "t,u_a,u_b,u_c,i_a,i_b,i_c,theta\n0,1,2,3,4,5,6,0\n0.00025,1,2\n"
+                                      "0.0005,1,2,3,4,5,6,0\n"));
   EXPECT_EQ(o.code, 1);
   EXPECT_NE(o.err.find(":3:"), std::string::npos) << o.err;
 }

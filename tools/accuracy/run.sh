@@ -8,8 +8,8 @@ set -euo pipefail
 top=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-$top/build}
 dur2=${2:-120}
-sim=$build/sim/imest-sim
-rep=$build/tools/replay/imest-replay
+sim=$build/bin/imest-sim
+rep=$build/bin/imest-replay
 [ -x "$sim" ] && [ -x "$rep" ] || { echo "build first: cmake --build $build --target imest-sim imest-replay" >&2; exit 2; }
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 motor="--pole-pairs 2 --ls 0.2908 --sigma 0.096"

@@ -40,15 +40,15 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "drive_loop.h"
 #include "imest/imest.h"
 #include "imest/imest_can.h"
 #include "imest_candump.h"
 #include "imsim/imsim.h"
+#include "tool_args.h"
 #ifdef IMEST_DEMO_HAVE_SOCKETCAN
 #include "imest_socketcan.h"
 #endif
-
-#define TWO_PI 6.283185307179586476925
 
 /* ------------------------------------------------------------------------- */
 /* Options                                                                    */
@@ -134,6 +134,7 @@ typedef struct {
 #endif
   int live;
   unsigned long live_sent, live_failed;
+  imest_can_pub_t pub; /* publishes each result through this port */
 } tee_port_t;
 
 static int tee_send(void *ctx, const struct imest_can_frame *f)
@@ -283,191 +284,238 @@ static int exp1_wave(job_t *j, const char *dir, double tr_id, double rs_id)
   return 0;
 }
 
-static int run_job(job_t *j)
-{
-  const options_t *o = j->opt;
+/* One experiment while it runs: its simulator, estimator, CAN port, output
+ * files, and the truth of every window (the simulator's, averaged over the
+ * window's samples). */
+typedef struct {
+  job_t *j;
+  const char *name;
   char dir[1024];
-  snprintf(dir, sizeof dir, "%.900s/raw", o->out);
-  const char *name = k_exp_name[j->id];
-
   imsim_config c;
-  sim_config(j->id, o->seed, &c);
-  static _Thread_local imsim sim;
+  imsim *sim;
   imsim_sample s;
-  if (imsim_init(&sim, &c, &s) != 0) {
-    snprintf(j->err, sizeof j->err, "%s: simulator: %s", name, imsim_error(&sim));
+  imest_t *est;
+  tee_port_t *tee;
+  FILE *log, *csv;
+  truth_t *truth;
+  uint32_t wn; /* samples per window */
+  size_t nwin; /* truth slots */
+  size_t win;  /* windows whose truth is complete */
+  int have_id; /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
+} run_t;
+
+static void run_release(run_t *x)
+{
+  if (x->log) fclose(x->log);
+  if (x->csv) fclose(x->csv);
+  free(x->truth);
+  x->log = x->csv = NULL;
+  x->truth = NULL;
+}
+
+/* The live SocketCAN interface (exp2 only): a note if it cannot be used. */
+static void open_live(job_t *j, tee_port_t *tee)
+{
+  const char *iface = j->opt->can_iface;
+  if (j->id != EXP2 || iface == NULL) return;
+#ifdef IMEST_DEMO_HAVE_SOCKETCAN
+  if (imest_socketcan_open(&tee->sc, iface) == 0) {
+    tee->live = 1;
+    snprintf(j->live_note, sizeof j->live_note, "sending exp2's frames on %s", iface);
+  } else {
+    snprintf(j->live_note, sizeof j->live_note,
+             "--can-iface %.32s: %.256s; continuing with the candump log only", iface, tee->sc.err);
+  }
+#else
+  (void)tee;
+  snprintf(j->live_note, sizeof j->live_note,
+           "--can-iface %.32s: built without SocketCAN support; continuing with the candump log "
+           "only",
+           iface);
+#endif
+}
+
+/* Simulator, estimator, CAN port (candump log, live interface), output files. */
+static int job_open(job_t *j, run_t *x)
+{
+  static _Thread_local imsim sim;
+  static _Thread_local imest_t est;
+  static _Thread_local tee_port_t tee;
+  memset(x, 0, sizeof *x);
+  x->j = j;
+  x->name = k_exp_name[j->id];
+  x->sim = &sim;
+  x->est = &est;
+  x->tee = &tee;
+  snprintf(x->dir, sizeof x->dir, "%.900s/raw", j->opt->out);
+
+  sim_config(j->id, j->opt->seed, &x->c);
+  if (imsim_init(&sim, &x->c, &x->s) != 0) {
+    snprintf(j->err, sizeof j->err, "%s: simulator: %s", x->name, imsim_error(&sim));
     return -1;
   }
   imest_config_t cfg;
-  est_config(&c, &cfg);
+  est_config(&x->c, &cfg);
   const char *field = NULL;
   if (imest_config_check(&cfg, &field) != IMEST_OK) {
-    snprintf(j->err, sizeof j->err, "%s: estimator config: bad %s", name, field);
+    snprintf(j->err, sizeof j->err, "%s: estimator config: bad %s", x->name, field);
     return -1;
   }
-  static _Thread_local imest_t est;
   if (imest_init(&est, &cfg) != IMEST_OK) {
-    snprintf(j->err, sizeof j->err, "%s: imest_init failed", name);
+    snprintf(j->err, sizeof j->err, "%s: imest_init failed", x->name);
     return -1;
   }
 
   char fname[256];
-  snprintf(fname, sizeof fname, "%s.candump.log", name);
-  FILE *log = open_out(j, dir, fname);
-  if (log == NULL) return -1;
-  static _Thread_local tee_port_t tee;
+  snprintf(fname, sizeof fname, "%s.candump.log", x->name);
+  if ((x->log = open_out(j, x->dir, fname)) == NULL) return -1;
   memset(&tee, 0, sizeof tee);
-  if (imest_candump_port_open(&tee.log, log, "vcan0") != 0) {
-    snprintf(j->err, sizeof j->err, "%s: candump port", name);
-    fclose(log);
+  if (imest_candump_port_open(&tee.log, x->log, "vcan0") != 0) {
+    snprintf(j->err, sizeof j->err, "%s: candump port", x->name);
     return -1;
   }
-  if (j->id == EXP2 && o->can_iface != NULL) {
-#ifdef IMEST_DEMO_HAVE_SOCKETCAN
-    const int rc = imest_socketcan_open(&tee.sc, o->can_iface);
-    if (rc == 0) {
-      tee.live = 1;
-      snprintf(j->live_note, sizeof j->live_note, "sending exp2's frames on %s", o->can_iface);
-    } else {
-      snprintf(j->live_note, sizeof j->live_note,
-               "--can-iface %.32s: %.256s; continuing with the candump log only", o->can_iface,
-               tee.sc.err);
-    }
-#else
-    snprintf(j->live_note, sizeof j->live_note,
-             "--can-iface %.32s: built without SocketCAN support; continuing with the candump log "
-             "only",
-             o->can_iface);
-#endif
-  }
+  open_live(j, &tee);
   j->live = tee.live;
   tee.port.send = tee_send;
   tee.port.ctx = &tee;
-  static _Thread_local imest_can_pub_t pub;
-  if (imest_can_pub_init(&pub, &tee.port, IMEST_CAN_DEFAULT_BASE_ID) != IMEST_OK) {
-    snprintf(j->err, sizeof j->err, "%s: imest_can_pub_init failed", name);
-    fclose(log);
+  if (imest_can_pub_init(&tee.pub, &tee.port, IMEST_CAN_DEFAULT_BASE_ID) != IMEST_OK) {
+    snprintf(j->err, sizeof j->err, "%s: imest_can_pub_init failed", x->name);
     return -1;
   }
 
-  snprintf(fname, sizeof fname, "%s_direct.csv", name);
-  FILE *csv = open_out(j, dir, fname);
-  if (csv == NULL) {
-    fclose(log);
-    return -1;
-  }
-  fprintf(csv,
+  snprintf(fname, sizeof fname, "%s_direct.csv", x->name);
+  if ((x->csv = open_out(j, x->dir, fname)) == NULL) return -1;
+  fprintf(x->csv,
           "experiment,seq,t_end_s,T_R_s,R_S_ohm,valid,status,T_R_true_s,R_S_true_ohm,E_I,"
           "pe_k1_rel,pe_k2_rel,slip_ratio,i_rms_a,n_roots,n_admissible,used_samples,flags,"
           "speed_rad_s,torque_nm,load_nm,torque_ref_nm,torque_err_rms_nm,psi_r_wb,psi_ref_wb,"
-          "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s\n");
+          "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s,"
+          "tr_valid,tr_reason,rs_valid,rs_reason\n");
 
-  const uint32_t wn = (uint32_t)lround((double)cfg.window_s * (double)cfg.fs_hz);
-  const unsigned long long total = (unsigned long long)llround(j->duration_s * c.fs_hz);
-  j->total = total;
-  size_t nwin = (size_t)(total / wn) + 2;
-  truth_t *truth = calloc(nwin, sizeof *truth);
-  if (truth == NULL) {
-    snprintf(j->err, sizeof j->err, "%s: out of memory", name);
-    fclose(log);
-    fclose(csv);
+  j->total = (unsigned long long)llround(j->duration_s * x->c.fs_hz);
+  x->wn = (uint32_t)lround((double)cfg.window_s * (double)cfg.fs_hz);
+  x->nwin = (size_t)(j->total / x->wn) + 2;
+  if ((x->truth = calloc(x->nwin, sizeof *x->truth)) == NULL) {
+    snprintf(j->err, sizeof j->err, "%s: out of memory", x->name);
     return -1;
   }
+  return 0;
+}
+
+/* exp1 keeps an estimate for the identified-parameter simulation. */
+static void keep_identified(job_t *j, const imest_result_t *r)
+{
+  j->id_tr = r->tr_s;
+  j->id_rs = r->rs_ohm;
+  j->id_seq = (int)r->seq;
+  j->id_status = r->status;
+}
+
+/* drive_window_fn: one result as the background task returns it. */
+static void on_window(void *ctx, const imest_result_t *r)
+{
+  run_t *x = (run_t *)ctx;
+  job_t *j = x->j;
+  (void)imest_can_publish(&x->tee->pub, r); /* refusals are counted by the log port */
+  static const truth_t nan_t = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+  const truth_t *t = (r->seq < x->nwin && r->seq < x->win) ? &x->truth[r->seq] : &nan_t;
+  fprintf(x->csv,
+          "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
+          "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s\n",
+          x->name, r->seq, r->t_end_s, r->tr_s, r->rs_ohm, r->valid, imest_reason_name(r->status),
+          t->tr, t->rs, r->e_i, r->pe_k1_rel, r->pe_k2_rel, r->slip_ratio, r->i_rms_a, r->n_roots,
+          r->n_admissible, r->used_samples, r->flags, t->speed, t->te, t->load, t->te_ref,
+          t->te_err_rms, t->psi, t->psi_ref, t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr,
+          r->tr_valid, imest_reason_name(r->tr_reason), r->rs_valid, imest_reason_name(r->rs_reason));
+  /* the controller takes T_R whenever T_R itself is trusted */
+  if (r->tr_valid && j->id == IFOC_ADAPTIVE) imsim_set_ifoc_tr(x->sim, r->tr_s);
+  if (r->valid) {
+    if (j->id == EXP1 && x->have_id < 2) {
+      x->have_id = 2; /* the first valid window */
+      keep_identified(j, r);
+    }
+  } else if (j->id == EXP1 && x->have_id == 0 && r->seq == 0 && r->tr_s > 0 && r->rs_ohm > 0) {
+    x->have_id = 1; /* no valid window yet: the run-up window's estimate, flagged invalid */
+    keep_identified(j, r);
+  }
+}
+
+/* The samples: each one's truth into its window, then the drive loop (ISR
+ * call with float32 values and the wrapped encoder angle, background drained
+ * when a window is done, publishing over CAN). */
+static void job_loop(run_t *x)
+{
+  job_t *j = x->j;
+  const unsigned long long total = j->total;
+  drive_t d;
+  drive_init(&d, x->est, on_window, x);
   acc_t acc;
   memset(&acc, 0, sizeof acc);
   uint32_t in_win = 0;
-  size_t win = 0;
-  imest_result_t r;
-  int have_id = 0;
-
   for (unsigned long long k = 0; k < total; ++k) {
-    if (k > 0) imsim_step(&sim, &s);
-    /* truth of this sample belongs to the window being filled */
-    acc_add(&acc, &s);
-    if (++in_win == wn) {
-      if (win < nwin) truth[win] = acc_mean(&acc);
-      win++;
+    if (k > 0) imsim_step(x->sim, &x->s);
+    acc_add(&acc, &x->s);
+    if (++in_win == x->wn) {
+      if (x->win < x->nwin) x->truth[x->win] = acc_mean(&acc);
+      x->win++;
       in_win = 0;
       memset(&acc, 0, sizeof acc);
     }
-    /* what the firmware's ISR gets: float32 ADC values, wrapped encoder angle */
-    const float u[3] = {(float)s.u_abc[0], (float)s.u_abc[1], (float)s.u_abc[2]};
-    const float i[3] = {(float)s.i_abc[0], (float)s.i_abc[1], (float)s.i_abc[2]};
-    double thw = fmod(s.theta, TWO_PI);
-    if (thw < 0) thw += TWO_PI;
-    float th = (float)thw;
-    if (th >= (float)TWO_PI) th = 0.0f;
-    if (imest_isr_abc(&est, u, i, th)) {
-      /* background task: runs when woken, publishes over CAN */
-      imest_candump_port_set_time(&tee.log, s.t);
-      while (imest_background(&est, &r) == 1) {
-        (void)imest_can_publish(&pub, &r);
-        const truth_t *t = (r.seq < nwin) ? &truth[r.seq] : NULL;
-        const truth_t nan_t = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
-        if (t == NULL || r.seq >= win) t = &nan_t;
-        fprintf(csv,
-                "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
-                "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g\n",
-                name, r.seq, r.t_end_s, r.tr_s, r.rs_ohm, r.valid, imest_reason_name(r.status),
-                t->tr, t->rs, r.e_i, r.pe_k1_rel, r.pe_k2_rel, r.slip_ratio, r.i_rms_a, r.n_roots,
-                r.n_admissible, r.used_samples, r.flags, t->speed, t->te, t->load, t->te_ref,
-                t->te_err_rms, t->psi, t->psi_ref, t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr);
-        j->windows++;
-        if (r.valid) {
-          j->valid++;
-          if (j->id == IFOC_ADAPTIVE) imsim_set_ifoc_tr(&sim, r.tr_s);
-          if (j->id == EXP1 && have_id < 2) {
-            have_id = 2; /* first valid window */
-            j->id_tr = r.tr_s;
-            j->id_rs = r.rs_ohm;
-            j->id_seq = (int)r.seq;
-            j->id_status = r.status;
-          }
-        } else if (j->id == EXP1 && have_id == 0 && r.seq == 0 && r.tr_s > 0 && r.rs_ohm > 0) {
-          have_id = 1; /* no valid window yet: the run-up window's estimate, flagged invalid */
-          j->id_tr = r.tr_s;
-          j->id_rs = r.rs_ohm;
-          j->id_seq = (int)r.seq;
-          j->id_status = r.status;
-        }
-      }
-    }
+    imest_candump_port_set_time(&x->tee->log, x->s.t); /* frames carry their window's end */
+    drive_sample(&d, x->s.u_abc, x->s.i_abc, x->s.theta);
     if ((k & 1023u) == 0) atomic_store(&j->done, k);
   }
   atomic_store(&j->done, total);
-  free(truth);
-  j->can_lines = tee.log.lines;
-  j->can_failed = tee.log.failed;
-  j->live_sent = tee.live_sent;
-  j->live_failed = tee.live_failed;
+  j->windows = d.windows;
+  j->valid = d.valid;
+}
+
+/* Files closed; exp1 goes on to its identified-parameter simulation. */
+static int job_close(run_t *x)
+{
+  job_t *j = x->j;
+  j->can_lines = x->tee->log.lines;
+  j->can_failed = x->tee->log.failed;
+  j->live_sent = x->tee->live_sent;
+  j->live_failed = x->tee->live_failed;
 #ifdef IMEST_DEMO_HAVE_SOCKETCAN
-  if (tee.live) imest_socketcan_close(&tee.sc);
+  if (x->tee->live) imest_socketcan_close(&x->tee->sc);
 #endif
-  int bad = 0;
-  if (fclose(log) != 0) bad = 1;
-  if (fclose(csv) != 0) bad = 1;
+  const int bad = (fclose(x->log) != 0) | (fclose(x->csv) != 0);
+  x->log = x->csv = NULL;
+  run_release(x);
   if (bad) {
-    snprintf(j->err, sizeof j->err, "%s: write error in %s", name, dir);
+    snprintf(j->err, sizeof j->err, "%s: write error in %s", x->name, x->dir);
     return -1;
   }
-  if (j->id == EXP1) {
-    if (!have_id) {
-      /* no estimate at all: still draw the run-up, with the nominal parameters */
-      j->id_tr = c.tr_s;
-      j->id_rs = c.rs_ohm;
-      j->id_seq = -1;
-    }
-    FILE *f = open_out(j, dir, "exp1_identified.csv");
-    if (f == NULL) return -1;
-    fprintf(f, "seq,valid,status,T_R_s,R_S_ohm,source\n%d,%d,%s,%.9g,%.9g,%s\n", j->id_seq,
-            have_id == 2, have_id ? imest_reason_name(j->id_status) : "none", j->id_tr, j->id_rs,
-            have_id == 2   ? "first valid window"
-            : have_id == 1 ? "run-up window 0, NOT valid (no valid window)"
-                           : "nominal parameters (no usable estimate)");
-    if (fclose(f) != 0) return -1;
-    if (exp1_wave(j, dir, j->id_tr, j->id_rs) != 0) return -1;
+  if (j->id != EXP1) return 0;
+  if (!x->have_id) {
+    /* no estimate at all: still draw the run-up, with the nominal parameters */
+    j->id_tr = x->c.tr_s;
+    j->id_rs = x->c.rs_ohm;
+    j->id_seq = -1;
   }
-  return 0;
+  FILE *f = open_out(j, x->dir, "exp1_identified.csv");
+  if (f == NULL) return -1;
+  fprintf(f, "seq,valid,status,T_R_s,R_S_ohm,source\n%d,%d,%s,%.9g,%.9g,%s\n", j->id_seq,
+          x->have_id == 2, x->have_id ? imest_reason_name(j->id_status) : "none", j->id_tr,
+          j->id_rs,
+          x->have_id == 2   ? "first valid window"
+          : x->have_id == 1 ? "run-up window 0, NOT valid (no valid window)"
+                            : "nominal parameters (no usable estimate)");
+  if (fclose(f) != 0) return -1;
+  return exp1_wave(j, x->dir, j->id_tr, j->id_rs);
+}
+
+static int run_job(job_t *j)
+{
+  run_t x;
+  if (job_open(j, &x) != 0) {
+    run_release(&x);
+    return -1;
+  }
+  job_loop(&x);
+  return job_close(&x);
 }
 
 static void *job_thread(void *arg)
@@ -494,6 +542,7 @@ static void usage(FILE *f)
           "Experiments run in parallel threads: exp1 (run-up), exp2 (30 Hz V/f heat run),\n"
           "ifoc_fixed and ifoc_adaptive (the heat run under IFOC, controller T_R fixed at\n"
           "the cold value / taken from the estimator).\n"
+          "Options take a value as '--opt VALUE' or '--opt=VALUE'.\n"
           "\n"
           "  --out DIR           output folder (default results)\n"
           "  --duration S        motor time of exp2 and the IFOC runs (default 3600)\n"
@@ -502,20 +551,11 @@ static void usage(FILE *f)
           "  --can-iface NAME    also send exp2's frames on this SocketCAN interface\n"
           "  --seed N            sensor noise seed (default 1)\n"
           "  --quiet             no progress on stderr (default: progress if it is a terminal)\n"
+          "  -h, --help          this text\n"
           "\n"
-          "stdout: one line per experiment, key=value pairs.\n");
-}
-
-static int parse_pos(const char *opt, const char *v, double *out)
-{
-  char *end = NULL;
-  const double x = v ? strtod(v, &end) : (double)NAN;
-  if (v == NULL || end == v || *end || !(x > 0) || !isfinite(x)) {
-    fprintf(stderr, "imest-demo: %s needs a positive number\n", opt);
-    return -1;
-  }
-  *out = x;
-  return 0;
+          "stdout: one line per experiment, key=value pairs.\n"
+          "exit status: 0 done; 1 an experiment failed or the output cannot be written;\n"
+          "2 bad option.\n");
 }
 
 static int mkdir_p(const char *path)
@@ -533,91 +573,107 @@ static int mkdir_p(const char *path)
   return 0;
 }
 
-int main(int argc, char **argv)
+/* --only exp1,exp2: the bit mask of experiments. */
+static int parse_only(const char *v, unsigned int *only)
 {
-  options_t o;
-  memset(&o, 0, sizeof o);
-  o.out = "results";
-  o.duration_s = 3600.0;
-  o.exp1_duration_s = 2.0;
-  o.seed = 1;
-  o.only = (1u << NEXP) - 1u;
-  for (int a = 1; a < argc; ++a) {
-    const char *opt = argv[a], *v = a + 1 < argc ? argv[a + 1] : NULL;
-    if (!strcmp(opt, "-h") || !strcmp(opt, "--help")) {
-      usage(stdout);
-      return 0;
-    } else if (!strcmp(opt, "--out") && v) {
-      o.out = v;
-      a++;
-    } else if (!strcmp(opt, "--duration")) {
-      if (parse_pos(opt, v, &o.duration_s)) return 2;
-      a++;
-    } else if (!strcmp(opt, "--exp1-duration")) {
-      if (parse_pos(opt, v, &o.exp1_duration_s)) return 2;
-      a++;
-    } else if (!strcmp(opt, "--can-iface") && v) {
-      o.can_iface = v;
-      a++;
-    } else if (!strcmp(opt, "--seed") && v) {
-      o.seed = strtoul(v, NULL, 0);
-      a++;
-    } else if (!strcmp(opt, "--only") && v) {
-      o.only = 0;
-      char buf[256];
-      snprintf(buf, sizeof buf, "%s", v);
-      for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
-        int found = 0;
-        for (int e = 0; e < NEXP; ++e)
-          if (!strcmp(tok, k_exp_name[e])) {
-            o.only |= 1u << e;
-            found = 1;
-          }
-        if (!found) {
-          fprintf(stderr, "imest-demo: --only: unknown experiment '%s'\n", tok);
-          return 2;
-        }
+  *only = 0;
+  char buf[256];
+  snprintf(buf, sizeof buf, "%s", v);
+  for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+    int found = 0;
+    for (int e = 0; e < NEXP; ++e)
+      if (!strcmp(tok, k_exp_name[e])) {
+        *only |= 1u << e;
+        found = 1;
       }
-      a++;
-    } else if (!strcmp(opt, "--quiet")) {
-      o.quiet = 1;
-    } else {
-      fprintf(stderr, "imest-demo: unknown option or missing value: '%s' (see --help)\n", opt);
-      return 2;
+    if (!found) {
+      fprintf(stderr, "imest-demo: --only: unknown experiment '%s' (exp1, exp2, ifoc_fixed, "
+              "ifoc_adaptive)\n", tok);
+      return -1;
     }
   }
-  if (o.duration_s < 1.0 || o.exp1_duration_s < 1.0) {
-    fprintf(stderr, "imest-demo: durations must be at least one window (1 s)\n");
-    return 2;
-  }
-  char raw[1024];
-  snprintf(raw, sizeof raw, "%.900s/raw", o.out);
-  if (mkdir_p(raw) != 0) {
-    fprintf(stderr, "imest-demo: cannot create %s: %s\n", raw, strerror(errno));
-    return 1;
-  }
+  if (*only == 0) fprintf(stderr, "imest-demo: --only: no experiment named\n");
+  return *only ? 0 : -1;
+}
 
-  static job_t jobs[NEXP];
-  pthread_t th[NEXP];
-  int started[NEXP] = {0};
-  const double t0 = now_s();
+/* Returns -1 to go on, or the exit code to end with. */
+static int parse_options(int argc, char **argv, options_t *o)
+{
+  memset(o, 0, sizeof *o);
+  o->out = "results";
+  o->duration_s = 3600.0;
+  o->exp1_duration_s = 2.0;
+  o->seed = 1;
+  o->only = (1u << NEXP) - 1u;
+  tool_args_t a;
+  tool_args_init(&a, "imest-demo", argc, argv);
+  tool_arg_kind_t kind;
+  double x;
+  while ((kind = tool_args_next(&a)) != TOOL_ARG_END) {
+    if (kind == TOOL_ARG_OPERAND) {
+      fprintf(stderr, "imest-demo: unexpected argument '%s' (see --help)\n", a.operand);
+      return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "-h") || tool_args_is(&a, "--help")) {
+      usage(stdout);
+      return TOOL_EXIT_OK;
+    } else if (tool_args_is(&a, "--out")) {
+      if ((o->out = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--duration") || tool_args_is(&a, "--exp1-duration")) {
+      if (tool_args_number(&a, &x)) return TOOL_EXIT_USAGE;
+      if (x < 1.0) {
+        fprintf(stderr, "imest-demo: %s must be at least one window (1 s)\n", a.opt);
+        return TOOL_EXIT_USAGE;
+      }
+      *(tool_args_is(&a, "--duration") ? &o->duration_s : &o->exp1_duration_s) = x;
+    } else if (tool_args_is(&a, "--can-iface")) {
+      if ((o->can_iface = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--seed")) {
+      if (tool_args_number(&a, &x)) return TOOL_EXIT_USAGE;
+      if (x < 0 || x != floor(x) || x > 4294967295.0) {
+        fprintf(stderr, "imest-demo: --seed must be a whole number >= 0\n");
+        return TOOL_EXIT_USAGE;
+      }
+      o->seed = (unsigned long)x;
+    } else if (tool_args_is(&a, "--only")) {
+      const char *v = tool_args_value(&a);
+      if (v == NULL || parse_only(v, &o->only)) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--quiet")) {
+      if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
+      o->quiet = 1;
+    } else {
+      return tool_args_unknown(&a);
+    }
+  }
+  return -1;
+}
+
+/* One thread per experiment asked for. */
+static int start_jobs(const options_t *o, job_t jobs[NEXP], pthread_t th[NEXP], int started[NEXP])
+{
   for (int e = 0; e < NEXP; ++e) {
     jobs[e].id = e;
-    jobs[e].opt = &o;
-    jobs[e].duration_s = e == EXP1 ? o.exp1_duration_s : o.duration_s;
+    jobs[e].opt = o;
+    jobs[e].duration_s = e == EXP1 ? o->exp1_duration_s : o->duration_s;
     jobs[e].total = (unsigned long long)llround(jobs[e].duration_s * 4000.0);
     atomic_store(&jobs[e].done, 0);
-    if (!(o.only & (1u << e))) continue;
+    started[e] = 0;
+    if (!(o->only & (1u << e))) continue;
     /* the threads' simulators and estimators are thread-local statics: the
        default 8 MiB stack is plenty */
     if (pthread_create(&th[e], NULL, job_thread, &jobs[e]) != 0) {
       fprintf(stderr, "imest-demo: cannot start a thread\n");
-      return 1;
+      return -1;
     }
     started[e] = 1;
   }
+  return 0;
+}
 
-  const int tty = !o.quiet && isatty(2);
+/* Progress on a terminal until every thread is done; then joins them. */
+static void wait_jobs(const options_t *o, job_t jobs[NEXP], pthread_t th[NEXP],
+                      const int started[NEXP], double t0)
+{
+  const int tty = !o->quiet && isatty(2);
   for (;;) {
     int running = 0;
     unsigned long long done = 0, total = 0;
@@ -640,10 +696,15 @@ int main(int argc, char **argv)
     struct timespec ts = {0, 250000000L};
     nanosleep(&ts, NULL);
   }
-  int fail = 0;
   for (int e = 0; e < NEXP; ++e)
     if (started[e]) pthread_join(th[e], NULL);
   if (tty) fprintf(stderr, "\n");
+}
+
+/* One stdout line per experiment; returns nonzero if any failed. */
+static int report(const job_t jobs[NEXP], const int started[NEXP], double t0)
+{
+  int fail = 0;
   for (int e = 0; e < NEXP; ++e) {
     const job_t *j = &jobs[e];
     if (!started[e]) continue;
@@ -671,4 +732,25 @@ int main(int argc, char **argv)
   const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
   printf("simulate_wall_s=%.2f simulate_cpu_s=%.2f cpus=%ld\n", now_s() - t0, cpu, ncpu);
   return fail;
+}
+
+int main(int argc, char **argv)
+{
+  static options_t o;
+  int rc = parse_options(argc, argv, &o);
+  if (rc >= 0) return rc;
+  char raw[1024];
+  snprintf(raw, sizeof raw, "%.900s/raw", o.out);
+  if (mkdir_p(raw) != 0) {
+    fprintf(stderr, "imest-demo: cannot create %s: %s\n", raw, strerror(errno));
+    return TOOL_EXIT_DATA;
+  }
+  static job_t jobs[NEXP];
+  pthread_t th[NEXP];
+  int started[NEXP];
+  const double t0 = now_s();
+  const int bad_start = start_jobs(&o, jobs, th, started);
+  wait_jobs(&o, jobs, th, started, t0);
+  if (bad_start) return TOOL_EXIT_DATA;
+  return report(jobs, started, t0) ? TOOL_EXIT_DATA : TOOL_EXIT_OK;
 }

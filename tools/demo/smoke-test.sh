@@ -25,7 +25,8 @@ done
 /usr/bin/python3 - "$out" <<'EOF'
 import csv, re, sys
 out = sys.argv[1]
-need = ["t_end_s", "T_R_s", "R_S_ohm", "valid", "status", "T_R_true_s", "R_S_true_ohm"]
+need = ["t_end_s", "T_R_s", "R_S_ohm", "valid", "status", "T_R_true_s", "R_S_true_ohm",
+        "tr_valid", "tr_reason", "rs_valid", "rs_reason"]
 rows = list(csv.DictReader(open(f"{out}/windows.csv")))
 assert len(rows) == 60, f"windows.csv: {len(rows)} rows, expected 60"
 for k in need:
@@ -40,13 +41,23 @@ rows = re.findall(r"^\| (exp1|exp2|ifoc_fixed|ifoc_adaptive) \| (1 s|30 s avg|12
 assert ("exp2", "1 s") in [(a, b) for a, b, _ in rows], "summary: no exp2 1-s row"
 for a, b, rest in rows:
     cells = [c.strip() for c in rest.split("|")]
-    int(cells[0])
+    assert len(cells) == 8, f"summary: error row {a} {b}: {len(cells)} cells"
+    int(cells[0]), int(cells[4])  # n for T_R, n for R_S
     for c in cells[1:]:
         float(c)
-tel = re.search(r"^\| exp2 \| (\d+) \| (\d+) \| [^|]* \| (\d+) \| (\d+) \|", md, re.M)
+tel = re.search(r"^\| exp2 \| (\d+) \| (\d+) \| [^|]* \| [^|]* \| (\d+) \| (\d+) \|", md, re.M)
 assert tel, "summary: no exp2 telemetry row"
 assert int(tel.group(1)) == 60 and int(tel.group(3)) == 60, tel.group(0)
 assert int(tel.group(4)) == 0, "lost frames in a local log"
 assert re.search(r"^\| total \| [0-9.]+ \|$", md, re.M), "summary: no total wall time"
+# a window that is not valid: its estimate never appears in the summary (only its verdict)
+for name in ("exp1_windows.csv", "windows.csv"):
+    for r in csv.DictReader(open(f"{out}/{name}")):
+        if r["valid"] != "1":
+            for key, fmt in (("R_S_ohm", "%.5g"), ("R_S_ohm", "%.4f"), ("T_R_s", "%.5g"), ("T_R_s", "%.5f")):
+                txt = fmt % float(r[key])
+                assert txt not in md, f"summary prints {name} window {r['seq']}'s {key} {txt}"
+for sec in ("## R_S and the encoder", "Why the fixed-T_R torque error changes sign"):
+    assert sec in md, f"summary: no '{sec}'"
 print("demo smoke test: ok")
 EOF

@@ -20,12 +20,10 @@
 #include "imest/imest_can.h"
 #include "imest_can_id.h"
 #include "imest_candump.h"
+#include "tool_args.h"
 #ifdef IMEST_MONITOR_SOCKETCAN
 #include "imest_socketcan.h"
 #endif
-
-#define EXIT_DATA 1
-#define EXIT_USAGE 2
 
 static const char *const k_frame_name[IMEST_CAN_NFRAMES] = {
     "IMEST_TR", "IMEST_RS", "IMEST_QUAL", "IMEST_STAT", "IMEST_VERDICT", "IMEST_BOUNDS"};
@@ -397,9 +395,9 @@ static int finish(monitor_t *m, int live)
           (unsigned long)m->last_tx_failed);
   if (m->windows == 0u) {
     explain_nothing(m, live);
-    return EXIT_DATA;
+    return TOOL_EXIT_DATA;
   }
-  return 0;
+  return TOOL_EXIT_OK;
 }
 
 /* --- sources ------------------------------------------------------------------ */
@@ -423,12 +421,12 @@ static int run_log(monitor_t *m, const char *path)
   ssize_t n;
   if (fp == NULL) {
     fprintf(stderr, "imest-monitor: cannot open log '%s': %s\n", path, strerror(errno));
-    return EXIT_DATA;
+    return TOOL_EXIT_DATA;
   }
   if (fstat(fileno(fp), &st) == 0 && S_ISDIR(st.st_mode)) {
     fprintf(stderr, "imest-monitor: cannot read log '%s': it is a directory (give a candump -L file)\n", path);
     if (!is_stdin) fclose(fp);
-    return EXIT_DATA;
+    return TOOL_EXIT_DATA;
   }
   print_header(m);
   errno = 0;
@@ -468,7 +466,7 @@ static int run_log(monitor_t *m, const char *path)
   if (read_error) {
     fprintf(stderr, "imest-monitor: cannot read log '%s': %s\n", label, strerror(saved));
     (void)finish(m, 0);
-    return EXIT_DATA;
+    return TOOL_EXIT_DATA;
   }
   return finish(m, 0);
 }
@@ -481,7 +479,7 @@ static int run_iface(monitor_t *m, const char *ifname, double timeout_s)
   char id[24];
   if (imest_socketcan_open(&sc, ifname) != 0) {
     fprintf(stderr, "imest-monitor: %s\n", sc.err);
-    return EXIT_DATA;
+    return TOOL_EXIT_DATA;
   }
   print_header(m);
   fprintf(stderr, "imest-monitor: listening on %s (base id %s)\n", ifname,
@@ -494,7 +492,7 @@ static int run_iface(monitor_t *m, const char *ifname, double timeout_s)
       fprintf(stderr, "imest-monitor: %s\n", sc.err);
       imest_socketcan_close(&sc);
       (void)finish(m, 1);
-      return EXIT_DATA;
+      return TOOL_EXIT_DATA;
     }
     if (r == 0) {
       idle += 0.2;
@@ -516,35 +514,6 @@ static int run_iface(monitor_t *m, const char *ifname, double timeout_s)
 
 /* --- options ------------------------------------------------------------------ */
 
-/* argv[*i] is `name` (value in the next argument) or `name=value`. Returns 1
- * and *val when it matches, 0 when it is another option, -1 (message printed)
- * when the value is missing. */
-static int option(int argc, char **argv, int *i, const char *name, const char **val)
-{
-  const char *a = argv[*i];
-  const size_t n = strlen(name);
-  if (strncmp(a, name, n) != 0) return 0;
-  if (a[n] == '=') {
-    *val = a + n + 1;
-    return 1;
-  }
-  if (a[n] != '\0') return 0;
-  if (*i + 1 >= argc) {
-    fprintf(stderr, "imest-monitor: %s needs a value (see --help)\n", name);
-    return -1;
-  }
-  *val = argv[++*i];
-  return 1;
-}
-
-static int flag(const char *a, const char *name)
-{
-  const size_t n = strlen(name);
-  if (strncmp(a, name, n) != 0) return 0;
-  if (a[n] == '\0') return 1;
-  return a[n] == '=' ? -1 : 0;
-}
-
 /* A count of windows: 1, 2, ... (no sign, no zero). */
 static int parse_count(const char *v, unsigned long *out)
 {
@@ -560,62 +529,59 @@ static int parse_count(const char *v, unsigned long *out)
 int main(int argc, char **argv)
 {
   static monitor_t m;
-  const char *iface = NULL, *log = NULL, *base_text = NULL;
+  const char *iface = NULL, *log = NULL, *base_text = NULL, *v;
   int ext = 0;
   double timeout_s = 0.0;
+  tool_args_t a;
+  tool_arg_kind_t kind;
   memset(&m, 0, sizeof m);
-  for (int i = 1; i < argc; i++) {
-    const char *a = argv[i];
-    const char *v = NULL;
-    int r;
-    if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+  tool_args_init(&a, "imest-monitor", argc, argv);
+  while ((kind = tool_args_next(&a)) != TOOL_ARG_END) {
+    if (kind == TOOL_ARG_OPERAND) {
+      fprintf(stderr, "imest-monitor: unexpected argument '%s' (a log is given with --log; see --help)\n",
+              a.operand);
+      return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "-h") || tool_args_is(&a, "--help")) {
       usage(stdout);
-      return 0;
-    } else if ((r = flag(a, "--csv")) != 0 || (r = flag(a, "--ext")) != 0) {
-      if (r < 0) {
-        fprintf(stderr, "imest-monitor: %.5s takes no value\n", a);
-        return EXIT_USAGE;
-      }
-      if (a[2] == 'c') m.csv = 1;
-      else ext = 1;
-    } else if ((r = option(argc, argv, &i, "--iface", &v)) != 0) {
-      if (r < 0) return EXIT_USAGE;
-      iface = v;
-    } else if ((r = option(argc, argv, &i, "--log", &v)) != 0) {
-      if (r < 0) return EXIT_USAGE;
-      log = v;
-    } else if ((r = option(argc, argv, &i, "--base-id", &v)) != 0) {
-      if (r < 0) return EXIT_USAGE;
-      base_text = v;
-    } else if ((r = option(argc, argv, &i, "--count", &v)) != 0) {
-      if (r < 0) return EXIT_USAGE;
+      return TOOL_EXIT_OK;
+    } else if (tool_args_is(&a, "--csv")) {
+      if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
+      m.csv = 1;
+    } else if (tool_args_is(&a, "--ext")) {
+      if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
+      ext = 1;
+    } else if (tool_args_is(&a, "--iface")) {
+      if ((iface = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--log")) {
+      if ((log = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--base-id")) {
+      if ((base_text = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--count")) {
+      if ((v = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
       if (parse_count(v, &m.count) != 0) {
         fprintf(stderr, "imest-monitor: bad --count '%s': give a number of windows >= 1\n", v);
-        return EXIT_USAGE;
+        return TOOL_EXIT_USAGE;
       }
-    } else if ((r = option(argc, argv, &i, "--timeout", &v)) != 0) {
-      char *end = NULL;
-      if (r < 0) return EXIT_USAGE;
-      timeout_s = strtod(v, &end);
-      if (end == v || *end != '\0' || !(timeout_s >= 0.0) || !isfinite(timeout_s)) {
-        fprintf(stderr, "imest-monitor: bad --timeout '%s': give seconds >= 0\n", v);
-        return EXIT_USAGE;
+    } else if (tool_args_is(&a, "--timeout")) {
+      if (tool_args_number(&a, &timeout_s)) return TOOL_EXIT_USAGE;
+      if (!(timeout_s >= 0.0)) {
+        fprintf(stderr, "imest-monitor: bad --timeout %g: give seconds >= 0\n", timeout_s);
+        return TOOL_EXIT_USAGE;
       }
     } else {
-      fprintf(stderr, "imest-monitor: unknown option '%s' (see --help)\n", a);
-      return EXIT_USAGE;
+      return tool_args_unknown(&a);
     }
   }
   if ((iface == NULL) == (log == NULL)) {
     fprintf(stderr, "imest-monitor: give exactly one of --iface NAME or --log FILE (see --help)\n");
-    return EXIT_USAGE;
+    return TOOL_EXIT_USAGE;
   }
   m.base_id = IMEST_CAN_DEFAULT_BASE_ID | (ext ? IMEST_CAN_ID_EXT : 0u);
   if (base_text != NULL) {
     char err[256];
     if (imest_can_id_parse(base_text, ext, "--ext", &m.base_id, err, sizeof err) != IMEST_OK) {
       fprintf(stderr, "imest-monitor: bad --base-id %s\n", err);
-      return EXIT_USAGE;
+      return TOOL_EXIT_USAGE;
     }
   }
   imest_can_rx_init(&m.rx, m.base_id);
@@ -627,6 +593,6 @@ int main(int argc, char **argv)
 #else
   (void)timeout_s;
   fprintf(stderr, "imest-monitor: built without SocketCAN support: use --log\n");
-  return EXIT_USAGE;
+  return TOOL_EXIT_USAGE;
 #endif
 }

@@ -33,19 +33,46 @@ static char *trim(char *s)
   return s;
 }
 
+/* stdin into a temporary file: the reader makes two passes. */
+static FILE *copy_stdin(void)
+{
+  FILE *f = tmpfile();
+  if (f == NULL) return NULL;
+  char chunk[1 << 16];
+  size_t n;
+  while ((n = fread(chunk, 1, sizeof chunk, stdin)) > 0) {
+    if (fwrite(chunk, 1, n, f) != n) {
+      fclose(f);
+      return NULL;
+    }
+  }
+  if (ferror(stdin) || fflush(f) != 0 || fseek(f, 0, SEEK_SET) != 0) {
+    fclose(f);
+    return NULL;
+  }
+  return f;
+}
+
 int csv_open(csv_reader_t *r, const char *path)
 {
   memset(r, 0, sizeof *r);
-  r->name = path;
-  r->f = fopen(path, "rb");
+  const int from_stdin = strcmp(path, "-") == 0;
+  r->name = from_stdin ? "stdin" : path;
+  path = r->name;
+  r->f = from_stdin ? copy_stdin() : fopen(path, "rb");
   if (r->f == NULL) {
-    snprintf(r->err, sizeof r->err, "%s: cannot open: %s", path, strerror(errno));
+    snprintf(r->err, sizeof r->err, "%s: cannot %s: %s", path, from_stdin ? "read" : "open",
+             strerror(errno));
     return -1;
   }
   for (int k = 0; k < CSV_NEED; ++k) r->col[k] = -1;
+  errno = 0;
   long len = read_line(r);
   if (len < 0) {
-    snprintf(r->err, sizeof r->err, "%s: empty file (no header row)", path);
+    if (ferror(r->f))
+      snprintf(r->err, sizeof r->err, "%s: cannot read: %s", path, strerror(errno));
+    else
+      snprintf(r->err, sizeof r->err, "%s: empty file (no header row)", path);
     return -1;
   }
   /* strip a UTF-8 byte order mark */
@@ -80,6 +107,28 @@ int csv_open(csv_reader_t *r, const char *path)
   return 0;
 }
 
+/* Half a unit in the last printed decimal of a number's text: the bound of
+ * its rounding ("0.0003" -> 5e-5, "2.5e-4" -> 5e-6, "12" -> 0.5). */
+static double half_unit(const char *s)
+{
+  long decimals = 0;
+  const char *p = s;
+  while (*p && *p != '.' && *p != 'e' && *p != 'E') p++;
+  if (*p == '.')
+    for (++p; isdigit((unsigned char)*p); ++p) decimals++;
+  if (*p == 'e' || *p == 'E') decimals -= strtol(p + 1, NULL, 10);
+  return 0.5 * pow(10.0, -(double)decimals);
+}
+
+/* Nothing but blank lines up to the end of the file. */
+static int at_last_line(csv_reader_t *r)
+{
+  long len;
+  while ((len = read_line(r)) == 0) {
+  }
+  return len < 0;
+}
+
 int csv_next(csv_reader_t *r, double v[CSV_NEED])
 {
   long len;
@@ -87,7 +136,7 @@ int csv_next(csv_reader_t *r, double v[CSV_NEED])
     len = read_line(r);
     if (len < 0) return 0;
   } while (len == 0); /* blank lines are ignored */
-  int idx = 0, got = 0;
+  int idx = 0, got = 0, cut = 0; /* cut: the line looks cut off mid-write */
   char *tok = r->buf;
   for (;; ++idx) {
     char *comma = strchr(tok, ',');
@@ -100,13 +149,16 @@ int csv_next(csv_reader_t *r, double v[CSV_NEED])
       if (*s == '\0' || end == s || *trim(end) != '\0') {
         snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': '%.40s' is not a number", r->name,
                  r->line, CSV_NAMES[k], s);
-        return -1;
+        /* cut off inside its last field: what is left of it is the start of a number */
+        cut = comma == NULL && idx + 1 <= r->ncols && strspn(s, "0123456789+-.eE") == strlen(s);
+        goto bad;
       }
       if (!isfinite(x)) {
         snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': non-finite value '%.40s'", r->name,
                  r->line, CSV_NAMES[k], s);
         return -1;
       }
+      if (k == 0) r->t_round = half_unit(s);
       v[k] = x;
       got++;
     }
@@ -116,9 +168,23 @@ int csv_next(csv_reader_t *r, double v[CSV_NEED])
   if (idx + 1 != r->ncols || got != CSV_NEED) {
     snprintf(r->err, sizeof r->err, "%s:%ld: %d fields, the header has %d", r->name, r->line,
              idx + 1, r->ncols);
-    return -1;
+    cut = idx + 1 < r->ncols;
+    goto bad;
   }
   return 1;
+bad:
+  /* A recording cut off mid-write: drop its last line, keep the rest. */
+  if (cut) {
+    const long line = r->line;
+    if (at_last_line(r)) {
+      r->truncated_line = line;
+      snprintf(r->warn, sizeof r->warn, "%s", r->err);
+      r->err[0] = '\0';
+      return 0;
+    }
+    r->line = line; /* the peek read on: the error is the bad line's */
+  }
+  return -1;
 }
 
 int csv_rewind(csv_reader_t *r)

@@ -9,7 +9,7 @@ IFS='|' read -r NAME SIMARGS REPARGS CUT <<<"$LINE"
 CSV="$OUT/tmp/$NAME.csv"
 mkdir -p "$OUT/tmp" "$OUT/cases"
 # shellcheck disable=SC2086
-if ! "$B/sim/imest-sim" $SIMARGS --no-progress --out "$CSV" 2>"$OUT/cases/$NAME.simlog"; then
+if ! "$B/bin/imest-sim" $SIMARGS --no-progress --out "$CSV" 2>"$OUT/cases/$NAME.simlog"; then
   echo "SIM FAILED: $NAME" >&2; exit 0
 fi
 if [ -n "$CUT" ] && [ "$CUT" != 0 ]; then
@@ -17,7 +17,7 @@ if [ -n "$CUT" ] && [ "$CUT" != 0 ]; then
   awk -F, -v c="$CUT" 'NR == 1 || $1 + 1e-9 >= c' "$CSV" >"$CSV.cut" && mv "$CSV.cut" "$CSV"
 fi
 # shellcheck disable=SC2086
-"$B/tools/replay/imest-replay" $REPARGS ${REPLAY_ARGS:-} "$CSV" >"$OUT/cases/$NAME.replay.csv" 2>"$OUT/cases/$NAME.log"
+"$B/bin/imest-replay" $REPARGS ${REPLAY_ARGS:-} "$CSV" >"$OUT/cases/$NAME.replay.csv" 2>"$OUT/cases/$NAME.log"
 # window k = data rows k*N .. k*N+N-1, N = window length in samples (1 s windows)
 awk -F, -v name="$NAME" '
   NR == 1 { for (j = 1; j <= NF; j++) col[$j] = j; next }

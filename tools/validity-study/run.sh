@@ -14,7 +14,7 @@ ROOT=$(cd "$HERE/../.." && pwd)
 B=${1:-$ROOT/build-vs}
 OUT=${2:-$B/validity-study}
 JOBS=${JOBS:-2}
-if [ ! -x "$B/sim/imest-sim" ] || [ ! -x "$B/tools/replay/imest-replay" ]; then
+if [ ! -x "$B/bin/imest-sim" ] || [ ! -x "$B/bin/imest-replay" ]; then
   cmake -S "$ROOT" -B "$B" -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build "$B" -j2 --target imest-sim imest-replay >/dev/null
 fi

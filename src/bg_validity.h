@@ -1,0 +1,13 @@
+/* Background stage: the verdict on one window (docs/METHOD.md §7; README "When
+ * is a window valid"). Internal: not part of the public API. */
+#ifndef IMEST_BG_VALIDITY_H
+#define IMEST_BG_VALIDITY_H
+
+#include "bg_window.h"
+
+/* Fills valid/status and the per-parameter verdicts of r from the window
+ * flags, the window's statistics and the solve. */
+void bg_judge(const imest_t *s, const bg_window_stats_t *st, const bg_solve_out_t *so,
+              imest_result_t *r);
+
+#endif /* IMEST_BG_VALIDITY_H */

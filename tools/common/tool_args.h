@@ -1,0 +1,49 @@
+/* Command lines the same way in every host tool: "--opt value" and
+ * "--opt=value", "-" as a file name (stdin), "--" ends the options, and one
+ * exit-code convention. Host tool code (stdio). */
+#ifndef IMEST_TOOL_ARGS_H
+#define IMEST_TOOL_ARGS_H
+
+/* Exit codes of every imest tool. */
+enum {
+  TOOL_EXIT_OK = 0,    /* success */
+  TOOL_EXIT_DATA = 1,  /* the input or data is unusable (bad content, nothing decoded, I/O) */
+  TOOL_EXIT_USAGE = 2  /* bad option or argument */
+};
+
+typedef enum { TOOL_ARG_END = 0, TOOL_ARG_OPTION, TOOL_ARG_OPERAND } tool_arg_kind_t;
+
+typedef struct {
+  const char *prog;         /* for messages: "prog: ..." */
+  int argc;
+  char **argv;
+  int next;                 /* index of the next argv element */
+  int options_done;         /* after "--" everything is an operand */
+  char opt[64];             /* current option's name without "=value" */
+  const char *inline_value; /* the text after '=' of "--opt=value", else NULL */
+  const char *operand;      /* current operand (TOOL_ARG_OPERAND) */
+} tool_args_t;
+
+void tool_args_init(tool_args_t *a, const char *prog, int argc, char **argv);
+
+/* The next argument: an option (a->opt), an operand (a->operand; "-" is an
+ * operand) or the end. */
+tool_arg_kind_t tool_args_next(tool_args_t *a);
+
+/* Whether the current option is `name` (e.g. "--window"). */
+int tool_args_is(const tool_args_t *a, const char *name);
+
+/* The current option's value: "--opt=value" or the next argument. NULL after
+ * printing "prog: --opt needs a value". */
+const char *tool_args_value(tool_args_t *a);
+
+/* The value as a finite number. 0, or -1 after printing the reason. */
+int tool_args_number(tool_args_t *a, double *out);
+
+/* A flag takes no value: 0, or -1 after printing "--flag takes no value". */
+int tool_args_flag(tool_args_t *a);
+
+/* Prints "prog: unknown option '--x' (see --help)"; returns TOOL_EXIT_USAGE. */
+int tool_args_unknown(const tool_args_t *a);
+
+#endif

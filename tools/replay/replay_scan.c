@@ -1,0 +1,278 @@
+#include "replay_scan.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "tool_args.h"
+
+#define PI 3.14159265358979323846
+/* Below this rate no motor log is usable (a 64-sample window, the supply
+ * frequency): a lower rate from t means t is not in seconds. */
+#define FS_IMPLAUSIBLE_HZ 100.0
+
+static const char *const k_prog = "imest-replay";
+
+static double wrap_pi(double x) { return x - 2.0 * PI * floor((x + PI) / (2.0 * PI)); }
+
+/* Clipping signature: runs of >= 5 identical samples at the record's extreme. */
+static void clip_feed(clip_t *c, double x)
+{
+  const double a = fabs(x);
+  if (a > c->max_abs) {
+    c->max_abs = a;
+    c->plateau = 0;
+    c->run = 1;
+  } else if (a == c->max_abs && x == c->prev) {
+    c->run++;
+    if (c->run == 5) c->plateau += 5;
+    else if (c->run > 5) c->plateau++;
+  } else if (a == c->max_abs) {
+    c->run = 1;
+  } else {
+    c->run = 0;
+  }
+  c->prev = x;
+}
+
+/* What the time column and the conventions look like over the whole file. */
+typedef struct {
+  double tprev, qprev;       /* previous t and its rounding bound */
+  double dt_min, dt_max;     /* raw steps */
+  long line_min, line_max;
+  double lo, hi;             /* steps widened / narrowed by their rounding */
+  long line_lo, line_hi;
+  long repeats, line_repeat; /* steps of exactly 0 */
+  double t_repeat;
+  double q_repeat, q_worst;  /* rounding of t at the first repeat, at the widest step */
+  int all_unit_steps;        /* every step exactly 1 (a sample index) */
+  double p_sum, s_sum;       /* sum of u.i, sum of |u||i| */
+  double field_rad, mech_rad;/* net rotation of the current vector, of theta */
+  double i_prev[2];
+  double th_prev, th_min, th_max;
+  long th_wraps;             /* steps beyond +-pi: the angle wraps somewhere */
+} tally_t;
+
+static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const double v[CSV_NEED])
+{
+  /* power-invariant alpha/beta of the currents: the field's direction */
+  const double ia = (2.0 * v[4] - v[5] - v[6]) / 3.0, ib = (v[5] - v[6]) / sqrt(3.0);
+  const double u2 = v[1] * v[1] + v[2] * v[2] + v[3] * v[3];
+  const double i2 = v[4] * v[4] + v[5] * v[5] + v[6] * v[6];
+  y->p_sum += v[1] * v[4] + v[2] * v[5] + v[3] * v[6];
+  y->s_sum += sqrt(u2 * i2);
+  if (s->n == 0) {
+    s->t0 = v[0];
+    s->i_first = fmax(fabs(v[4]), fmax(fabs(v[5]), fabs(v[6])));
+    y->th_min = y->th_max = v[7];
+  } else {
+    const double dt = v[0] - y->tprev, q = r->t_round + y->qprev;
+    if (dt < y->dt_min) { y->dt_min = dt; y->line_min = r->line; }
+    if (dt > y->dt_max) { y->dt_max = dt; y->line_max = r->line; }
+    if (dt + q < y->lo) { y->lo = dt + q; y->line_lo = r->line; }
+    if (dt - q > y->hi) { y->hi = dt - q; y->line_hi = r->line; }
+    if (dt == y->dt_max) y->q_worst = r->t_round;
+    if (dt == 0.0 && y->repeats++ == 0) {
+      y->line_repeat = r->line;
+      y->t_repeat = v[0];
+      y->q_repeat = r->t_round;
+    }
+    if (dt != 1.0) y->all_unit_steps = 0;
+    const double dth = v[7] - y->th_prev;
+    if (fabs(dth) > PI) y->th_wraps++;
+    y->mech_rad += wrap_pi(dth);
+    if (s->n == 1) s->th_step1 = fabs(wrap_pi(dth));
+    y->field_rad += atan2(y->i_prev[0] * ib - y->i_prev[1] * ia, y->i_prev[0] * ia + y->i_prev[1] * ib);
+    y->th_min = fmin(y->th_min, v[7]);
+    y->th_max = fmax(y->th_max, v[7]);
+  }
+  for (int k = 0; k < 3; ++k) {
+    clip_feed(&s->clip_u[k], v[1 + k]);
+    clip_feed(&s->clip_i[k], v[4 + k]);
+    s->i_max = fmax(s->i_max, fabs(v[4 + k]));
+  }
+  y->i_prev[0] = ia;
+  y->i_prev[1] = ib;
+  y->th_prev = v[7];
+  y->tprev = v[0];
+  y->qprev = r->t_round;
+  s->n++;
+}
+
+/* Decimals a rounding bound stands for (5e-5 -> 4). */
+static int decimals(double q) { return q > 0 ? (int)lround(-log10(2.0 * q)) : 0; }
+
+/* t is not in seconds, or not a time at all: say which, and what to do. */
+static int bad_unit(const char *name, const tally_t *y, double step)
+{
+  if (y->all_unit_steps) {
+    fprintf(stderr,
+            "%s: %s: t counts samples (every step is exactly 1), it is not a time in seconds. "
+            "Give the drive's sample rate with --fs HZ (t then only orders the rows), or write "
+            "t in seconds.\n",
+            k_prog, name);
+    return TOOL_EXIT_DATA;
+  }
+  fprintf(stderr, "%s: %s: t steps by %.6g on average: %.6g Hz if t is in seconds, too slow for "
+          "any motor log (the estimator needs at least several hundred Hz).",
+          k_prog, name, step, 1.0 / step);
+  if (1e3 / step >= FS_IMPLAUSIBLE_HZ && 1e3 / step <= 1e6)
+    fprintf(stderr, " If t is in milliseconds (%.6g Hz), divide it by 1000 or give --fs %.6g.",
+            1e3 / step, 1e3 / step);
+  else if (1e6 / step >= FS_IMPLAUSIBLE_HZ && 1e6 / step <= 1e6)
+    fprintf(stderr, " If t is in microseconds (%.6g Hz), divide it by 1e6 or give --fs %.6g.",
+            1e6 / step, 1e6 / step);
+  fprintf(stderr, " If t is a sample index or a timer count, give --fs with the drive's sample "
+                  "rate.\n");
+  return TOOL_EXIT_DATA;
+}
+
+/* Without --fs: t in seconds, increasing, steps fixed but for its rounding. */
+static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s, int quiet)
+{
+  const double step = (s->t_last - s->t0) / (double)(s->n - 1);
+  if (y->repeats) {
+    if (2.0 * y->q_repeat >= 0.5 * step)
+      fprintf(stderr,
+              "%s: %s:%ld: t = %.9g repeats the previous row's t: t is printed with %d decimals, "
+              "too few for its mean step of %.6g s (%.6g Hz). Write t with more decimals, or give "
+              "--fs HZ (t then only orders the rows).\n",
+              k_prog, name, y->line_repeat, y->t_repeat, decimals(y->q_repeat), step, 1.0 / step);
+    else
+      fprintf(stderr,
+              "%s: %s:%ld: t = %.9g repeats the previous row's t (%ld times in the file): a duplicated "
+              "row? If the drive did sample at a fixed rate, give --fs HZ (t then only orders "
+              "the rows).\n",
+              k_prog, name, y->line_repeat, y->t_repeat, y->repeats);
+    return TOOL_EXIT_DATA;
+  }
+  if (1.0 / step < FS_IMPLAUSIBLE_HZ || y->all_unit_steps) return bad_unit(name, y, step);
+  if (1.0 / step > 1e6) {
+    fprintf(stderr, "%s: %s: t steps by %.6g s on average, %.6g Hz: is t in seconds? Write t in "
+            "seconds or give --fs HZ.\n", k_prog, name, step, 1.0 / step);
+    return TOOL_EXIT_DATA;
+  }
+  if (y->hi > 1.05 * step || y->lo < 0.95 * step) {
+    const int gap = y->hi - 1.05 * step > 0.95 * step - y->lo;
+    const long line = gap ? y->line_hi : y->line_lo;
+    const double dt = gap ? y->dt_max : y->dt_min;
+    fprintf(stderr,
+            "%s: %s:%ld: irregular sampling: a step of %.6g s where the record's mean step is "
+            "%.6g s (%.6g Hz)%s. The estimator needs a fixed sample rate. If the drive did sample "
+            "at a fixed rate and only t is inaccurate, give --fs HZ.\n",
+            k_prog, name, line, dt, step, 1.0 / step,
+            gap && dt > 1.5 * step ? ": samples are missing there" : "");
+    return TOOL_EXIT_DATA;
+  }
+  s->fs = s->fs_t = 1.0 / step;
+  s->t_unit_s = 1.0;
+  s->t_rounded = y->dt_max > 1.05 * step || y->dt_min < 0.95 * step;
+  if (s->t_rounded && !quiet)
+    fprintf(stderr,
+            "%s: note: t is printed with %d decimals; its steps (%.6g .. %.6g s) are read as the "
+            "rounding of a fixed %.6g s step (%.6g Hz from the record's span)\n",
+            k_prog, decimals(y->q_worst), y->dt_min, y->dt_max, step, s->fs);
+  return -1;
+}
+
+/* With --fs: t only orders the rows; its unit follows from its mean step. */
+static int time_base_given(const char *name, const tally_t *y, replay_scan_t *s, double fs,
+                           int quiet)
+{
+  const double step = (s->t_last - s->t0) / (double)(s->n - 1);
+  s->fs = fs;
+  if (y->dt_min < 0) {
+    /* a timer that wrapped, or no time at all: the output counts from the first row */
+    if (!quiet)
+      fprintf(stderr, "%s: note: %s:%ld: t decreases; with --fs it is not used, output times "
+              "count from the first row\n", k_prog, name, y->line_min);
+    s->t_unit_s = 0.0;
+    return -1;
+  }
+  s->fs_t = step > 0 ? 1.0 / step : 0.0;
+  double unit = step > 0 ? 1.0 / (fs * step) : 0.0;
+  static const double k_units[] = {1.0, 1e-3, 1e-6};
+  for (size_t k = 0; k < sizeof k_units / sizeof k_units[0]; ++k)
+    if (fabs(unit / k_units[k] - 1.0) < 0.05) {
+      if (k == 0 && fabs(unit - 1.0) > 0.01 && !quiet)
+        fprintf(stderr, "%s: note: t says %.6g Hz, --fs says %.6g Hz: using --fs\n", k_prog,
+                s->fs_t, fs);
+      unit = k_units[k];
+      break;
+    }
+  s->t_unit_s = unit;
+  if (step > 0 && (y->hi > 1.05 * step || y->lo < 0.95 * step) && !quiet)
+    fprintf(stderr, "%s: note: t's steps vary from %.6g to %.6g (mean %.6g, line %ld); with --fs "
+            "they are not checked: the rows are taken as samples at %.6g Hz\n",
+            k_prog, y->dt_min, y->dt_max, step, y->hi > 1.05 * step ? y->line_hi : y->line_lo, fs);
+  return -1;
+}
+
+/* The quick tests of the conventions (docs/feeding-logs.md). A negative power
+ * is a note (a braking drive draws it); theta turning against the field over
+ * the whole record is an error: such data fit a motor with a far smaller T_R
+ * and pass as valid (measured: T_R -97.5 %, E_I 0.007). */
+static int check_conventions(const tally_t *y, const char *name, int quiet)
+{
+  if (!quiet && y->s_sum > 0 && y->p_sum < -0.2 * y->s_sum)
+    fprintf(stderr,
+            "%s: note: the mean power u.i is negative (%.3g of the apparent power): unless the "
+            "motor was braking, the current sign is inverted (currents must be positive into the "
+            "motor) or a voltage and a current column are of different phases\n",
+            k_prog, y->p_sum / y->s_sum);
+  if (fabs(y->field_rad) > 4.0 * PI && fabs(y->mech_rad) > PI &&
+      (y->field_rad > 0) != (y->mech_rad > 0)) {
+    fprintf(stderr,
+            "%s: %s: theta turns %s (%.3g turns) while the a-b-c current field turns %s (%.3g "
+            "turns): theta must increase with the a-b-c field, else T_R comes out far too small "
+            "and can look valid. Negate theta, or swap two phases of u and i alike.\n",
+            k_prog, name, y->mech_rad > 0 ? "forward" : "backward", fabs(y->mech_rad) / (2 * PI),
+            y->field_rad > 0 ? "forward" : "backward", fabs(y->field_rad) / (2 * PI));
+    return TOOL_EXIT_DATA;
+  }
+  if (quiet) return -1;
+  if (y->th_wraps > 0 && y->th_max - y->th_min > 2.0 * PI * 1.05)
+    fprintf(stderr,
+            "%s: note: theta wraps around at about %.6g; an angle in rad wraps at 2 pi = 6.283. "
+            "theta must be the mechanical angle in rad, not degrees (360) or encoder counts\n",
+            k_prog, y->th_max - y->th_min);
+  return -1;
+}
+
+int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s)
+{
+  memset(s, 0, sizeof *s);
+  tally_t y;
+  memset(&y, 0, sizeof y);
+  y.dt_min = y.lo = INFINITY;
+  y.dt_max = y.hi = -INFINITY;
+  y.all_unit_steps = 1;
+  double v[CSV_NEED];
+  int rc;
+  while ((rc = csv_next(r, v)) == 1) {
+    if (s->n > 0 && v[0] < y.tprev && o->fs_hz <= 0) {
+      fprintf(stderr, "%s: %s:%ld: t = %.9g does not increase (previous %.9g): rows out of "
+              "order, or a timer that wrapped (then give --fs HZ)\n",
+              k_prog, r->name, r->line, v[0], y.tprev);
+      return TOOL_EXIT_DATA;
+    }
+    tally_row(&y, s, r, v);
+  }
+  if (rc < 0) {
+    fprintf(stderr, "%s: %s\n", k_prog, r->err);
+    return TOOL_EXIT_DATA;
+  }
+  if (r->truncated_line && !o->quiet)
+    fprintf(stderr, "%s: warning: %s: the last line looks cut off; it is left out and the "
+            "%ld rows before it are used\n", k_prog, r->warn, s->n);
+  if (s->n < 2) {
+    fprintf(stderr, "%s: %s: %s\n", k_prog, r->name,
+            s->n == 0 ? "no data rows after the header" : "only one data row: no sample rate");
+    return TOOL_EXIT_DATA;
+  }
+  s->t_last = y.tprev;
+  rc = o->fs_hz > 0 ? time_base_given(r->name, &y, s, o->fs_hz, o->quiet)
+                    : time_base_from_t(r->name, &y, s, o->quiet);
+  if (rc >= 0) return rc;
+  return check_conventions(&y, r->name, o->quiet);
+}

@@ -1,0 +1,32 @@
+/* imest-replay's first pass over a recording: its time base (sample rate,
+ * unit and rounding of t), ADC clipping, whether it starts at rest, and a
+ * check of the sign conventions. Everything the run needs before the first
+ * sample goes to the estimator. */
+#ifndef IMEST_REPLAY_SCAN_H
+#define IMEST_REPLAY_SCAN_H
+
+#include "csv_reader.h"
+#include "replay_options.h"
+
+typedef struct {
+  double max_abs, prev;
+  long run, plateau;
+} clip_t;
+
+typedef struct {
+  long n;                 /* data rows */
+  double t0, t_last;      /* first and last t, in the file's unit */
+  double fs;              /* the sample rate used [Hz]: --fs, or from t */
+  double fs_t;            /* the rate t implies if it is in seconds [Hz] */
+  double t_unit_s;        /* seconds per unit of t (1 unless --fs says otherwise) */
+  int t_rounded;          /* t's steps vary only by its printed rounding */
+  clip_t clip_i[3], clip_u[3];
+  double i_first, i_max;  /* for the at-rest test */
+  double th_step1;        /* |first angle step| [rad] */
+} replay_scan_t;
+
+/* Reads the whole file once. Returns -1 to go on, or the exit code after a
+ * message on stderr (TOOL_EXIT_DATA: the file cannot be used, with what to do). */
+int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s);
+
+#endif
