@@ -1,5 +1,5 @@
 /* Arithmetic of the ISR path: imest_real_t is float (float64 only in the
- * host-side reference build, IMEST_ISR_DOUBLE). Literals go through RL() so the
+ * host-side reference build, src/CMakeLists.txt). Literals go through RL() so the
  * float build never promotes to double (-Wdouble-promotion). */
 #ifndef IMEST_ISR_REAL_H
 #define IMEST_ISR_REAL_H
@@ -24,7 +24,9 @@
  * Clang expand the builtin to one instruction (VABS.F32 on Cortex-M4F: the
  * comparison form costs four, six times per sample). */
 #if defined(__GNUC__) || defined(__clang__)
-#ifdef IMEST_ISR_DOUBLE
+/* the float64 reference build's copy of imest.h (src/CMakeLists.txt) defines
+ * IMEST_REF64_REAL_DOUBLE; the public header does not */
+#ifdef IMEST_REF64_REAL_DOUBLE
 static inline imest_real_t isr_abs(imest_real_t x) { return __builtin_fabs(x); }
 #else
 static inline imest_real_t isr_abs(imest_real_t x) { return __builtin_fabsf(x); }

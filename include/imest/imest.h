@@ -261,17 +261,11 @@ typedef struct {
 } imest_result_t;
 
 /* ----------------------------------------------------------------------------
- * Instance (caller-owned; treat as opaque)
+ * Instance (caller-owned storage; every field is private to the library)
  * ------------------------------------------------------------------------- */
 
-/** Arithmetic type of the ISR path: float32. Defining IMEST_ISR_DOUBLE builds
- *  an all-float64 variant, used only by the host tests as the reference that
- *  the float32 path is measured against. */
-#ifdef IMEST_ISR_DOUBLE
-typedef double imest_real_t;
-#else
+/** Arithmetic type of the ISR path: float32. */
 typedef float imest_real_t;
-#endif
 
 /** Number of accumulated entries: 28 of R_W (7 columns), 7 of R_Wy, 1 of R_y,
  *  and the rotation of the rotor-frame current (sum of i x di/dt: slip excitation). */

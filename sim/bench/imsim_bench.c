@@ -55,5 +55,15 @@ int main(int argc, char **argv) {
   imsim_config_preset(&c, "exp2");
   c.supply = IMSIM_SUPPLY_IFOC;
   run("exp2 IFOC + pwm, 12-bit", &c, motor_s);
+  imsim_config_preset(&c, "4kw");
+  run("4kw drive 8 kHz, svpwm, firmware timing", &c, motor_s);
+  c.dead_time_s = 2e-6;
+  c.v_switch_v = 1.0;
+  c.r_switch_ohm = 0.02;
+  c.v_diode_v = 0.8;
+  c.r_diode_ohm = 0.01;
+  run("  same, dead time 2 us + device drops", &c, motor_s);
+  c.pwm_moments = false;
+  run("  same, --pwm-segments", &c, motor_s);
   return 0;
 }

@@ -1,9 +1,11 @@
-/* imest-sim: writes a simulated induction-motor record as CSV. A thin layer on the imsim API. */
+/* imest-sim: writes a simulated induction-motor record as CSV. A thin layer on the imsim API:
+ * parse (flags -> imsim_config) and run (simulate, write rows, progress). */
 #define _POSIX_C_SOURCE 200809L
 #include "imsim_cli.h"
 
 #include <errno.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -13,44 +15,89 @@ static const char HEADER[] =
     "t,u_a,u_b,u_c,i_a,i_b,i_c,theta,"
     "T_R_true_s,R_S_true_ohm,speed_rad_s,torque_nm,load_nm,psi_r_wb,temp_stator_c,temp_rotor_c,"
     "i_a_true,i_b_true,i_c_true,theta_true,u_a_true,u_b_true,u_c_true,"
-    "ifoc_torque_ref_nm,ifoc_flux_ref_wb,ifoc_tr_s,ifoc_speed_ref_rad_s";
+    "ifoc_torque_ref_nm,ifoc_flux_ref_wb,ifoc_tr_s,ifoc_speed_ref_rad_s,"
+    "d_a,d_b,d_c,v_dc";
 
 const char *imsim_cli_header(void) { return HEADER; }
 
 static const char USAGE[] =
     "usage: imest-sim [options]\n"
-    "Simulates the induction motor of Wang et al. (IEEE TCST 2007) and writes CSV:\n"
-    "  t,u_a,u_b,u_c,i_a,i_b,i_c,theta (measured) followed by truth columns.\n"
+    "Simulates an induction motor (by default the one of Wang et al., IEEE TCST 2007) fed by an\n"
+    "ideal source, a PWM inverter or an IFOC drive, and writes CSV: t,u_a,u_b,u_c,i_a,i_b,i_c,theta\n"
+    "(measured), truth columns, then the drive's d_a,d_b,d_c (duties applied from this row to the\n"
+    "next, firmware timing) and v_dc (bus sample). Every flag is optional: the defaults are the\n"
+    "preset's (exp1 when none is given); a flag given overrides the preset. --opt value and\n"
+    "--opt=value both work.\n"
     "\n"
-    "  --preset exp1|exp2    experiment preset (applied before every other flag)\n"
-    "  --duration S          simulated time (rows t = 0 .. S)\n"
-    "  --fs HZ               sampling frequency (default 4000)\n"
-    "  --out FILE            output file, '-' = stdout (default -)\n"
-    "  --decimate N          write every N-th sample (default 1)\n"
-    "motor:\n"
-    "  --pole-pairs N --ls H --lr H --sigma X --rs OHM --tr S --j KGM2 --b NMS\n"
+    "run:\n"
+    "  --preset NAME         exp1: the paper's motor, 60 Hz, 230 V applied at standstill, no load,\n"
+    "                        2 s; exp2: the paper's motor, 30 Hz V/f (115 V) at rated load\n"
+    "                        2.064 N m, 3600 s; 4kw|11kw|15kw|37kw|75kw: a 400 V 50 Hz motor on a\n"
+    "                        560 V 8 kHz drive (svpwm, firmware timing, fs 8 kHz), steady at\n"
+    "                        rated load, 390 V 50 Hz, 10 s (see sim/README.md, Presets)\n"
+    "  --duration S          simulated time, rows t = 0 .. S (exp1 2, exp2 3600)\n"
+    "  --fs HZ               sample rate (4000)\n"
+    "  --out FILE            output file, '-' = stdout (-)\n"
+    "  --decimate N          write every N-th sample (1)\n"
+    "  --progress, --no-progress   bar on stderr (default: when stderr is a terminal)\n"
+    "  --help                this text\n"
+    "motor (default: the paper's motor; resistances cold, at --t-amb):\n"
+    "  --pole-pairs N (2)  --ls H (0.2908)  --lr H (0.2908)  --sigma X (0.096)\n"
+    "  --rs OHM (5.04)  --tr S (0.12)  --j KGM2 (1.2e-3)  --b NMS (1e-4, viscous friction)\n"
     "supply:\n"
-    "  --supply sine|vf|pwm|ifoc   --vll V (line-line rms)   --freq HZ\n"
-    "  --vf-ramp S --vf-boost V    --carrier-hz HZ --vdc V --dead-time S\n"
-    "  --pwm-segments        integrate piecewise between PWM switching instants (reference accuracy,\n"
-    "                        ~2.3x slower; default: one step per half carrier period, see README)\n"
-    "  --start rest|steady   (steady: begin in the sinusoidal steady state, full load)\n"
-    "load:\n"
-    "  --load-nm NM --load-on S --load-ramp S\n"
-    "IFOC:\n"
-    "  --ifoc-tr S --ifoc-flux WB --ifoc-mode speed|torque --speed-ref RPM --speed-ramp S\n"
-    "  --torque-ref NM --torque-limit NM --ifoc-ideal-stage\n"
+    "  --supply sine|vf|pwm|ifoc   ideal sine applied at once | ideal V/f ramp | PWM inverter on\n"
+    "                        the V/f reference | IFOC driving the PWM inverter (exp1 sine, exp2 vf)\n"
+    "  --vll V               line-to-line rms voltage (exp1 230, exp2 115)\n"
+    "  --freq HZ             electrical frequency (exp1 60, exp2 30)\n"
+    "  --vf-ramp S           V/f ramp from 0 to --freq (exp1 0 = at once, exp2 1)\n"
+    "  --vf-boost V          V/f voltage at 0 Hz (0)\n"
+    "  --start rest|steady   rest: standstill, zero flux; steady: the sinusoidal steady state at\n"
+    "                        full load from t = 0 (rest)\n"
+    "PWM inverter (--supply pwm|ifoc):\n"
+    "  --carrier-hz HZ (10000)  --vdc V (400)\n"
+    "  --modulation spwm|svpwm   sine-triangle | min-max zero sequence (spwm)\n"
+    "  --timing ideal|firmware   ideal: reference at every half period's centre; firmware:\n"
+    "                        sample at a carrier valley every N = f_c/fs periods, duties from\n"
+    "                        sample k applied during [t_k+1, t_k+2) (ideal)\n"
+    "  --dead-time S         dead time incl. switching delays (0)\n"
+    "  --v-switch V  --r-switch OHM  --v-diode V  --r-diode OHM   device drops, threshold +\n"
+    "                        slope: switch V_sw + r_sw |i|, diode V_d + r_d |i| (0: ideal)\n"
+    "  --pwm-segments        integrate piecewise between switching instants (reference accuracy,\n"
+    "                        about 2.3x slower; default: one step per half carrier period)\n"
+    "load (opposes rotation):\n"
+    "  --load-nm NM (exp1 0, exp2 2.064)  --load-on S (exp2 1.5)  --load-ramp S (exp2 1)\n"
+    "IFOC (--supply ifoc):\n"
+    "  --ifoc-mode speed|torque (speed)\n"
+    "  --speed-ref RPM (exp1 1750, exp2 850)  --speed-ramp S (exp1 0.5, exp2 1)\n"
+    "  --torque-ref NM (0)  --torque-limit NM (4)\n"
+    "  --ifoc-tr S           the controller's T_R (default: the motor's cold T_R)\n"
+    "  --ifoc-flux WB        rotor-flux reference (default: the steady-state flux at --vll/--freq)\n"
+    "  --ifoc-ideal-stage    ideal voltage source instead of the PWM inverter\n"
     "sensors:\n"
-    "  --ideal-sensors (exact samples: no quantisation, noise, clipping, AA, encoder)\n"
-    "  --seed N --adc-bits N --i-range A --u-range V --noise-lsb X --encoder-counts N\n"
-    "  --i-offset A,A,A --u-offset V,V,V --i-gain-err X,X,X   per-phase sensor offsets and\n"
-    "                        relative gain errors (default 0)\n"
-    "  --aa-hz HZ (0 = off) --vmeas auto|avg|aa|inst\n"
+    "  --ideal-sensors       exact samples: no quantisation, noise, clipping, AA filter, encoder\n"
+    "  --adc-bits N (12)  --i-range A (20)  --u-range V (400): ADC full scale is +-range\n"
+    "  --vdc-range V         DC-bus ADC full scale, 0 .. V (800)\n"
+    "  --noise-lsb X (1)     white Gaussian noise before the ADC, rms in LSB\n"
+    "  --seed N (1)          noise seed\n"
+    "  --encoder-counts N    counts per mechanical revolution (4096)\n"
+    "  --i-offset A,A,A  --u-offset V,V,V  --i-gain-err X,X,X   per-phase (a,b,c) sensor offsets\n"
+    "                        and relative gain errors, 0.01 = reads 1 % high (0,0,0)\n"
+    "  --aa-hz HZ            2nd-order Butterworth anti-alias filter on every electrical\n"
+    "                        channel (0 = off)\n"
+    "  --vmeas auto|avg|aa|inst   voltage channel: avg = phase voltage from the commanded duties\n"
+    "                        and Vdc (PWM only); aa = through the AA filter; inst = instantaneous\n"
+    "                        (ideal supplies only); auto = avg with PWM, inst otherwise (auto)\n"
     "thermal:\n"
-    "  --no-thermal --t-amb C --thermal-speedup X\n"
+    "  --no-thermal          freeze R_S and R_R\n"
+    "  --t-amb C (22)  --thermal-speedup X (1; multiplies both thermal rates)\n"
     "integrator:\n"
-    "  --integrator fast|rk4 --rk4-substeps N --steps-per-sample N\n"
-    "  --progress / --no-progress (default: bar on stderr when it is a terminal)\n";
+    "  --integrator fast|rk4 (fast; rk4 = slow reference)  --rk4-substeps N (8)\n"
+    "  --steps-per-sample N  steps per sample for the ideal supplies (0 = auto: 5; PWM: fixed)\n"
+    "\n"
+    "Exit status: 0 done (a warning on stderr says when the PWM modulation was clipped),\n"
+    "1 the output cannot be written, 2 a bad flag or an impossible configuration.\n";
+
+/* ---- parse ------------------------------------------------------------------------------ */
 
 static int perr(char *err, size_t n, const char *a, const char *b) {
   snprintf(err, n, "%s%s", a, b);
@@ -77,15 +124,234 @@ static int inum(const char *s, long *v) {
   return 0;
 }
 
-typedef enum { K_D, K_I, K_U64, K_STR } kind;
+#define CFG(field) offsetof(imsim_config, field)
+#define NONE_LO (-INFINITY)
+#define NONE_HI INFINITY
 
-int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, char *err, size_t errlen) {
-  o->out = "-";
-  o->decimate = 1;
-  o->progress = -1;
-  o->help = 0;
-  err[0] = '\0';
-  /* pass 1: preset */
+/* Real-valued flags: value in (lo, hi) or [lo, hi] as lo_open/hi_open say. */
+typedef struct {
+  const char *flag;
+  size_t off;
+  double lo, hi;
+  bool lo_open, hi_open;
+  const char *what;
+} real_flag;
+
+static const real_flag REAL_FLAGS[] = {
+    {"--duration", CFG(duration_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--fs", CFG(fs_hz), 0.0, NONE_HI, true, true, "> 0 Hz"},
+    {"--ls", CFG(ls_h), 0.0, NONE_HI, true, true, "> 0 H"},
+    {"--lr", CFG(lr_h), 0.0, NONE_HI, true, true, "> 0 H"},
+    {"--sigma", CFG(sigma), 0.0, 1.0, true, true, "0 < sigma < 1"},
+    {"--rs", CFG(rs_ohm), 0.0, NONE_HI, true, true, "> 0 ohm"},
+    {"--tr", CFG(tr_s), 0.0, NONE_HI, true, true, "> 0 s"},
+    {"--j", CFG(j_kgm2), 0.0, NONE_HI, true, true, "> 0 kg m^2"},
+    {"--b", CFG(b_nms), 0.0, NONE_HI, false, true, ">= 0 N m s"},
+    {"--vll", CFG(vll_v), 0.0, NONE_HI, false, true, ">= 0 V"},
+    {"--freq", CFG(freq_hz), 0.0, NONE_HI, false, true, ">= 0 Hz"},
+    {"--vf-ramp", CFG(vf_ramp_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--vf-boost", CFG(vf_boost_v), 0.0, NONE_HI, false, true, ">= 0 V"},
+    {"--load-nm", CFG(load_nm), NONE_LO, NONE_HI, true, true, "N m"},
+    {"--load-on", CFG(load_on_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--load-ramp", CFG(load_ramp_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--carrier-hz", CFG(carrier_hz), 0.0, NONE_HI, true, true, "> 0 Hz"},
+    {"--vdc", CFG(vdc_v), 0.0, NONE_HI, true, true, "> 0 V"},
+    {"--dead-time", CFG(dead_time_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--v-switch", CFG(v_switch_v), 0.0, NONE_HI, false, true, ">= 0 V"},
+    {"--r-switch", CFG(r_switch_ohm), 0.0, NONE_HI, false, true, ">= 0 ohm"},
+    {"--v-diode", CFG(v_diode_v), 0.0, NONE_HI, false, true, ">= 0 V"},
+    {"--r-diode", CFG(r_diode_ohm), 0.0, NONE_HI, false, true, ">= 0 ohm"},
+    {"--vdc-range", CFG(vdc_range_v), 0.0, NONE_HI, true, true, "> 0 V"},
+    {"--ifoc-tr", CFG(ifoc_tr_s), 0.0, NONE_HI, true, true, "> 0 s"},
+    {"--ifoc-flux", CFG(ifoc_flux_wb), 0.0, NONE_HI, true, true, "> 0 Wb"},
+    {"--speed-ref", CFG(speed_ref_rpm), NONE_LO, NONE_HI, true, true, "rpm"},
+    {"--speed-ramp", CFG(speed_ramp_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--torque-ref", CFG(torque_ref_nm), NONE_LO, NONE_HI, true, true, "N m"},
+    {"--torque-limit", CFG(torque_limit_nm), 0.0, NONE_HI, true, true, "> 0 N m"},
+    {"--i-range", CFG(i_range_a), 0.0, NONE_HI, true, true, "> 0 A"},
+    {"--u-range", CFG(u_range_v), 0.0, NONE_HI, true, true, "> 0 V"},
+    {"--noise-lsb", CFG(noise_lsb), 0.0, NONE_HI, false, true, ">= 0 LSB"},
+    {"--aa-hz", CFG(aa_hz), 0.0, NONE_HI, false, true, ">= 0 Hz (0 = off)"},
+    {"--t-amb", CFG(t_amb_c), -273.15, NONE_HI, true, true, "degC"},
+    {"--thermal-speedup", CFG(thermal_speedup), 0.0, NONE_HI, true, true, "> 0"},
+};
+
+/* Integer flags (int fields), value in [lo, hi]. */
+typedef struct {
+  const char *flag;
+  size_t off;
+  long lo, hi;
+} int_flag;
+
+static const int_flag INT_FLAGS[] = {
+    {"--pole-pairs", CFG(pole_pairs), 1, 64},
+    {"--adc-bits", CFG(adc_bits), 2, 30},
+    {"--encoder-counts", CFG(encoder_counts), 1, 1000000000},
+    {"--rk4-substeps", CFG(rk4_substeps), 1, 100000},
+    {"--steps-per-sample", CFG(steps_per_sample), 0, 100000},
+};
+
+/* Flags that name one of a few choices (enum fields, stored as int). */
+_Static_assert(sizeof(imsim_supply) == sizeof(int) && sizeof(imsim_vmeas) == sizeof(int) &&
+                   sizeof(imsim_start) == sizeof(int) && sizeof(imsim_ifoc_mode) == sizeof(int) &&
+                   sizeof(imsim_integrator) == sizeof(int) && sizeof(imsim_timing) == sizeof(int) &&
+                   sizeof(imsim_modulation) == sizeof(int),
+               "choice flags store enums as int");
+typedef struct {
+  const char *flag;
+  size_t off;
+  const char *names[5]; /* NULL-terminated */
+  int values[5];
+} choice_flag;
+
+static const choice_flag CHOICE_FLAGS[] = {
+    {"--supply", CFG(supply), {"sine", "vf", "pwm", "ifoc", NULL},
+     {IMSIM_SUPPLY_SINE, IMSIM_SUPPLY_VF, IMSIM_SUPPLY_PWM, IMSIM_SUPPLY_IFOC, 0}},
+    {"--vmeas", CFG(vmeas), {"auto", "avg", "aa", "inst", NULL},
+     {IMSIM_VMEAS_AUTO, IMSIM_VMEAS_AVG, IMSIM_VMEAS_AA, IMSIM_VMEAS_INST, 0}},
+    {"--start", CFG(start), {"rest", "steady", NULL, NULL, NULL}, {IMSIM_START_REST, IMSIM_START_STEADY, 0, 0, 0}},
+    {"--ifoc-mode", CFG(ifoc_mode), {"speed", "torque", NULL, NULL, NULL},
+     {IMSIM_IFOC_SPEED, IMSIM_IFOC_TORQUE, 0, 0, 0}},
+    {"--integrator", CFG(integrator), {"fast", "rk4", NULL, NULL, NULL},
+     {IMSIM_INTEGRATOR_FAST, IMSIM_INTEGRATOR_RK4, 0, 0, 0}},
+    {"--timing", CFG(timing), {"ideal", "firmware", NULL, NULL, NULL},
+     {IMSIM_TIMING_IDEAL, IMSIM_TIMING_FIRMWARE, 0, 0, 0}},
+    {"--modulation", CFG(modulation), {"spwm", "svpwm", NULL, NULL, NULL}, {IMSIM_MOD_SPWM, IMSIM_MOD_SVPWM, 0, 0, 0}},
+};
+
+/* Per-phase flags: three comma-separated numbers for phases a, b, c. */
+typedef struct {
+  const char *flag;
+  size_t off;
+} phase_flag;
+
+static const phase_flag PHASE_FLAGS[] = {
+    {"--i-offset", CFG(i_offset_a)},
+    {"--u-offset", CFG(u_offset_v)},
+    {"--i-gain-err", CFG(i_gain_err)},
+};
+
+#define COUNT(a) (sizeof(a) / sizeof((a)[0]))
+
+static void *field(imsim_config *c, size_t off) { return (char *)c + off; }
+
+/* Flags without a value, and the valued flags handled one by one in parse_valued. */
+static const char *const SWITCH_FLAGS[] = {"--help", "--ideal-sensors", "--no-thermal", "--ifoc-ideal-stage",
+                                           "--progress", "--no-progress", "--pwm-segments"};
+static const char *const OTHER_FLAGS[] = {"--preset", "--out", "--decimate", "--seed"};
+
+size_t imsim_cli_flags(const char **names, size_t max) {
+  size_t n = 0;
+#define ADD(x)                  \
+  do {                          \
+    if (n < max) names[n] = (x); \
+    ++n;                        \
+  } while (0)
+  for (size_t k = 0; k < COUNT(SWITCH_FLAGS); ++k) ADD(SWITCH_FLAGS[k]);
+  for (size_t k = 0; k < COUNT(OTHER_FLAGS); ++k) ADD(OTHER_FLAGS[k]);
+  for (size_t k = 0; k < COUNT(PHASE_FLAGS); ++k) ADD(PHASE_FLAGS[k].flag);
+  for (size_t k = 0; k < COUNT(CHOICE_FLAGS); ++k) ADD(CHOICE_FLAGS[k].flag);
+  for (size_t k = 0; k < COUNT(REAL_FLAGS); ++k) ADD(REAL_FLAGS[k].flag);
+  for (size_t k = 0; k < COUNT(INT_FLAGS); ++k) ADD(INT_FLAGS[k].flag);
+#undef ADD
+  return n;
+}
+
+const char *imsim_cli_usage(void) { return USAGE; }
+
+/* Flags without a value. Returns 1 if name is one (and applies it), 0 otherwise. */
+static int parse_switch(const char *name, imsim_config *c, imsim_cli_opts *o) {
+  if (strcmp(name, "--help") == 0) o->help = 1;
+  else if (strcmp(name, "--ideal-sensors") == 0) c->ideal_sensors = true;
+  else if (strcmp(name, "--no-thermal") == 0) c->thermal = false;
+  else if (strcmp(name, "--ifoc-ideal-stage") == 0) c->ifoc_ideal_stage = true;
+  else if (strcmp(name, "--progress") == 0) o->progress = 1;
+  else if (strcmp(name, "--no-progress") == 0) o->progress = 0;
+  else if (strcmp(name, "--pwm-segments") == 0) c->pwm_moments = false;
+  else return 0;
+  return 1;
+}
+
+/* Flags with a value. Returns 0 (applied), -1 (bad value, message in err) or 1 (unknown). */
+static int parse_valued(const char *name, const char *val, imsim_config *c, imsim_cli_opts *o, char *err,
+                        size_t errlen) {
+  if (strcmp(name, "--preset") == 0) return 0; /* applied in the first pass */
+  if (strcmp(name, "--out") == 0) {
+    if (val[0] == '\0') return perr(err, errlen, "empty value for ", name);
+    o->out = val;
+    return 0;
+  }
+  long l = 0;
+  if (strcmp(name, "--decimate") == 0) {
+    if (inum(val, &l) != 0 || l < 1) return perr(err, errlen, "invalid value for --decimate (integer >= 1): ", val);
+    o->decimate = l;
+    return 0;
+  }
+  if (strcmp(name, "--seed") == 0) {
+    char *end = NULL;
+    errno = 0;
+    const unsigned long long u = strtoull(val, &end, 10);
+    if (errno != 0 || end == val || *end != '\0' || val[0] == '-')
+      return perr(err, errlen, "invalid value for --seed (unsigned integer): ", val);
+    c->seed = (uint64_t)u;
+    return 0;
+  }
+  for (size_t k = 0; k < COUNT(PHASE_FLAGS); ++k) {
+    if (strcmp(name, PHASE_FLAGS[k].flag) != 0) continue;
+    double *per_phase = field(c, PHASE_FLAGS[k].off);
+    const char *p = val;
+    for (int q = 0; q < 3; ++q) {
+      char *end = NULL;
+      const double x = strtod(p, &end);
+      if (end == p || !isfinite(x) || (q < 2 ? *end != ',' : *end != '\0'))
+        return perr(err, errlen, "expected three comma-separated numbers (phases a,b,c) for ", name);
+      per_phase[q] = x;
+      p = end + 1;
+    }
+    return 0;
+  }
+  for (size_t k = 0; k < COUNT(CHOICE_FLAGS); ++k) {
+    const choice_flag *f = &CHOICE_FLAGS[k];
+    if (strcmp(name, f->flag) != 0) continue;
+    char list[64] = "";
+    for (int q = 0; f->names[q] != NULL; ++q) {
+      if (strcmp(val, f->names[q]) == 0) {
+        memcpy(field(c, f->off), &f->values[q], sizeof(int));
+        return 0;
+      }
+      if (q > 0) strncat(list, "|", sizeof list - strlen(list) - 1);
+      strncat(list, f->names[q], sizeof list - strlen(list) - 1);
+    }
+    snprintf(err, errlen, "invalid value for %s (%s): %s", name, list, val);
+    return -1;
+  }
+  for (size_t k = 0; k < COUNT(REAL_FLAGS); ++k) {
+    const real_flag *f = &REAL_FLAGS[k];
+    if (strcmp(name, f->flag) != 0) continue;
+    double d = 0.0;
+    const bool ok = num(val, &d) == 0 && (f->lo_open ? d > f->lo : d >= f->lo) && (f->hi_open ? d < f->hi : d <= f->hi);
+    if (!ok) {
+      snprintf(err, errlen, "invalid value for %s: '%s' (%s)", name, val, f->what);
+      return -1;
+    }
+    *(double *)field(c, f->off) = d;
+    return 0;
+  }
+  for (size_t k = 0; k < COUNT(INT_FLAGS); ++k) {
+    const int_flag *f = &INT_FLAGS[k];
+    if (strcmp(name, f->flag) != 0) continue;
+    if (inum(val, &l) != 0 || l < f->lo || l > f->hi) {
+      snprintf(err, errlen, "invalid value for %s: '%s' (integer %ld..%ld)", name, val, f->lo, f->hi);
+      return -1;
+    }
+    *(int *)field(c, f->off) = (int)l;
+    return 0;
+  }
+  return 1;
+}
+
+/* Pass 1: the preset, wherever it stands, so that every other flag overrides it. */
+static int parse_preset(int argc, char **argv, imsim_config *c, char *err, size_t errlen) {
   imsim_config_default(c);
   for (int a = 1; a < argc; ++a) {
     const char *arg = argv[a];
@@ -95,191 +361,155 @@ int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, c
       if (a + 1 >= argc) return perr(err, errlen, "missing value for ", arg);
       val = argv[a + 1];
     }
-    if (val != NULL && imsim_config_preset(c, val) != 0)
-      return perr(err, errlen, "unknown preset (exp1|exp2): ", val);
+    if (val != NULL && imsim_config_preset(c, val) != 0) {
+      snprintf(err, errlen, "unknown preset (%s): %s", imsim_preset_names(), val);
+      return -1;
+    }
   }
-  /* pass 2: everything */
+  return 0;
+}
+
+int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, char *err, size_t errlen) {
+  o->out = "-";
+  o->decimate = 1;
+  o->progress = -1;
+  o->help = 0;
+  err[0] = '\0';
+  if (parse_preset(argc, argv, c, err, errlen) != 0) return -1;
+  /* pass 2: every flag, in order (--opt value or --opt=value) */
   for (int a = 1; a < argc; ++a) {
     char name[64];
     const char *arg = argv[a];
-    const char *val = NULL;
     if (strncmp(arg, "--", 2) != 0) return perr(err, errlen, "unexpected argument: ", arg);
     const char *eq = strchr(arg, '=');
-    size_t len = eq != NULL ? (size_t)(eq - arg) : strlen(arg);
+    const size_t len = eq != NULL ? (size_t)(eq - arg) : strlen(arg);
     if (len >= sizeof name) return perr(err, errlen, "unknown flag: ", arg);
     memcpy(name, arg, len);
     name[len] = '\0';
-    if (eq != NULL) val = eq + 1;
-
-    /* flags without values */
-    if (strcmp(name, "--help") == 0 || strcmp(name, "--ideal-sensors") == 0 || strcmp(name, "--no-thermal") == 0 ||
-        strcmp(name, "--ifoc-ideal-stage") == 0 || strcmp(name, "--progress") == 0 ||
-        strcmp(name, "--pwm-segments") == 0 ||
-        strcmp(name, "--no-progress") == 0) {
+    const char *val = eq != NULL ? eq + 1 : NULL;
+    if (parse_switch(name, c, o)) {
       if (eq != NULL) return perr(err, errlen, "flag takes no value: ", name);
-      if (strcmp(name, "--help") == 0) o->help = 1;
-      else if (strcmp(name, "--ideal-sensors") == 0) c->ideal_sensors = true;
-      else if (strcmp(name, "--no-thermal") == 0) c->thermal = false;
-      else if (strcmp(name, "--ifoc-ideal-stage") == 0) c->ifoc_ideal_stage = true;
-      else if (strcmp(name, "--progress") == 0) o->progress = 1;
-      else if (strcmp(name, "--pwm-segments") == 0) c->pwm_moments = false;
-      else o->progress = 0;
       continue;
     }
     if (val == NULL) {
       if (a + 1 >= argc) return perr(err, errlen, "missing value for ", name);
       val = argv[++a];
     }
-    double d = 0.0;
-    long l = 0;
-#define DBL(flag, field, cond, what)                                                        \
-  if (strcmp(name, flag) == 0) {                                                            \
-    if (num(val, &d) != 0 || !(cond)) {                                                      \
-      snprintf(err, errlen, "invalid value for %s: '%s' (%s)", flag, val, what);           \
-      return -1;                                                                            \
-    }                                                                                       \
-    field = d;                                                                              \
-    continue;                                                                               \
-  }
-#define INT(flag, field, lo, hi)                                                            \
-  if (strcmp(name, flag) == 0) {                                                            \
-    if (inum(val, &l) != 0 || l < (lo) || l > (hi)) {                                        \
-      snprintf(err, errlen, "invalid value for %s: '%s' (integer %ld..%ld)", flag, val,     \
-               (long)(lo), (long)(hi));                                                     \
-      return -1;                                                                            \
-    }                                                                                       \
-    field = (int)l;                                                                         \
-    continue;                                                                               \
-  }
-    if (strcmp(name, "--preset") == 0) continue; /* done in pass 1 */
-    if (strcmp(name, "--out") == 0) {
-      if (val[0] == '\0') return perr(err, errlen, "empty value for ", name);
-      o->out = val;
-      continue;
-    }
-    if (strcmp(name, "--decimate") == 0) {
-      if (inum(val, &l) != 0 || l < 1) return perr(err, errlen, "invalid value for --decimate (integer >= 1): ", val);
-      o->decimate = l;
-      continue;
-    }
-    if (strcmp(name, "--seed") == 0) {
-      char *end = NULL;
-      errno = 0;
-      const unsigned long long u = strtoull(val, &end, 10);
-      if (errno != 0 || end == val || *end != '\0' || val[0] == '-')
-        return perr(err, errlen, "invalid value for --seed (unsigned integer): ", val);
-      c->seed = (uint64_t)u;
-      continue;
-    }
-    double *per_phase = strcmp(name, "--i-offset") == 0   ? c->i_offset_a
-                        : strcmp(name, "--u-offset") == 0   ? c->u_offset_v
-                        : strcmp(name, "--i-gain-err") == 0 ? c->i_gain_err
-                                                            : NULL;
-    if (per_phase != NULL) {
-      const char *p = val;
-      for (int k = 0; k < 3; ++k) {
-        char *end = NULL;
-        const double x = strtod(p, &end);
-        if (end == p || !isfinite(x) || (k < 2 ? *end != ',' : *end != '\0'))
-          return perr(err, errlen, "expected three comma-separated numbers (phases a,b,c) for ", name);
-        per_phase[k] = x;
-        p = end + 1;
-      }
-      continue;
-    }
-    if (strcmp(name, "--supply") == 0) {
-      if (strcmp(val, "sine") == 0) c->supply = IMSIM_SUPPLY_SINE;
-      else if (strcmp(val, "vf") == 0) c->supply = IMSIM_SUPPLY_VF;
-      else if (strcmp(val, "pwm") == 0) c->supply = IMSIM_SUPPLY_PWM;
-      else if (strcmp(val, "ifoc") == 0) c->supply = IMSIM_SUPPLY_IFOC;
-      else return perr(err, errlen, "invalid value for --supply (sine|vf|pwm|ifoc): ", val);
-      continue;
-    }
-    if (strcmp(name, "--vmeas") == 0) {
-      if (strcmp(val, "auto") == 0) c->vmeas = IMSIM_VMEAS_AUTO;
-      else if (strcmp(val, "avg") == 0) c->vmeas = IMSIM_VMEAS_AVG;
-      else if (strcmp(val, "aa") == 0) c->vmeas = IMSIM_VMEAS_AA;
-      else if (strcmp(val, "inst") == 0) c->vmeas = IMSIM_VMEAS_INST;
-      else return perr(err, errlen, "invalid value for --vmeas (auto|avg|aa|inst): ", val);
-      continue;
-    }
-    if (strcmp(name, "--start") == 0) {
-      if (strcmp(val, "rest") == 0) c->start = IMSIM_START_REST;
-      else if (strcmp(val, "steady") == 0) c->start = IMSIM_START_STEADY;
-      else return perr(err, errlen, "invalid value for --start (rest|steady): ", val);
-      continue;
-    }
-    if (strcmp(name, "--ifoc-mode") == 0) {
-      if (strcmp(val, "speed") == 0) c->ifoc_mode = IMSIM_IFOC_SPEED;
-      else if (strcmp(val, "torque") == 0) c->ifoc_mode = IMSIM_IFOC_TORQUE;
-      else return perr(err, errlen, "invalid value for --ifoc-mode (speed|torque): ", val);
-      continue;
-    }
-    if (strcmp(name, "--integrator") == 0) {
-      if (strcmp(val, "fast") == 0) c->integrator = IMSIM_INTEGRATOR_FAST;
-      else if (strcmp(val, "rk4") == 0) c->integrator = IMSIM_INTEGRATOR_RK4;
-      else return perr(err, errlen, "invalid value for --integrator (fast|rk4): ", val);
-      continue;
-    }
-    DBL("--duration", c->duration_s, d >= 0.0, ">= 0 s")
-    DBL("--fs", c->fs_hz, d > 0.0, "> 0 Hz")
-    INT("--pole-pairs", c->pole_pairs, 1, 64)
-    DBL("--ls", c->ls_h, d > 0.0, "> 0 H")
-    DBL("--lr", c->lr_h, d > 0.0, "> 0 H")
-    DBL("--sigma", c->sigma, d > 0.0 && d < 1.0, "0 < sigma < 1")
-    DBL("--rs", c->rs_ohm, d > 0.0, "> 0 ohm")
-    DBL("--tr", c->tr_s, d > 0.0, "> 0 s")
-    DBL("--j", c->j_kgm2, d > 0.0, "> 0 kg m^2")
-    DBL("--b", c->b_nms, d >= 0.0, ">= 0 N m s")
-    DBL("--vll", c->vll_v, d >= 0.0, ">= 0 V")
-    DBL("--freq", c->freq_hz, d >= 0.0, ">= 0 Hz")
-    DBL("--vf-ramp", c->vf_ramp_s, d >= 0.0, ">= 0 s")
-    DBL("--vf-boost", c->vf_boost_v, d >= 0.0, ">= 0 V")
-    DBL("--load-nm", c->load_nm, 1, "N m")
-    DBL("--load-on", c->load_on_s, d >= 0.0, ">= 0 s")
-    DBL("--load-ramp", c->load_ramp_s, d >= 0.0, ">= 0 s")
-    DBL("--carrier-hz", c->carrier_hz, d > 0.0, "> 0 Hz")
-    DBL("--vdc", c->vdc_v, d > 0.0, "> 0 V")
-    DBL("--dead-time", c->dead_time_s, d >= 0.0, ">= 0 s")
-    DBL("--ifoc-tr", c->ifoc_tr_s, d > 0.0, "> 0 s")
-    DBL("--ifoc-flux", c->ifoc_flux_wb, d > 0.0, "> 0 Wb")
-    DBL("--speed-ref", c->speed_ref_rpm, 1, "rpm")
-    DBL("--speed-ramp", c->speed_ramp_s, d >= 0.0, ">= 0 s")
-    DBL("--torque-ref", c->torque_ref_nm, 1, "N m")
-    DBL("--torque-limit", c->torque_limit_nm, d > 0.0, "> 0 N m")
-    INT("--adc-bits", c->adc_bits, 2, 30)
-    DBL("--i-range", c->i_range_a, d > 0.0, "> 0 A")
-    DBL("--u-range", c->u_range_v, d > 0.0, "> 0 V")
-    DBL("--noise-lsb", c->noise_lsb, d >= 0.0, ">= 0 LSB")
-    INT("--encoder-counts", c->encoder_counts, 1, 1000000000)
-    DBL("--aa-hz", c->aa_hz, d >= 0.0, ">= 0 Hz (0 = off)")
-    DBL("--t-amb", c->t_amb_c, d > -273.15, "degC")
-    DBL("--thermal-speedup", c->thermal_speedup, d > 0.0, "> 0")
-    INT("--rk4-substeps", c->rk4_substeps, 1, 100000)
-    INT("--steps-per-sample", c->steps_per_sample, 0, 100000)
-#undef DBL
-#undef INT
-    return perr(err, errlen, "unknown flag: ", name);
+    const int r = parse_valued(name, val, c, o, err, errlen);
+    if (r < 0) return -1;
+    if (r > 0) return perr(err, errlen, "unknown flag: ", name);
   }
   return 0;
 }
+
+/* ---- run -------------------------------------------------------------------------------- */
 
 /* %.9g is exact to ~1e-9 relative, which is what the spec asks for. */
 void imsim_cli_write_row(FILE *f, const imsim_sample *s) {
   fprintf(f,
           "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
-          "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+          "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
           s->t, s->u_abc[0], s->u_abc[1], s->u_abc[2], s->i_abc[0], s->i_abc[1], s->i_abc[2], s->theta,
           s->tr_s, s->rs_ohm, s->speed_rad_s, s->torque_nm, s->load_nm, s->psi_r_wb, s->temp_stator_c,
           s->temp_rotor_c, s->i_abc_true[0], s->i_abc_true[1], s->i_abc_true[2], s->theta_true,
           s->u_abc_true[0], s->u_abc_true[1], s->u_abc_true[2], s->ifoc_torque_ref_nm, s->ifoc_flux_ref_wb,
-          s->ifoc_tr_s, s->ifoc_speed_ref_rad_s);
+          s->ifoc_tr_s, s->ifoc_speed_ref_rad_s, s->duty[0], s->duty[1], s->duty[2], s->vdc_v);
 }
 
 static double now_s(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Progress bar on stderr. */
+typedef struct {
+  int on;
+  double t0_wall, total_s;
+  uint64_t total, next, step;
+} progress;
+
+static void progress_start(progress *p, int on, uint64_t total, double total_s) {
+  p->on = on;
+  p->t0_wall = now_s();
+  p->total = total;
+  p->total_s = total_s;
+  p->next = 0;
+  p->step = total / 200u + 1u;
+}
+
+static void progress_update(progress *p, uint64_t n, double t) {
+  if (!p->on || n < p->next) return;
+  p->next = n + p->step;
+  const double frac = (double)n / (double)p->total;
+  const int w = (int)(frac * 40.0);
+  char line[48];
+  for (int k = 0; k < 40; ++k) line[k] = k < w ? '#' : ' ';
+  line[40] = '\0';
+  fprintf(stderr, "\r[%s] %5.1f%%  %.1f/%.1f s motor  %.1f s wall  ", line, 100.0 * frac, t, p->total_s,
+          now_s() - p->t0_wall);
+  fflush(stderr);
+}
+
+/* Opens the output ('-' = stdout) with a large buffer. NULL on failure (message printed). */
+static FILE *open_output(const char *path) {
+  static char buf[1 << 20];
+  FILE *f = stdout;
+  if (strcmp(path, "-") != 0) {
+    f = fopen(path, "w");
+    if (f == NULL) {
+      fprintf(stderr, "imest-sim: cannot open '%s': %s\n", path, strerror(errno));
+      return NULL;
+    }
+  }
+  setvbuf(f, buf, _IOFBF, sizeof buf);
+  return f;
+}
+
+/* A bus too low for the reference saturates the inverter, as in a real drive: the run is
+   valid, but the voltage is not the commanded one, so say so with the numbers. */
+static void report_clipping(const imsim *sim, const imsim_config *c) {
+  imsim_pwm_stats st;
+  imsim_get_pwm_stats(sim, &st);
+  if (st.clipped_half_periods == 0u) return;
+  fprintf(stderr,
+          "imest-sim: warning: the PWM reference exceeded the DC bus in %.3g %% of the half carrier periods "
+          "(%llu of %llu) and was clipped: it needs Vdc >= %.1f V, given --vdc %.1f V. The applied voltage is "
+          "not the commanded sine; raise --vdc or lower --vll.\n",
+          100.0 * (double)st.clipped_half_periods / (double)st.half_periods,
+          (unsigned long long)st.clipped_half_periods, (unsigned long long)st.half_periods, st.vdc_needed_v,
+          c->vdc_v);
+}
+
+/* Simulates c and writes the CSV. Returns the exit status. */
+static int run(const imsim_config *c, const imsim_cli_opts *o) {
+  static imsim sim;
+  imsim_sample smp;
+  if (imsim_init(&sim, c, &smp) != 0) {
+    fprintf(stderr, "imest-sim: %s\n", imsim_error(&sim));
+    return 2;
+  }
+  FILE *f = open_output(o->out);
+  if (f == NULL) return 1;
+  const uint64_t total = (uint64_t)llround(c->duration_s * c->fs_hz);
+  progress bar;
+  progress_start(&bar, o->progress < 0 ? isatty(STDERR_FILENO) : o->progress, total, c->duration_s);
+  fprintf(f, "%s\n", HEADER);
+  imsim_cli_write_row(f, &smp);
+  for (uint64_t n = 1; n <= total; ++n) {
+    imsim_step(&sim, &smp);
+    if ((n % (uint64_t)o->decimate) == 0u) imsim_cli_write_row(f, &smp);
+    progress_update(&bar, n, smp.t);
+  }
+  if (bar.on) fprintf(stderr, "\n");
+  report_clipping(&sim, c);
+  int rc = 0;
+  if (fflush(f) != 0 || ferror(f)) {
+    fprintf(stderr, "imest-sim: write error\n");
+    rc = 1;
+  }
+  if (f != stdout && fclose(f) != 0) rc = 1;
+  return rc;
 }
 
 int imsim_cli_main(int argc, char **argv) {
@@ -294,52 +524,5 @@ int imsim_cli_main(int argc, char **argv) {
     fputs(USAGE, stdout);
     return 0;
   }
-  static imsim sim;
-  imsim_sample smp;
-  if (imsim_init(&sim, &c, &smp) != 0) {
-    fprintf(stderr, "imest-sim: %s\n", imsim_error(&sim));
-    return 2;
-  }
-  FILE *f = stdout;
-  if (strcmp(o.out, "-") != 0) {
-    f = fopen(o.out, "w");
-    if (f == NULL) {
-      fprintf(stderr, "imest-sim: cannot open '%s': %s\n", o.out, strerror(errno));
-      return 1;
-    }
-  }
-  static char buf[1 << 20];
-  setvbuf(f, buf, _IOFBF, sizeof buf);
-  const uint64_t total = (uint64_t)llround(c.duration_s * c.fs_hz);
-  const int bar = o.progress < 0 ? isatty(STDERR_FILENO) : o.progress;
-  const double t0 = now_s();
-  uint64_t next_bar = 0;
-  const uint64_t bar_step = total / 200u + 1u;
-  fprintf(f, "%s\n", HEADER);
-  imsim_cli_write_row(f, &smp);
-  for (uint64_t n = 1; n <= total; ++n) {
-    imsim_step(&sim, &smp);
-    if ((n % (uint64_t)o.decimate) == 0u) imsim_cli_write_row(f, &smp);
-    if (bar && n >= next_bar) {
-      next_bar = n + bar_step;
-      const double frac = (double)n / (double)total;
-      const int w = (int)(frac * 40.0);
-      char line[48];
-      for (int k = 0; k < 40; ++k) line[k] = k < w ? '#' : ' ';
-      line[40] = '\0';
-      const double el = now_s() - t0;
-      fprintf(stderr, "\r[%s] %5.1f%%  %.1f/%.1f s motor  %.1f s wall  ", line, 100.0 * frac, smp.t, c.duration_s, el);
-      fflush(stderr);
-    }
-  }
-  if (bar) fprintf(stderr, "\n");
-  int rc = 0;
-  if (fflush(f) != 0 || ferror(f)) {
-    fprintf(stderr, "imest-sim: write error\n");
-    rc = 1;
-  }
-  if (f != stdout) {
-    if (fclose(f) != 0) rc = 1;
-  }
-  return rc;
+  return run(&c, &o);
 }

@@ -21,6 +21,12 @@ typedef struct {
 /* The CSV header line (no newline). */
 const char *imsim_cli_header(void);
 
+/* The --help text. */
+const char *imsim_cli_usage(void);
+
+/* Every flag the parser accepts: writes up to max names, returns how many there are. */
+size_t imsim_cli_flags(const char **names, size_t max);
+
 /* Parses argv into c (preset applied first, then the other flags in order) and o.
    Returns 0, or -1 with a message in err. */
 int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, char *err, size_t errlen);

@@ -18,6 +18,15 @@ inline imsim_config ideal(const char *preset = "exp1") {
   return c;
 }
 
+// The inverter errors of the tests: 2 us dead time, switch 1 V + 0.02 ohm, diode 0.8 V + 0.01 ohm.
+inline void add_inverter_errors(imsim_config &c) {
+  c.dead_time_s = 2e-6;
+  c.v_switch_v = 1.0;
+  c.r_switch_ohm = 0.02;
+  c.v_diode_v = 0.8;
+  c.r_diode_ohm = 0.01;
+}
+
 // Runs n samples (after the t = 0 one) and returns all samples including t = 0.
 inline std::vector<imsim_sample> run(const imsim_config &c, long n) {
   static imsim sim;  // large-ish, keep off the stack

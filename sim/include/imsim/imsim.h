@@ -3,7 +3,9 @@
  *
  * Model: eq. (1) of Wang, Chiasson, Bodson, Tolbert (IEEE TCST 2007) in the stationary
  * (a, b) frame, power-invariant 3-2 transform (docs/METHOD.md §1). Supplies: ideal sine,
- * ideal V/f, sine-triangle PWM inverter (event-exact), indirect field-oriented control (IFOC).
+ * ideal V/f, PWM inverter (event-exact; dead time and switch/diode drops; sine-triangle or
+ * space-vector modulation; ideal or firmware timing), indirect field-oriented control (IFOC),
+ * and commands from a controller outside the simulator (closed loop, firmware timing).
  * Sensors: ADCs (bits, range, clipping, seeded white noise), optional 2nd-order analog
  * anti-alias filter, incremental encoder. Thermal drift of R_S and R_R.
  *
@@ -33,16 +35,34 @@ extern "C" {
 typedef enum {
   IMSIM_SUPPLY_SINE = 0, /* ideal balanced sine, fixed vll/freq from t = 0 (DOL start)     */
   IMSIM_SUPPLY_VF = 1,   /* ideal sine following a V/f ramp over vf_ramp_s                */
-  IMSIM_SUPPLY_PWM = 2,  /* sine-triangle PWM inverter, reference = the V/f ramp (or step)  */
-  IMSIM_SUPPLY_IFOC = 3  /* IFOC current control driving the PWM inverter (or ideal stage)  */
+  IMSIM_SUPPLY_PWM = 2,  /* PWM inverter, reference = the V/f ramp (or step)                */
+  IMSIM_SUPPLY_IFOC = 3, /* IFOC current control driving the PWM inverter (or ideal stage)  */
+  IMSIM_SUPPLY_EXT = 4   /* PWM inverter driven by the caller's commands, sample by sample
+                            (imsim_set_duty / imsim_set_voltage), with firmware timing     */
 } imsim_supply;
+
+/* When the inverter's duties change (see sim/README.md, Firmware timing). */
+typedef enum {
+  IMSIM_TIMING_IDEAL = 0,   /* reference sampled at every half carrier period's centre: no
+                               delay, duties change every half period (the default)          */
+  IMSIM_TIMING_FIRMWARE = 1 /* as a drive's firmware: sample k at a carrier valley, duties
+                               computed from it applied during [t_k+1, t_k+2); fs = f_c / N  */
+} imsim_timing;
+
+/* How phase references become leg duties. */
+typedef enum {
+  IMSIM_MOD_SPWM = 0, /* sine-triangle, no zero sequence: V_dc >= 2 sqrt(2/3) V_ll (default)  */
+  IMSIM_MOD_SVPWM = 1 /* min-max zero-sequence injection (= symmetric space-vector PWM):
+                         V_dc >= sqrt(2) V_ll                                                   */
+} imsim_modulation;
 
 typedef enum {
   IMSIM_VMEAS_AUTO = 0, /* AVG with PWM stages, INST with ideal supplies                      */
   IMSIM_VMEAS_AVG = 1,  /* phase-to-neutral volt-seconds of the carrier period that just ended,
                            from commanded duties and Vdc (what a drive knows); delay 1/(2 f_c) */
   IMSIM_VMEAS_AA = 2,   /* measured phase-to-neutral voltage through the AA filter            */
-  IMSIM_VMEAS_INST = 3  /* raw instantaneous sample (PWM: zero vector, i.e. 0 V)              */
+  IMSIM_VMEAS_INST = 3  /* raw instantaneous sample; ideal supplies only (with PWM every sample
+                           falls in a zero vector, so imsim_init refuses it)                    */
 } imsim_vmeas;
 
 typedef enum { IMSIM_START_REST = 0, IMSIM_START_STEADY = 1 } imsim_start;
@@ -62,6 +82,10 @@ typedef struct {
   double rs_ohm; /* stator resistance at t_amb_c (cold)   */
   double tr_s;   /* rotor time constant at t_amb_c (cold) */
   double j_kgm2, b_nms;
+  /* Nameplate, informational (0 = not given; the exp presets leave it so): the motor presets
+     set it and size the load, sensors and IFOC limits from it. Line-to-line rms voltage,
+     phase rms current, shaft power, torque and speed at the rated point. */
+  double rated_voltage_v, rated_freq_hz, rated_power_w, rated_torque_nm, rated_speed_rpm, rated_current_a;
 
   /* Thermal model (copper): R(T) = R_cold (1 + alpha (T - t_amb_c)); each body first order,
      tau dT/dt = (t_amb + rth * P_cu) - T, P_cu = copper loss of that body (I^2 R). */
@@ -81,9 +105,15 @@ typedef struct {
   imsim_supply supply;
   double vll_v, freq_hz, vf_ramp_s, vf_boost_v;
 
-  /* PWM inverter: regular-sampled sine-triangle, reference sampled once per half carrier
-     period (at its centre, i.e. delay-compensated); dead time with current-sign logic. */
-  double carrier_hz, vdc_v, dead_time_s;
+  /* PWM inverter: regular sampled; with ideal timing the reference is sampled once per half
+     carrier period (at its centre, i.e. delay-compensated); dead time and device drops with
+     the half bridge's current-direction logic (sim/README.md, Inverter). */
+  double carrier_hz, vdc_v, dead_time_s; /* dead time includes the effective switching delays */
+  /* Inverter devices, per leg: a conducting switch drops v_switch_v + r_switch_ohm |i|, a
+     conducting freewheeling diode v_diode_v + r_diode_ohm |i| (0 = ideal devices). */
+  double v_switch_v, r_switch_ohm, v_diode_v, r_diode_ohm;
+  imsim_modulation modulation;
+  imsim_timing timing;
   bool pwm_moments; /* fast integrator with PWM. true (default, fast): one step per half carrier
                        period, the PWM input entering through its exact moments; the electrical
                        part is exact for the step's speed, the torque ripple inside the step is
@@ -108,6 +138,7 @@ typedef struct {
   bool ideal_sensors;   /* exact samples: no quantisation, noise, clipping, AA or encoder   */
   int adc_bits;
   double i_range_a, u_range_v; /* symmetric ranges: +-range (clipping)                    */
+  double vdc_range_v;          /* DC-bus ADC, unipolar 0..range (PWM stages)               */
   double noise_lsb;            /* white Gaussian noise, rms in LSB, added before the ADC    */
   int encoder_counts;          /* counts per mechanical revolution, floor quantisation      */
   double i_offset_a[3];        /* per-phase sensor offset, added before the ADC [A]         */
@@ -140,13 +171,19 @@ typedef struct {
   double psi_r_wb;             /* rotor-flux magnitude |psi_R| (alpha-beta)     */
   double temp_stator_c, temp_rotor_c;
   double i_abc_true[3], theta_true;
-  double u_abc_true[3];        /* ideal supplies: instantaneous; PWM: actual applied
-                                  (dead-time inclusive) average over the last carrier period */
+  double u_abc_true[3];        /* ideal supplies: instantaneous; PWM: actual applied (dead
+                                  time and drops included) average over the last carrier
+                                  period (firmware timing: the last sample period)       */
   double i_ab_true[2], psi_ab[2], u_ab_true[2]; /* alpha-beta state (power invariant)   */
   double accel_rad_s2;         /* d omega / dt from the model at t               */
   double p_cu_stator_w, p_cu_rotor_w;
   /* IFOC (NaN when not IFOC). */
   double ifoc_torque_ref_nm, ifoc_flux_ref_wb, ifoc_tr_s, ifoc_speed_ref_rad_s;
+  /* Drive (PWM stages). duty: upper-switch duty of each leg, in [0, 1], applied during
+     [t, t + 1/fs) (computed one sample earlier); firmware timing only, else NaN.
+     vdc_v: DC bus sampled at t through its ADC; vdc_true_v: the bus (NaN without PWM). */
+  double duty[3];
+  double vdc_v, vdc_true_v;
 } imsim_sample;
 
 /* Steady state of the model under a balanced sinusoidal supply (phasor solution of eq. (1)). */
@@ -159,8 +196,13 @@ typedef struct {
 /* Private state. Declared here only so that the caller can own the storage (no malloc). */
 typedef struct { double re, im; } imsim_cpx_;
 typedef struct {
+  uint64_t s[4]; /* xoshiro256** */
+  double spare;  /* second Gaussian of the polar method */
+  bool has_spare;
+} imsim_rng_;
+typedef struct {
   imsim_config c;
-  char err[160];
+  char err[320];
   /* derived constants */
   double m_h, rr0_ohm, ts_s, h_s;
   int k_steps;
@@ -182,18 +224,37 @@ typedef struct {
   double w_meas, th_meas_prev, slip_angle, integ_d, integ_q, integ_w;
   double v_dq[2], rho, we_ctrl, t_ctrl, te_ref, id_ref, iq_ref;
   double u_zoh[2];
-  /* sensors */
-  uint64_t rng[4];
-  double gauss_spare; bool has_spare;
+  /* sensors: rng for the phase channels, rng_vdc (own stream) for the bus */
+  imsim_rng_ rng, rng_vdc;
   double i_meas_ab[2]; double th_meas;
+  double vdc_meas;
+  /* firmware timing: duties applied now and those computed at the last sample */
+  double duty[3], duty_next[3];
+  double u_sp_cmd[2], u_sp_act[2]; /* sums over the half periods of the last sample period */
   /* Taylor coefficients h^k/k! */
   double hk[32];
+  /* modulation statistics (imsim_get_pwm_stats) */
+  uint64_t pwm_half_periods, pwm_clipped_half_periods;
+  double pwm_vdc_needed;
 } imsim;
+
+/* What the PWM modulator was asked for: a reference beyond the bus is clipped (the inverter
+   saturates, as a real one does); these numbers let the caller say so. */
+typedef struct {
+  uint64_t half_periods;         /* PWM half carrier periods simulated so far                  */
+  uint64_t clipped_half_periods; /* of which at least one leg's reference exceeded the bus     */
+  double vdc_needed_v;           /* bus voltage that the largest reference so far would need  */
+} imsim_pwm_stats;
 
 /* Fills c with the paper's motor and the exp1 experiment (same as preset "exp1"). */
 void imsim_config_default(imsim_config *c);
-/* name: "exp1" or "exp2". Returns 0, or -1 for an unknown name (c then holds exp1). */
+/* name: "exp1", "exp2" (the paper's motor and experiments) or one of the industrial drives
+   "4kw", "11kw", "15kw", "37kw", "75kw" (400 V 50 Hz motors on a 560 V, 8 kHz inverter with
+   firmware timing, at rated load; see sim/README.md, Presets). Returns 0, or -1 for an
+   unknown name (c then holds exp1). */
 int imsim_config_preset(imsim_config *c, const char *name);
+/* The preset names, separated by '|'. */
+const char *imsim_preset_names(void);
 
 /* Validates c, sets up sim, and fills *first (may be NULL) with the t = 0 sample.
    Returns 0, or -1 with a message in imsim_error(sim). */
@@ -203,11 +264,26 @@ const char *imsim_error(const imsim *sim);
 /* Advances exactly one sample period 1/fs and fills *out with the sample at the new time. */
 void imsim_step(imsim *sim, imsim_sample *out);
 
+/* Modulation statistics since imsim_init (all zero without a PWM stage). */
+void imsim_get_pwm_stats(const imsim *sim, imsim_pwm_stats *out);
+
 /* Run-time controls. */
 void imsim_set_ifoc_tr(imsim *sim, double tr_s);   /* controller's T_R, takes effect at the next step */
 void imsim_set_speed_ref(imsim *sim, double rpm);  /* IFOC speed reference (no ramp)          */
 void imsim_set_torque_ref(imsim *sim, double nm);  /* IFOC torque-mode reference              */
 void imsim_set_load(imsim *sim, double load_nm);   /* overrides the load profile              */
+
+/* External commands (supply IMSIM_SUPPLY_EXT), firmware timing: after imsim_init or
+   imsim_step has returned the sample at t_k, the caller sets the command computed from it; it
+   is applied during [t_k+1, t_k+2) (the step after the next one). A command holds until the
+   next call; before the first one the duties are 0.5 (zero voltage).
+   imsim_set_duty: upper-switch duties of legs a, b, c in [0, 1] (clipped).
+   imsim_set_voltage: phase-voltage command (V, phase-to-neutral; its zero sequence is
+   ignored), converted to duties with the configured modulation and the bus voltage measured
+   at t_k (the sample's vdc_v), clipped at the bus. Both return 0, or -1 if the supply is not
+   IMSIM_SUPPLY_EXT or a value is not finite. Clipping is counted in imsim_get_pwm_stats. */
+int imsim_set_duty(imsim *sim, const double duty[3]);
+int imsim_set_voltage(imsim *sim, const double u_abc[3]);
 
 /* Phasor steady state of the configured motor (cold parameters) at the given supply and load
    (load opposes rotation; viscous friction included). Returns 0, or -1 if the load exceeds

@@ -1,0 +1,65 @@
+/* Phasor steady state of eq. (1) under a balanced sinusoidal supply: the operating point of
+ * --start steady, the IFOC rated flux, and the presets' checks. */
+#include "imsim_internal.h"
+
+static void steady_at(const imsim_config *c, double m, double tr, double w, double vll, double we,
+                      cpx *i, cpx *psi, double *te) {
+  const double sl = c->sigma * c->ls_h;
+  const double gamma = c->rs_ohm / sl + (1.0 - c->sigma) / (c->sigma * tr);
+  const double beta = m / (c->sigma * c->ls_h * c->lr_h);
+  const double nw = (double)c->pole_pairs * w;
+  /* (j we - A) z = b U */
+  const cpx m11 = cx(gamma, we);
+  const cpx m12 = cx(-beta / tr, beta * nw);
+  const cpx m21 = cx(-m / tr, 0.0);
+  const cpx m22 = cx(1.0 / tr, we - nw);
+  const cpx det = cadd(cmul(m11, m22), cscale(cmul(m12, m21), -1.0));
+  const double dd = cabs2(det);
+  const cpx inv = cx(det.re / dd, -det.im / dd);
+  const double bu = vll / sl;
+  *i = cmul(cscale(m22, bu), inv);
+  *psi = cmul(cscale(m21, -bu), inv);
+  *te = (double)c->pole_pairs * m / c->lr_h * (i->im * psi->re - i->re * psi->im);
+}
+
+int imsim_steady_state(const imsim_config *c, double vll_v, double freq_hz, double load_nm, imsim_steady *out) {
+  const double m = sqrt((1.0 - c->sigma) * c->ls_h * c->lr_h);
+  const double we = 2.0 * PI * freq_hz;
+  const double wsync = we / (double)c->pole_pairs;
+  cpx i, psi;
+  double te;
+#define F_OF(wv) (steady_at(c, m, c->tr_s, (wv), vll_v, we, &i, &psi, &te), te - load_nm - c->b_nms * (wv))
+  double hi = wsync, lo = wsync;
+  double fhi = F_OF(hi);
+  if (fhi >= 0.0) {
+    /* no load and no friction: synchronous speed */
+    lo = hi;
+  } else {
+    int k = 0;
+    for (k = 1; k <= 4000; ++k) {
+      lo = wsync * (1.0 - (double)k / 4000.0);
+      if (F_OF(lo) > 0.0) break;
+      hi = lo;
+    }
+    if (k > 4000) return -1;
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      if (F_OF(mid) > 0.0) lo = mid;
+      else hi = mid;
+    }
+  }
+#undef F_OF
+  const double w = 0.5 * (lo + hi);
+  steady_at(c, m, c->tr_s, w, vll_v, we, &i, &psi, &te);
+  out->speed_rad_s = w;
+  out->speed_rpm = w * 60.0 / (2.0 * PI);
+  out->slip = wsync > 0.0 ? (wsync - w) / wsync : 0.0;
+  out->i_rms_phase = sqrt(cabs2(i)) / sqrt(3.0);
+  out->torque_nm = te;
+  out->psi_r_wb = sqrt(cabs2(psi));
+  out->i_ab[0] = i.re;
+  out->i_ab[1] = i.im;
+  out->psi_ab[0] = psi.re;
+  out->psi_ab[1] = psi.im;
+  return 0;
+}
