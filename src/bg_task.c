@@ -1,11 +1,10 @@
 /* The background task: once per finished window, take the buffer from the
- * ISR, solve, judge, publish, and release the buffer with the centring for a
- * later window. */
+ * ISR, solve, judge, and release the buffer with the centring for a later
+ * window. Telemetry is the caller's (imest_can_publish()). */
 #include <math.h>
 #include <stddef.h>
 
 #include "bg_validity.h"
-#include "imest/imest_can.h"
 
 static void result_clear(imest_result_t *r)
 {
@@ -99,7 +98,5 @@ int imest_background(imest_t *s, imest_result_t *out)
   }
   IMEST_BARRIER(); /* buffer cleared before it is released */
   s->released = s->released + 1u;
-
-  if (s->can != NULL) (void)imest_can_publish(s, out);
   return 1;
 }

@@ -1,6 +1,5 @@
-/* CAN telemetry codec: packing, CRC, decoding and the reader's loss /
- * repeat / corruption detection. Layout: port/README.md and tools/imest.dbc
- * (the single source of truth; test/can checks this file against it).
+/* CAN telemetry codec: the signal table (can_signals.c) turned into frames
+ * and back, the CRC, and the identifier rules.
  *
  * Bits are numbered as in a DBC file with Intel (little-endian) byte order:
  * bit k is bit (k mod 8) of payload octet k / 8. Every field is written with
@@ -25,50 +24,98 @@ typedef union {
 
 _Static_assert(sizeof(float) == sizeof(uint32_t), "float and uint32_t differ in size");
 
-/* --- bit field helpers (Intel byte order, start = LSB) ------------------- */
+#define F32_QNAN 0x7FC00000u
 
-static void put_bits(unsigned char *d, unsigned int start, unsigned int len, uint32_t v) {
-  unsigned int i;
-  for (i = 0u; i < len; i++) {
-    unsigned int k = start + i;
-    unsigned int byte = k >> 3;
-    unsigned int bit = k & 7u;
-    unsigned int cur = (unsigned int)d[byte] & 0xFFu;
-    if ((v >> i) & 1u) {
-      cur |= (1u << bit);
-    } else {
-      cur &= ~(1u << bit) & 0xFFu;
-    }
-    d[byte] = (unsigned char)cur;
+/* --- identifiers ------------------------------------------------------------ */
+
+int imest_can_base_id_check(uint32_t base_id)
+{
+  const uint32_t last = (uint32_t)IMEST_CAN_NFRAMES - 1u;
+  if (base_id & IMEST_CAN_ID_EXT) {
+    return (base_id & ~IMEST_CAN_ID_EXT) <= IMEST_CAN_EFF_MASK - last ? IMEST_OK : IMEST_ERR_ARG;
+  }
+  return base_id <= IMEST_CAN_SFF_MASK - last ? IMEST_OK : IMEST_ERR_ARG;
+}
+
+/* --- bit fields (Intel byte order, start = LSB) ---------------------------- */
+
+static void put_bits(unsigned char *d, unsigned int start, unsigned int len, uint32_t v)
+{
+  for (unsigned int i = 0u; i < len; i++) {
+    const unsigned int k = start + i;
+    const unsigned int bit = 1u << (k & 7u);
+    unsigned int cur = (unsigned int)d[k >> 3] & 0xFFu;
+    cur = ((v >> i) & 1u) ? (cur | bit) : (cur & ~bit & 0xFFu);
+    d[k >> 3] = (unsigned char)(cur & 0xFFu);
   }
 }
 
-static uint32_t get_bits(const unsigned char *d, unsigned int start, unsigned int len) {
+static uint32_t get_bits(const unsigned char *d, unsigned int start, unsigned int len)
+{
   uint32_t v = 0u;
-  unsigned int i;
-  for (i = 0u; i < len; i++) {
-    unsigned int k = start + i;
-    uint32_t b = ((uint32_t)d[k >> 3] >> (k & 7u)) & 1u;
-    v |= b << i;
+  for (unsigned int i = 0u; i < len; i++) {
+    const unsigned int k = start + i;
+    v |= (((uint32_t)d[k >> 3] >> (k & 7u)) & 1u) << i;
   }
   return v;
 }
 
-/* --- field encoders -------------------------------------------------------- */
+/* The raw value with every bit of a len-bit signal set. */
+static uint32_t all_ones(unsigned int len)
+{
+  return len >= 32u ? 0xFFFFFFFFu : ((uint32_t)1u << len) - 1u;
+}
+
+/* --- CRC-8 SAE J1850 -------------------------------------------------------- */
+
+static unsigned int crc8_update(unsigned int crc, unsigned int octet)
+{
+  crc ^= octet & 0xFFu;
+  for (unsigned int b = 0u; b < 8u; b++) {
+    crc = (crc & 0x80u) ? (((crc << 1) ^ 0x1Du) & 0xFFu) : ((crc << 1) & 0xFFu);
+  }
+  return crc;
+}
+
+unsigned int imest_can_crc8(const unsigned char *data, unsigned int n)
+{
+  unsigned int crc = 0xFFu;
+  if (data == NULL) return 0u;
+  for (unsigned int i = 0u; i < n; i++) crc = crc8_update(crc, data[i]);
+  return crc ^ 0xFFu;
+}
+
+/* CRC of a frame: over the data id (frame index) then payload octets 0..6, so
+ * a frame arriving under another frame's identifier fails too. */
+static unsigned int frame_crc(unsigned int index, const unsigned char *d)
+{
+  unsigned int crc = crc8_update(0xFFu, index);
+  for (unsigned int i = 0u; i < 7u; i++) crc = crc8_update(crc, d[i]);
+  return crc ^ 0xFFu;
+}
+
+/* --- field access through the table's offsets ------------------------------ */
+
+static const void *field_of(const imest_result_t *r, const imest_can_signal_t *s)
+{
+  return (const char *)r + s->field;
+}
+
+static void *field_in(imest_result_t *r, const imest_can_signal_t *s)
+{
+  return (char *)r + s->field;
+}
+
+/* --- encoding ----------------------------------------------------------------- */
 
 /* double -> binary32 bits: NaN -> canonical quiet NaN, +-inf kept, finite
- * values beyond +-FLT_MAX clamped to +-FLT_MAX with the saturation bit. */
-static uint32_t enc_f32(double x, unsigned int *sat, unsigned int bit) {
+ * values beyond +-FLT_MAX clamped with the saturation bit. */
+static uint32_t enc_f32(double x, unsigned int *sat, unsigned int bit)
+{
   imest_f32_bits_t v;
-  if (x != x) {
-    return 0x7FC00000u;
-  }
-  if (x > DBL_MAX) {
-    return 0x7F800000u;
-  }
-  if (x < -DBL_MAX) {
-    return 0xFF800000u;
-  }
+  if (x != x) return F32_QNAN;
+  if (x > DBL_MAX) return 0x7F800000u;
+  if (x < -DBL_MAX) return 0xFF800000u;
   if (x > (double)FLT_MAX) {
     *sat |= bit;
     x = (double)FLT_MAX;
@@ -80,397 +127,192 @@ static uint32_t enc_f32(double x, unsigned int *sat, unsigned int bit) {
   return v.u;
 }
 
-static double dec_f32(uint32_t u) {
+/* double >= 0 -> raw = round(x * scale) in 0 .. na-1; NaN -> na; negative or
+ * too large (+inf too) -> clamped with the saturation bit. */
+static uint32_t enc_scaled(double x, uint32_t scale, uint32_t na, unsigned int *sat, unsigned int bit)
+{
+  if (x != x) return na;
+  if (x < 0.0) {
+    *sat |= bit;
+    return 0u;
+  }
+  const double r = x * (double)scale + 0.5;
+  if (r >= (double)na) {
+    *sat |= bit;
+    return na - 1u;
+  }
+  return (uint32_t)r;
+}
+
+static uint32_t clamp_u(uint32_t v, uint32_t max) { return v > max ? max : v; }
+
+/* Raw value of signal s. sat_all: the saturation bits of the whole window
+ * (for SAT signals); *sat collects the bits this signal sets. */
+static uint32_t encode(const imest_can_signal_t *s, const imest_result_t *r, uint32_t tx_failed,
+                       unsigned int sat_all, unsigned int *sat)
+{
+  const uint32_t ones = all_ones(s->len);
+  switch ((imest_can_kind_t)s->kind) {
+  case IMEST_CAN_F32:
+    return enc_f32(*(const double *)field_of(r, s), sat, s->mask);
+  case IMEST_CAN_SCALED:
+    return enc_scaled(*(const double *)field_of(r, s), s->scale, ones, sat, s->mask);
+  case IMEST_CAN_COUNT:
+    return clamp_u((uint32_t)*(const unsigned int *)field_of(r, s), ones);
+  case IMEST_CAN_U32:
+    return clamp_u(*(const uint32_t *)field_of(r, s), ones);
+  case IMEST_CAN_ENUM: {
+    const int v = *(const int *)field_of(r, s);
+    if (v < 0) return ones;
+    return clamp_u((uint32_t)v, ones); /* out of range: all ones */
+  }
+  case IMEST_CAN_BOOL:
+    return *(const int *)field_of(r, s) != 0 ? 1u : 0u;
+  case IMEST_CAN_FLAG:
+    return (*(const unsigned int *)field_of(r, s) & s->mask) ? 1u : 0u;
+  case IMEST_CAN_SAT:
+    return (sat_all & s->mask) ? 1u : 0u;
+  case IMEST_CAN_TXFAIL:
+    return clamp_u(tx_failed, ones);
+  }
+  return 0u;
+}
+
+/* The saturation bits of every field, so each frame carries the same ones. */
+static unsigned int sat_bits(const imest_result_t *r, const imest_can_signal_t *t, unsigned int n)
+{
+  unsigned int sat = 0u;
+  for (unsigned int k = 0u; k < n; k++) {
+    if (t[k].kind == IMEST_CAN_F32 || t[k].kind == IMEST_CAN_SCALED) (void)encode(&t[k], r, 0u, 0u, &sat);
+  }
+  return sat;
+}
+
+static uint32_t frame_id(uint32_t base_id, unsigned int index)
+{
+  const uint32_t ext = base_id & IMEST_CAN_ID_EXT;
+  return ((base_id & ~IMEST_CAN_ID_EXT) + index) | ext;
+}
+
+int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id,
+                   unsigned int counter, uint32_t tx_failed, struct imest_can_frame *f)
+{
+  unsigned int n = 0u;
+  const imest_can_signal_t *t = imest_can_signal_table(&n);
+  if (r == NULL || f == NULL) return IMEST_ERR_NULL;
+  if (index >= (unsigned int)IMEST_CAN_NFRAMES || imest_can_base_id_check(base_id) != IMEST_OK) {
+    return IMEST_ERR_ARG;
+  }
+  const unsigned int sat_all = sat_bits(r, t, n);
+  f->id = frame_id(base_id, index);
+  f->dlc = 8u;
+  for (unsigned int i = 0u; i < 8u; i++) f->data[i] = 0u;
+  for (unsigned int k = 0u; k < n; k++) {
+    unsigned int unused = 0u;
+    if (t[k].frame == index) put_bits(f->data, t[k].start, t[k].len, encode(&t[k], r, tx_failed, sat_all, &unused));
+  }
+  put_bits(f->data, IMEST_CAN_COUNTER_START, 8u, counter & 0xFFu);
+  put_bits(f->data, IMEST_CAN_CRC_START, 8u, frame_crc(index, f->data));
+  return IMEST_OK;
+}
+
+/* --- decoding ----------------------------------------------------------------- */
+
+static double nan64(void)
+{
+  imest_f32_bits_t v;
+  v.u = F32_QNAN;
+  return (double)v.f;
+}
+
+static double dec_f32(uint32_t u)
+{
   imest_f32_bits_t v;
   v.u = u;
   return (double)v.f;
 }
 
-/* double >= 0 -> raw = round(x * inv_factor) in 0..65534; NaN -> 65535;
- * negative or too large (incl. +inf) -> clamped with the saturation bit. */
-static uint32_t enc_u16(double x, double inv_factor, unsigned int *sat, unsigned int bit) {
-  double r;
-  if (x != x) {
-    return IMEST_CAN_U16_NA;
-  }
-  if (x < 0.0) {
-    *sat |= bit;
-    return 0u;
-  }
-  r = x * inv_factor + 0.5;
-  if (r >= (double)IMEST_CAN_U16_NA) {
-    *sat |= bit;
-    return IMEST_CAN_U16_MAX;
-  }
-  return (uint32_t)r;
+static void set_bit(unsigned int *word, unsigned int mask, uint32_t on)
+{
+  *word = on ? (*word | mask) : (*word & ~mask);
 }
 
-static double dec_u16(uint32_t raw, double factor) {
-  if (raw == IMEST_CAN_U16_NA) {
-    imest_f32_bits_t v;
-    v.u = 0x7FC00000u;
-    return (double)v.f;
+static void decode(const imest_can_signal_t *s, uint32_t raw, imest_can_window_t *w)
+{
+  void *p = field_in(&w->result, s);
+  switch ((imest_can_kind_t)s->kind) {
+  case IMEST_CAN_F32:
+    *(double *)p = dec_f32(raw);
+    break;
+  case IMEST_CAN_SCALED:
+    *(double *)p = raw == all_ones(s->len) ? nan64() : (double)raw / (double)s->scale;
+    break;
+  case IMEST_CAN_COUNT:
+    *(unsigned int *)p = (unsigned int)raw;
+    break;
+  case IMEST_CAN_U32:
+    *(uint32_t *)p = raw;
+    break;
+  case IMEST_CAN_ENUM:
+  case IMEST_CAN_BOOL:
+    *(int *)p = (int)raw;
+    break;
+  case IMEST_CAN_FLAG:
+    set_bit((unsigned int *)p, s->mask, raw);
+    break;
+  case IMEST_CAN_SAT:
+    set_bit(&w->sat, s->mask, raw);
+    break;
+  case IMEST_CAN_TXFAIL:
+    w->tx_failed = raw;
+    break;
   }
-  return (double)raw * factor;
 }
 
-static double nan64(void) { return dec_f32(0x7FC00000u); }
-
-/* --- CRC-8 SAE J1850 ------------------------------------------------------- */
-
-static unsigned int crc8_update(unsigned int crc, unsigned int octet) {
-  unsigned int b;
-  crc ^= octet & 0xFFu;
-  for (b = 0u; b < 8u; b++) {
-    if (crc & 0x80u) {
-      crc = ((crc << 1) ^ 0x1Du) & 0xFFu;
-    } else {
-      crc = (crc << 1) & 0xFFu;
-    }
+void imest_can_window_clear(imest_can_window_t *w)
+{
+  unsigned int n = 0u;
+  const imest_can_signal_t *t = imest_can_signal_table(&n);
+  if (w == NULL) return;
+  unsigned char *raw = (unsigned char *)w;
+  for (size_t b = 0u; b < sizeof *w; b++) raw[b] = 0u;
+  for (unsigned int k = 0u; k < n; k++) {
+    void *p = field_in(&w->result, &t[k]);
+    if (t[k].kind == IMEST_CAN_F32 || t[k].kind == IMEST_CAN_SCALED) *(double *)p = nan64();
+    if (t[k].kind == IMEST_CAN_ENUM) *(int *)p = -1;
   }
-  return crc;
 }
 
-unsigned int imest_can_crc8(const unsigned char *data, unsigned int n) {
-  unsigned int crc = 0xFFu;
-  unsigned int i;
-  if (data == NULL) {
-    return 0u;
-  }
-  for (i = 0u; i < n; i++) {
-    crc = crc8_update(crc, data[i]);
-  }
-  return crc ^ 0xFFu;
-}
-
-/* CRC of a frame: over the data id (frame index) then payload octets 0..6. */
-static unsigned int frame_crc(unsigned int index, const unsigned char *d) {
-  unsigned int crc = crc8_update(0xFFu, index);
-  unsigned int i;
-  for (i = 0u; i < 7u; i++) {
-    crc = crc8_update(crc, d[i]);
-  }
-  return crc ^ 0xFFu;
-}
-
-/* --- layout (keep in step with tools/imest.dbc) --------------------------- */
-
-/* IMEST_QUAL bit positions */
-#define Q_PEK1 0u        /* 16 bits */
-#define Q_STATUS 16u     /* 8 bits */
-#define Q_VALID 24u
-#define Q_HESS 25u
-#define Q_SAT 26u        /* 5 bits: TR, RS, EI, PEK1, PEK2 */
-#define Q_WFLAGS 32u     /* 5 bits: WARMUP, INPUT_FAULT, ADC_SAT, ENCODER_FAULT, OVERRUN */
-#define Q_NROOTS 37u     /* 5 bits */
-#define Q_NADM 42u       /* 5 bits */
-#define B_COUNTER 48u
-#define B_CRC 56u
-
-static uint32_t sat5(unsigned int n) { return n > 31u ? 31u : (uint32_t)n; }
-
-/* Compute the saturation bits of all fields (so every frame agrees). */
-static unsigned int sat_bits(const imest_result_t *r) {
-  unsigned int sat = 0u;
-  (void)enc_f32(r->tr_s, &sat, IMEST_CAN_SAT_TR);
-  (void)enc_f32(r->rs_ohm, &sat, IMEST_CAN_SAT_RS);
-  (void)enc_u16(r->e_i, 1e4, &sat, IMEST_CAN_SAT_EI);
-  (void)enc_u16(r->pe_k1_rel, 5e4, &sat, IMEST_CAN_SAT_PEK1);
-  (void)enc_u16(r->pe_k2_rel, 5e4, &sat, IMEST_CAN_SAT_PEK2);
-  return sat;
-}
-
-int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id,
-                   unsigned int counter, uint32_t tx_failed, struct imest_can_frame *f) {
-  unsigned int sat = 0u;
-  unsigned int i;
-  uint32_t ext;
-  if (r == NULL || f == NULL) {
-    return IMEST_ERR_NULL;
-  }
-  if (index >= IMEST_CAN_NFRAMES) {
-    return IMEST_ERR_CONFIG;
-  }
-  ext = base_id & IMEST_CAN_ID_EXT;
-  f->id = (((base_id & IMEST_CAN_EFF_MASK) + index) & (ext ? IMEST_CAN_EFF_MASK : IMEST_CAN_SFF_MASK)) | ext;
-  f->dlc = 8u;
-  for (i = 0u; i < 8u; i++) {
-    f->data[i] = 0u;
-  }
-  switch (index) {
-    case IMEST_CAN_FRAME_TR:
-      put_bits(f->data, 0u, 32u, enc_f32(r->tr_s, &sat, IMEST_CAN_SAT_TR));
-      put_bits(f->data, 32u, 16u, enc_u16(r->e_i, 1e4, &sat, IMEST_CAN_SAT_EI));
-      break;
-    case IMEST_CAN_FRAME_RS:
-      put_bits(f->data, 0u, 32u, enc_f32(r->rs_ohm, &sat, IMEST_CAN_SAT_RS));
-      put_bits(f->data, 32u, 16u, enc_u16(r->pe_k2_rel, 5e4, &sat, IMEST_CAN_SAT_PEK2));
-      break;
-    case IMEST_CAN_FRAME_QUAL: {
-      unsigned int st = (r->status >= 0 && r->status <= 255) ? (unsigned int)r->status : 255u;
-      unsigned int wf = r->flags;
-      uint32_t bits = ((wf & IMEST_FLAG_WARMUP) ? 1u : 0u) | ((wf & IMEST_FLAG_INPUT_FAULT) ? 2u : 0u) |
-                      ((wf & IMEST_FLAG_ADC_SAT) ? 4u : 0u) | ((wf & IMEST_FLAG_ENCODER_FAULT) ? 8u : 0u) |
-                      ((wf & IMEST_FLAG_OVERRUN) ? 16u : 0u);
-      put_bits(f->data, Q_PEK1, 16u, enc_u16(r->pe_k1_rel, 5e4, &sat, IMEST_CAN_SAT_PEK1));
-      put_bits(f->data, Q_STATUS, 8u, st);
-      put_bits(f->data, Q_VALID, 1u, r->valid ? 1u : 0u);
-      put_bits(f->data, Q_HESS, 1u, (wf & IMEST_FLAG_HESSIAN_PD) ? 1u : 0u);
-      put_bits(f->data, Q_SAT, 5u, sat_bits(r));
-      put_bits(f->data, Q_WFLAGS, 5u, bits);
-      put_bits(f->data, Q_NROOTS, 5u, sat5(r->n_roots));
-      put_bits(f->data, Q_NADM, 5u, sat5(r->n_admissible));
-      break;
-    }
-    default: /* IMEST_CAN_FRAME_STAT */
-      put_bits(f->data, 0u, 32u, r->seq);
-      put_bits(f->data, 32u, 16u, tx_failed > 0xFFFFu ? 0xFFFFu : tx_failed);
-      break;
-  }
-  put_bits(f->data, B_COUNTER, 8u, counter & 0xFFu);
-  put_bits(f->data, B_CRC, 8u, frame_crc(index, f->data));
-  return IMEST_OK;
-}
-
-/* --- decoding -------------------------------------------------------------- */
-
-void imest_can_window_clear(imest_can_window_t *w) {
-  double nan = nan64();
-  if (w == NULL) {
-    return;
-  }
-  w->have = 0u;
-  w->counter = 0u;
-  w->seq = 0u;
-  w->tr_s = nan;
-  w->rs_ohm = nan;
-  w->e_i = nan;
-  w->pe_k1_rel = nan;
-  w->pe_k2_rel = nan;
-  w->valid = 0;
-  w->status = -1;
-  w->flags = 0u;
-  w->sat = 0u;
-  w->n_roots = 0u;
-  w->n_admissible = 0u;
-  w->tx_failed = 0u;
-}
-
-static int classify(const struct imest_can_frame *f, uint32_t base_id, unsigned int *index) {
-  uint32_t ext = base_id & IMEST_CAN_ID_EXT;
-  uint32_t mask = ext ? IMEST_CAN_EFF_MASK : IMEST_CAN_SFF_MASK;
-  uint32_t base = base_id & mask;
-  uint32_t id = f->id & mask;
-  uint32_t off;
+/* Ours? Then which frame, and is it intact? */
+static int classify(const struct imest_can_frame *f, uint32_t base_id, unsigned int *index)
+{
+  const uint32_t ext = base_id & IMEST_CAN_ID_EXT;
+  const uint32_t mask = ext ? IMEST_CAN_EFF_MASK : IMEST_CAN_SFF_MASK;
   if ((f->id & IMEST_CAN_ID_EXT) != ext || (f->id & ~(mask | IMEST_CAN_ID_EXT)) != 0u) {
     return IMEST_CAN_DEC_FOREIGN;
   }
-  off = (id - base) & mask;
-  if (off >= IMEST_CAN_NFRAMES) {
-    return IMEST_CAN_DEC_FOREIGN;
-  }
+  const uint32_t off = ((f->id & mask) - (base_id & mask)) & mask;
+  if (off >= (uint32_t)IMEST_CAN_NFRAMES) return IMEST_CAN_DEC_FOREIGN;
   *index = (unsigned int)off;
-  if (f->dlc != 8u) {
-    return IMEST_CAN_DEC_BAD_DLC;
-  }
-  if (frame_crc(*index, f->data) != ((unsigned int)f->data[7] & 0xFFu)) {
-    return IMEST_CAN_DEC_BAD_CRC;
-  }
+  if (f->dlc != 8u) return IMEST_CAN_DEC_BAD_DLC;
+  if (frame_crc(*index, f->data) != ((unsigned int)f->data[7] & 0xFFu)) return IMEST_CAN_DEC_BAD_CRC;
   return IMEST_CAN_DEC_OK;
 }
 
 int imest_can_decode_frame(const struct imest_can_frame *f, uint32_t base_id,
-                           imest_can_window_t *w, unsigned int *index) {
+                           imest_can_window_t *w, unsigned int *index)
+{
   unsigned int idx = 0u;
-  int dec;
-  const unsigned char *d;
-  if (f == NULL || w == NULL) {
-    return IMEST_CAN_DEC_FOREIGN;
+  unsigned int n = 0u;
+  const imest_can_signal_t *t = imest_can_signal_table(&n);
+  if (f == NULL || w == NULL) return IMEST_ERR_NULL;
+  const int dec = classify(f, base_id, &idx);
+  if (index != NULL && dec != IMEST_CAN_DEC_FOREIGN) *index = idx;
+  if (dec != IMEST_CAN_DEC_OK) return dec;
+  for (unsigned int k = 0u; k < n; k++) {
+    if (t[k].frame == idx) decode(&t[k], get_bits(f->data, t[k].start, t[k].len), w);
   }
-  dec = classify(f, base_id, &idx);
-  if (index != NULL && dec != IMEST_CAN_DEC_FOREIGN) {
-    *index = idx;
-  }
-  if (dec != IMEST_CAN_DEC_OK) {
-    return dec;
-  }
-  d = f->data;
-  switch (idx) {
-    case IMEST_CAN_FRAME_TR:
-      w->tr_s = dec_f32(get_bits(d, 0u, 32u));
-      w->e_i = dec_u16(get_bits(d, 32u, 16u), IMEST_CAN_EI_FACTOR);
-      break;
-    case IMEST_CAN_FRAME_RS:
-      w->rs_ohm = dec_f32(get_bits(d, 0u, 32u));
-      w->pe_k2_rel = dec_u16(get_bits(d, 32u, 16u), IMEST_CAN_PE_FACTOR);
-      break;
-    case IMEST_CAN_FRAME_QUAL: {
-      uint32_t wf = get_bits(d, Q_WFLAGS, 5u);
-      w->pe_k1_rel = dec_u16(get_bits(d, Q_PEK1, 16u), IMEST_CAN_PE_FACTOR);
-      w->status = (int)get_bits(d, Q_STATUS, 8u);
-      w->valid = (int)get_bits(d, Q_VALID, 1u);
-      w->sat = (unsigned int)get_bits(d, Q_SAT, 5u);
-      w->flags = ((wf & 1u) ? IMEST_FLAG_WARMUP : 0u) | ((wf & 2u) ? IMEST_FLAG_INPUT_FAULT : 0u) |
-                 ((wf & 4u) ? IMEST_FLAG_ADC_SAT : 0u) | ((wf & 8u) ? IMEST_FLAG_ENCODER_FAULT : 0u) |
-                 ((wf & 16u) ? IMEST_FLAG_OVERRUN : 0u) |
-                 (get_bits(d, Q_HESS, 1u) ? IMEST_FLAG_HESSIAN_PD : 0u);
-      w->n_roots = (unsigned int)get_bits(d, Q_NROOTS, 5u);
-      w->n_admissible = (unsigned int)get_bits(d, Q_NADM, 5u);
-      break;
-    }
-    default:
-      w->seq = get_bits(d, 0u, 32u);
-      w->tx_failed = get_bits(d, 32u, 16u);
-      break;
-  }
-  w->counter = (unsigned int)get_bits(d, B_COUNTER, 8u);
+  w->counter = (unsigned int)get_bits(f->data, IMEST_CAN_COUNTER_START, 8u);
   w->have |= 1u << idx;
   return IMEST_CAN_DEC_OK;
-}
-
-/* --- reader ---------------------------------------------------------------- */
-
-void imest_can_rx_init(imest_can_rx_t *rx, uint32_t base_id) {
-  unsigned int i;
-  if (rx == NULL) {
-    return;
-  }
-  rx->base_id = base_id;
-  rx->seen = 0u;
-  for (i = 0u; i < IMEST_CAN_NFRAMES; i++) {
-    rx->last_ctr[i] = 0u;
-  }
-  rx->open = 0;
-  imest_can_window_clear(&rx->cur);
-  rx->have_seq = 0;
-  rx->last_seq = 0u;
-  rx->last_seq_ctr = 0u;
-  rx->st.frames = 0u;
-  rx->st.foreign = 0u;
-  rx->st.corrupt = 0u;
-  rx->st.repeated = 0u;
-  rx->st.lost = 0u;
-  rx->st.windows = 0u;
-  rx->st.incomplete = 0u;
-  rx->st.seq_gaps = 0u;
-  rx->st.restarts = 0u;
-}
-
-static void copy_window(imest_can_window_t *dst, const imest_can_window_t *src) {
-  if (dst != NULL) {
-    *dst = *src;
-  }
-}
-
-unsigned int imest_can_rx_feed(imest_can_rx_t *rx, const struct imest_can_frame *f,
-                               imest_can_window_t *out, imest_can_rx_event_t *ev) {
-  imest_can_rx_event_t e;
-  unsigned int idx = 0u;
-  unsigned int ctr;
-  unsigned int full = (1u << IMEST_CAN_NFRAMES) - 1u;
-  imest_can_window_t probe;
-
-  e.events = 0u;
-  e.index = 0u;
-  e.counter = 0u;
-  e.prev_counter = 0u;
-  e.lost = 0u;
-  e.seq_gap = 0u;
-  e.dec = IMEST_CAN_DEC_FOREIGN;
-  if (rx == NULL || f == NULL) {
-    if (ev != NULL) {
-      *ev = e;
-    }
-    return 0u;
-  }
-  rx->st.frames++;
-  imest_can_window_clear(&probe);
-  e.dec = imest_can_decode_frame(f, rx->base_id, &probe, &idx);
-  e.index = idx;
-  if (e.dec == IMEST_CAN_DEC_FOREIGN) {
-    rx->st.foreign++;
-    e.events = IMEST_CAN_EV_FOREIGN;
-  } else if (e.dec != IMEST_CAN_DEC_OK) {
-    rx->st.corrupt++;
-    e.events = IMEST_CAN_EV_CORRUPT;
-  } else {
-    ctr = probe.counter;
-    e.counter = ctr;
-    if (rx->seen & (1u << idx)) {
-      unsigned int dctr = (ctr - rx->last_ctr[idx]) & 0xFFu;
-      e.prev_counter = rx->last_ctr[idx];
-      if (dctr == 0u) {
-        rx->st.repeated++;
-        e.events = IMEST_CAN_EV_REPEATED;
-        if (ev != NULL) {
-          *ev = e;
-        }
-        return e.events;
-      }
-      if (dctr > 1u) {
-        e.lost = dctr - 1u;
-        rx->st.lost += e.lost;
-        e.events |= IMEST_CAN_EV_LOST;
-      }
-    }
-    rx->seen |= 1u << idx;
-    rx->last_ctr[idx] = ctr;
-
-    if (rx->open && rx->cur.counter != ctr) {
-      /* a frame of the next window: hand out the incomplete one */
-      copy_window(out, &rx->cur);
-      rx->open = 0;
-      rx->st.windows++;
-      rx->st.incomplete++;
-      e.events |= IMEST_CAN_EV_WINDOW | IMEST_CAN_EV_INCOMPLETE;
-    }
-    if (!rx->open) {
-      imest_can_window_clear(&rx->cur);
-      rx->cur.counter = ctr;
-      rx->open = 1;
-    }
-    (void)imest_can_decode_frame(f, rx->base_id, &rx->cur, NULL);
-
-    if (idx == IMEST_CAN_FRAME_STAT) {
-      uint32_t seq = rx->cur.seq;
-      if (rx->have_seq) {
-        uint32_t g = seq - rx->last_seq;
-        uint32_t d = (ctr - rx->last_seq_ctr) & 0xFFu;
-        if (g & 0x80000000u) {
-          rx->st.restarts++;
-          e.events |= IMEST_CAN_EV_RESTART;
-        } else if (g > d) {
-          e.seq_gap = g - d;
-          rx->st.seq_gaps += e.seq_gap;
-          e.events |= IMEST_CAN_EV_SEQ_GAP;
-        }
-      }
-      rx->have_seq = 1;
-      rx->last_seq = seq;
-      rx->last_seq_ctr = ctr;
-    }
-    if (rx->cur.have == full) {
-      /* a window just opened by this frame cannot be complete, so at most
-       * one window is handed out per call */
-      copy_window(out, &rx->cur);
-      rx->open = 0;
-      rx->st.windows++;
-      e.events |= IMEST_CAN_EV_WINDOW;
-    }
-  }
-  if (ev != NULL) {
-    *ev = e;
-  }
-  return e.events;
-}
-
-unsigned int imest_can_rx_flush(imest_can_rx_t *rx, imest_can_window_t *out) {
-  if (rx == NULL || !rx->open) {
-    return 0u;
-  }
-  copy_window(out, &rx->cur);
-  rx->open = 0;
-  rx->st.windows++;
-  rx->st.incomplete++;
-  return IMEST_CAN_EV_WINDOW | IMEST_CAN_EV_INCOMPLETE;
 }

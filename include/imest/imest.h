@@ -334,10 +334,6 @@ typedef struct {
   float sigma, ls_h, tr_nominal_s, tr_min_s, tr_max_s, rs_min_ohm, rs_max_ohm;
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
   float last_k1, last_k2;        /* last valid estimate: centring of later windows */
-  const struct imest_can_port *can; /* telemetry port (NULL: none) */
-  uint32_t can_base_id;
-  uint32_t can_counter;
-  uint32_t can_tx_failed;
 } imest_t;
 
 /* ----------------------------------------------------------------------------

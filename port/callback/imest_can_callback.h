@@ -8,8 +8,10 @@
  * See example/example_stm32.c for an STM32-HAL-style implementation.
  *
  *     static struct imest_can_callback cb;
+ *     static imest_can_pub_t pub;
  *     imest_can_callback_init(&cb, my_can_tx, &hcan1);
- *     imest_attach_can(&est, &cb.port, 0x6A0u);
+ *     imest_can_pub_init(&pub, &cb.port, IMEST_CAN_DEFAULT_BASE_ID);
+ *     ...  imest_can_publish(&pub, &result) after imest_background() returned it
  *
  * C11, no stdio, no malloc; octets in `unsigned char`, one per element.
  */
@@ -31,7 +33,7 @@ typedef int (*imest_can_hal_tx_fn)(void *hal, uint32_t id, int extended,
                                    const unsigned char *data, unsigned int dlc);
 
 struct imest_can_callback {
-  struct imest_can_port port;   /**< pass &cb.port to imest_attach_can() */
+  struct imest_can_port port;   /**< pass &cb.port to imest_can_pub_init() */
   imest_can_hal_tx_fn tx;
   void *hal;                    /**< the HAL handle given to tx (e.g. &hcan1) */
   uint32_t sent;                /**< frames the HAL accepted */

@@ -50,7 +50,7 @@ int imest_candump_parse(const char *line, double *t_s, char iface[IMEST_CANDUMP_
 
 /** A port that writes every frame as one line to a FILE*. */
 struct imest_candump_port {
-  struct imest_can_port port;   /**< pass &p.port to imest_attach_can() */
+  struct imest_can_port port;   /**< pass &p.port to imest_can_pub_init() */
   FILE *fp;
   char iface[IMEST_CANDUMP_IFNAMSIZ];
   double t_s;                   /**< timestamp of the next lines */

@@ -4,12 +4,12 @@
  *
  *     struct imest_socketcan sc;
  *     if (imest_socketcan_open(&sc, "vcan0") != 0) { puts(sc.err); ... }
- *     imest_attach_can(&est, &sc.port, IMEST_CAN_DEFAULT_BASE_ID);
+ *     imest_can_pub_init(&pub, &sc.port, IMEST_CAN_DEFAULT_BASE_ID);
  *     ...
  *     imest_socketcan_close(&sc);
  *
  * Sending never blocks (MSG_DONTWAIT): a full queue (ENOBUFS/EAGAIN) or a
- * down interface is a failed send, counted by the publisher.
+ * down interface is a failed send, counted by the publisher (pub.tx_failed).
  */
 #ifndef IMEST_SOCKETCAN_H
 #define IMEST_SOCKETCAN_H
@@ -23,7 +23,7 @@ extern "C" {
 #endif
 
 struct imest_socketcan {
-  struct imest_can_port port;  /**< pass &sc.port to imest_attach_can() */
+  struct imest_can_port port;  /**< pass &sc.port to imest_can_pub_init() */
   int fd;                      /**< CAN_RAW socket, -1 when closed */
   int ifindex;
   char ifname[16];

@@ -1,10 +1,11 @@
 /* imest-can-selftest: publishes N synthetic window results through the real
- * library path (an imest instance, imest_attach_can, imest_can_publish) over
- * a SocketCAN interface (--iface) or into a candump -L log (--log). The
- * results are a deterministic function of the window number, with edge values
- * (NaN, infinity, out-of-range, saturation) mixed in, so two runs can be
- * compared after decoding. Used by the socketcan end-to-end test (qemu guest)
- * and by the DBC and monitor tests. */
+ * library path (imest_can_pub_init, imest_can_publish) over a SocketCAN
+ * interface (--iface) or into a candump -L log (--log). The results are a
+ * deterministic function of the window number, with edge values (NaN,
+ * infinity, out-of-range, saturation) mixed in, so two runs can be compared
+ * after decoding. Used by the socketcan end-to-end test (qemu guest) and by
+ * the DBC and monitor tests. --table prints the codec's signal table and the
+ * reason names instead (test_dbc.py compares them with tools/imest.dbc). */
 #define _GNU_SOURCE 1
 #include <float.h>
 #include <math.h>
@@ -15,6 +16,7 @@
 
 #include "imest/imest.h"
 #include "imest/imest_can.h"
+#include "imest_can_id.h"
 #include "imest_candump.h"
 #ifdef IMEST_SELFTEST_SOCKETCAN
 #include "imest_socketcan.h"
@@ -37,6 +39,14 @@ static void synth(unsigned int k, imest_result_t *r) {
   r->flags = IMEST_FLAG_HESSIAN_PD;
   r->n_roots = 1u + k % 5u;
   r->n_admissible = 1u;
+  r->tr_valid = 1;
+  r->rs_valid = 1;
+  r->tr_reason = IMEST_REASON_NONE;
+  r->rs_reason = IMEST_REASON_NONE;
+  r->tr_bound_rel = 0.0013 * (double)(k % 7u);
+  r->rs_bound_rel = k % 4u == 1u ? (double)NAN : 0.0071 * (double)(k % 5u);
+  r->windows = 1u + k % 3u;
+  r->span_s = 1.0 * (double)r->windows;
   switch (k % 10u) {
     case 3u: /* no candidate */
       r->tr_s = NAN;
@@ -46,6 +56,9 @@ static void synth(unsigned int k, imest_result_t *r) {
       r->pe_k2_rel = NAN;
       r->valid = 0;
       r->status = IMEST_REASON_NO_ROOT;
+      r->tr_valid = r->rs_valid = 0;
+      r->tr_reason = r->rs_reason = IMEST_REASON_NO_ROOT;
+      r->tr_bound_rel = r->rs_bound_rel = NAN;
       r->flags = IMEST_FLAG_WARMUP | IMEST_FLAG_ENCODER_FAULT;
       r->n_admissible = 0u;
       break;
@@ -57,13 +70,28 @@ static void synth(unsigned int k, imest_result_t *r) {
       r->pe_k2_rel = 2.0;
       r->valid = 0;
       r->status = IMEST_REASON_HIGH_RESIDUAL;
+      r->tr_valid = r->rs_valid = 0;
+      r->tr_reason = IMEST_REASON_HIGH_RESIDUAL;
+      r->rs_reason = 300; /* not a reason: sent as 255, out of range */
+      r->tr_bound_rel = 5.0;
+      r->rs_bound_rel = -1.0;
+      r->span_s = 100.0;
+      r->windows = 300u; /* saturates at 255 */
       r->flags = IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ADC_SAT | IMEST_FLAG_OVERRUN;
       r->n_roots = 20u;
       r->n_admissible = 17u;
       break;
+    case 7u: /* T_R trusted, R_S not */
+      r->valid = 0;
+      r->status = IMEST_REASON_RS_OUT_OF_RANGE;
+      r->rs_valid = 0;
+      r->rs_reason = IMEST_REASON_RS_OUT_OF_RANGE;
+      break;
     case 8u:
       r->valid = 0;
       r->status = IMEST_REASON_POORLY_DETERMINED;
+      r->tr_valid = r->rs_valid = 0;
+      r->tr_reason = r->rs_reason = IMEST_REASON_POORLY_DETERMINED;
       r->pe_k2_rel = 0.25;
       break;
     default:
@@ -71,63 +99,85 @@ static void synth(unsigned int k, imest_result_t *r) {
   }
 }
 
-static void usage(void) {
+static void usage(void)
+{
   fputs("usage: imest-can-selftest (--iface NAME | --log FILE|-) [--count N] [--period-ms MS]\n"
-        "                          [--base-id ID] [--epoch SEC]\n",
+        "                          [--base-id ID] [--ext] [--epoch SEC]\n"
+        "       imest-can-selftest --table\n",
         stderr);
 }
 
-int main(int argc, char **argv) {
-  static imest_t est;
-  imest_config_t cfg;
-  const char *iface = NULL, *log = NULL;
-  unsigned long count = 20u, period_ms = 0u, base = IMEST_CAN_DEFAULT_BASE_ID;
+/* The signal table and the reason names, one line each (test_dbc.py). */
+static void print_table(void)
+{
+  static const char *const kind[] = {"f32", "scaled", "count", "u32", "enum", "bool", "flag", "sat", "txfail"};
+  unsigned int n = 0u;
+  const imest_can_signal_t *t = imest_can_signal_table(&n);
+  printf("frames %d counter %u crc %u\n", IMEST_CAN_NFRAMES, IMEST_CAN_COUNTER_START, IMEST_CAN_CRC_START);
+  for (unsigned int k = 0u; k < n; k++) {
+    printf("signal %u %u %u %s %lu %u\n", t[k].frame, t[k].start, t[k].len, kind[t[k].kind],
+           (unsigned long)t[k].scale, t[k].mask);
+  }
+  for (int r = 0; r < 255; r++) {
+    if (strcmp(imest_reason_name(r), "unknown") != 0) printf("reason %d %s\n", r, imest_reason_name(r));
+  }
+}
+
+int main(int argc, char **argv)
+{
+  const char *iface = NULL, *log = NULL, *base_text = NULL;
+  unsigned long count = 20u, period_ms = 0u;
+  uint32_t base = IMEST_CAN_DEFAULT_BASE_ID;
+  int ext = 0;
   double epoch = 1700000000.0;
   struct imest_candump_port cd;
   FILE *fp = NULL;
-  unsigned int k;
   unsigned long failed = 0u;
-  int i, rc;
+  imest_can_pub_t pub;
+  char err[256];
 #ifdef IMEST_SELFTEST_SOCKETCAN
   struct imest_socketcan sc;
 #endif
   const struct imest_can_port *port = NULL;
-  for (i = 1; i < argc; i++) {
+  for (int i = 1; i < argc; i++) {
+    if (strcmp(argv[i], "--table") == 0) {
+      print_table();
+      return 0;
+    }
+    if (strcmp(argv[i], "--ext") == 0) {
+      ext = 1;
+      continue;
+    }
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
     if (v == NULL) {
       usage();
-      return 1;
+      return 2;
     }
     if (strcmp(argv[i], "--iface") == 0) iface = v;
     else if (strcmp(argv[i], "--log") == 0) log = v;
     else if (strcmp(argv[i], "--count") == 0) count = strtoul(v, NULL, 0);
     else if (strcmp(argv[i], "--period-ms") == 0) period_ms = strtoul(v, NULL, 0);
-    else if (strcmp(argv[i], "--base-id") == 0) base = strtoul(v, NULL, 0);
+    else if (strcmp(argv[i], "--base-id") == 0) base_text = v;
     else if (strcmp(argv[i], "--epoch") == 0) epoch = strtod(v, NULL);
     else {
       usage();
-      return 1;
+      return 2;
     }
     i++;
   }
   if ((iface == NULL) == (log == NULL)) {
     usage();
-    return 1;
+    return 2;
   }
-  imest_config_default(&cfg);
-  cfg.pole_pairs = 2u;
-  cfg.ls_h = 0.2908f;
-  cfg.sigma = 0.096f;
-  rc = imest_init(&est, &cfg);
-  if (rc != IMEST_OK) {
-    fprintf(stderr, "imest-can-selftest: imest_init failed (%d)\n", rc);
+  if (base_text != NULL && imest_can_id_parse(base_text, ext, "--ext", &base, err, sizeof err) != IMEST_OK) {
+    fprintf(stderr, "imest-can-selftest: --base-id %s\n", err);
     return 2;
   }
   if (log != NULL) {
     fp = strcmp(log, "-") == 0 ? stdout : fopen(log, "w");
     if (fp == NULL || imest_candump_port_open(&cd, fp, "vcan0") != 0) {
       fprintf(stderr, "imest-can-selftest: cannot write '%s'\n", log);
-      return 2;
+      return 1;
     }
     port = &cd.port;
   } else {
@@ -142,18 +192,18 @@ int main(int argc, char **argv) {
     return 2;
 #endif
   }
-  rc = imest_attach_can(&est, port, (uint32_t)base | (base > 0x7FFu ? IMEST_CAN_ID_EXT : 0u));
+  const int rc = imest_can_pub_init(&pub, port, base);
   if (rc != IMEST_OK) {
-    fprintf(stderr, "imest-can-selftest: imest_attach_can(0x%lX) failed (%d)\n", base, rc);
+    fprintf(stderr, "imest-can-selftest: imest_can_pub_init(0x%lX) failed (%s)\n", (unsigned long)base,
+            imest_err_name(rc));
     return 2;
   }
-  for (k = 0u; k < count; k++) {
+  for (unsigned int k = 0u; k < count; k++) {
     imest_result_t r;
-    int f;
     synth(k, &r);
     if (log != NULL) imest_candump_port_set_time(&cd, epoch + r.t_end_s);
-    f = imest_can_publish(&est, &r);
-    if (f != 0) failed += (unsigned long)f;
+    const int f = imest_can_publish(&pub, &r);
+    if (f > 0) failed += (unsigned long)f;
     if (period_ms != 0u) {
       struct timespec ts;
       ts.tv_sec = (time_t)(period_ms / 1000u);
@@ -161,8 +211,8 @@ int main(int argc, char **argv) {
       nanosleep(&ts, NULL);
     }
   }
-  fprintf(stderr, "imest-can-selftest: published %lu window(s), %lu failed send(s), can_tx_failed %lu\n",
-          count, failed, (unsigned long)est.can_tx_failed);
+  fprintf(stderr, "imest-can-selftest: published %lu window(s), %lu failed send(s), tx_failed %lu\n",
+          count, failed, (unsigned long)pub.tx_failed);
 #ifdef IMEST_SELFTEST_SOCKETCAN
   if (iface != NULL) imest_socketcan_close(&sc);
 #endif

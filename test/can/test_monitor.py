@@ -1,6 +1,8 @@
 #!/usr/bin/python3
 """imest-monitor on candump logs: clean, lost, repeated, corrupted,
-malformed and truncated input, options and error paths.
+malformed and truncated input, a sender restart, options, exit codes
+(0 decoded, 1 nothing decoded / input error, 2 usage) and the messages that
+say what is wrong when nothing decodes.
 
 usage: test_monitor.py SELFTEST MONITOR WORKDIR
 """
@@ -12,6 +14,7 @@ selftest, monitor, work = sys.argv[1:4]
 os.makedirs(work, exist_ok=True)
 fails = []
 N = 20
+NF = 6  # frames per window
 HEADER = "t_s,seq,T_R_s,R_S_ohm,E_I,valid,status"
 
 
@@ -27,7 +30,7 @@ def run(args, stdin=None):
 
 def rows(out):
     lines = out.splitlines()
-    return lines[1:] if lines and lines[0].startswith(HEADER) else None
+    return lines[1:] if lines and lines[0].startswith(HEADER) else []
 
 
 def write(name, lines):
@@ -37,55 +40,77 @@ def write(name, lines):
     return path
 
 
-clean = os.path.join(work, "mon_clean.log")
-subprocess.run([selftest, "--log", clean, "--count", str(N)], check=True)
-with open(clean) as fh:
-    good = fh.readlines()
-check(len(good) == 4 * N, f"selftest wrote {len(good)} lines")
+def publish(name, *args):
+    path = os.path.join(work, name)
+    subprocess.run([selftest, "--log", path] + list(args), check=True, capture_output=True)
+    with open(path) as fh:
+        return path, fh.readlines()
+
+
+clean, good = publish("mon_clean.log", "--count", str(N))
+check(len(good) == NF * N, f"selftest wrote {len(good)} lines")
 
 # 1. clean log, CSV
 rc, out, err = run(["--log", clean, "--csv"])
 check(rc == 0, f"clean: rc {rc}")
 check(out.splitlines()[0].startswith(HEADER + ","), "CSV header: " + out.splitlines()[0])
+check(out.splitlines()[0].endswith(",tr_valid,tr_reason,rs_valid,rs_reason,tr_bound_rel,rs_bound_rel,span_s,windows"),
+      "CSV header, verdict columns: " + out.splitlines()[0])
 r = rows(out)
-check(r is not None and len(r) == N, f"clean: {len(r or [])} rows")
+check(len(r) == N, f"clean: {len(r)} rows")
 check("lost 0, repeated 0, corrupted 0" in err, "clean summary: " + err)
 check("no_root" in out and "high_residual" in out and ",ok," in out, "status names in CSV")
-first = r[0].split(",")
-check(first[0] == "1700000001.000000" and first[1] == "0" and first[5] == "1" and first[6] == "ok",
-      f"first row {r[0]}")
+cols = out.splitlines()[0].split(",")
+first = dict(zip(cols, r[0].split(",")))
+check(first["t_s"] == "1700000001.000000" and first["seq"] == "0" and first["valid"] == "1"
+      and first["status"] == "ok" and first["frames"] == "0x3F", f"first row {r[0]}")
+sat_row = dict(zip(cols, r[5].split(",")))  # window 5: every field clamped
+check(sat_row["pe_k1_rel"] == ">1.31068" and sat_row["pe_k2_rel"] == ">1.31068" and sat_row["E_I"] == ">6.5534"
+      and sat_row["T_R_s"].startswith(">") and sat_row["span_s"] == ">65.534"
+      and sat_row["tr_bound_rel"] == ">1.31068" and sat_row["rs_bound_rel"] == "<0.00000",
+      f"saturated values must read as bounds: {r[5]}")
+check(sat_row["R_S_ohm"] == "-inf", "an infinity is carried as such, not saturated")
+row7 = dict(zip(cols, r[7].split(",")))  # window 7: T_R trusted, R_S not
+check(row7["tr_valid"] == "1" and row7["tr_reason"] == "ok" and row7["rs_valid"] == "0"
+      and row7["rs_reason"] == "rs_out_of_range", f"per-parameter verdicts: {r[7]}")
 
 # 2. table
 rc, out, err = run(["--log", clean])
 lines = out.splitlines()
-check(rc == 0 and "T_R [s]" in lines[0] and len(lines) == N + 1, f"table: {len(lines)} lines")
+check(rc == 0 and "T_R [s]" in lines[0] and "T_R verdict" in lines[0] and len(lines) == N + 1,
+      f"table: {len(lines)} lines")
+check(">1.31068" in lines[6] and " 1.31068" not in lines[6], "table: saturated PE shown as a bound: " + lines[6])
+check("rs_out_of_range" in lines[8] and " ok " in lines[8], "table: R_S verdict apart from T_R: " + lines[8])
+check("n/a" in lines[2], "table: a bound that is not available: " + lines[2])
 
-# 3. lost frame (line 10 = window 2, IMEST_RS)
-rc, out, err = run(["--log", write("mon_lost.log", good[:9] + good[10:]), "--csv"])
-r = rows(out)
-check(len(r) == N, f"lost: {len(r)} rows")
-check("lost 1 frame(s) 0x6A1 (IMEST_RS): counter 1 -> 3" in err, "lost event: " + err)
+# 3. lost frame: window 2's IMEST_RS
+rc, out, err = run(["--log", write("mon_lost.log", good[:2 * NF + 1] + good[2 * NF + 2:]), "--csv"])
+check(rc == 0 and len(rows(out)) == N, f"lost: rc {rc}, {len(rows(out))} rows")
+check("lost 1 frame(s) up to the window with counter 2" in err, "lost event: " + err)
 check("incomplete window (counter 2, seq 2): missing IMEST_RS" in err, "incomplete event: " + err)
-check(",0x5\n" in out or out.rstrip().endswith("0x5") or ",0xB" in out or ",0xD" in out,
-      "incomplete row frames mask")
+check(",0x3D," in out, "incomplete row frames mask")
 check("lost 1," in err and "windows 20 (incomplete 1)" in err, "lost summary: " + err)
+# a whole window lost
+rc, out, err = run(["--log", write("mon_lost_win.log", good[:3 * NF] + good[4 * NF:]), "--csv"])
+check(f"lost {NF}, repeated 0, corrupted 0" in err and "incomplete 0" in err, "lost window summary: " + err)
 
 # 4. repeated frame
 rc, out, err = run(["--log", write("mon_rep.log", good[:5] + [good[4]] + good[5:]), "--csv"])
 check(len(rows(out)) == N, "repeated: rows")
-check("mon_rep.log:6: repeated frame 0x6A0 (IMEST_TR), counter 1" in err, "repeat event: " + err)
-check("repeated 1," in err, "repeat summary")
+check("mon_rep.log:6: repeated frame 0x6A4 (IMEST_VERDICT), counter 0" in err, "repeat event: " + err)
+check("lost 0, repeated 1," in err, "repeat summary: " + err)
 
-# 5. corrupted frame (one hex digit of the payload changed)
-bad = good[6]
+# 5. corrupted frames are counted as corrupted, not also as lost
+bad = good[NF + 2]
 pos = bad.index("#") + 3
 bad = bad[:pos] + ("0" if bad[pos] != "0" else "1") + bad[pos + 1:]
-rc, out, err = run(["--log", write("mon_corrupt.log", good[:6] + [bad] + good[7:]), "--csv"])
-check("mon_corrupt.log:7: corrupted frame 0x6A2 (IMEST_QUAL): checksum mismatch" in err, "corrupt: " + err)
-check("corrupted 1," in err and "incomplete 1" in err, "corrupt summary: " + err)
-short = good[8].split("#")[0] + "#" + good[8].split("#")[1][:10] + "\n"
-rc, out, err = run(["--log", write("mon_dlc.log", good[:8] + [short] + good[9:]), "--csv"])
+rc, out, err = run(["--log", write("mon_corrupt.log", good[:NF + 2] + [bad] + good[NF + 3:]), "--csv"])
+check(f"mon_corrupt.log:{NF + 3}: corrupted frame 0x6A2 (IMEST_QUAL): checksum mismatch" in err, "corrupt: " + err)
+check("lost 0, repeated 0, corrupted 1," in err and "incomplete 1" in err, "corrupt summary: " + err)
+short = good[2 * NF].split("#")[0] + "#" + good[2 * NF].split("#")[1][:10] + "\n"
+rc, out, err = run(["--log", write("mon_dlc.log", good[:2 * NF] + [short] + good[2 * NF + 1:]), "--csv"])
 check("corrupted frame 0x6A0 (IMEST_TR): 5 data bytes, expected 8" in err, "short frame: " + err)
+check("lost 0, repeated 0, corrupted 1," in err, "short frame summary: " + err)
 
 # 6. malformed lines: named by number, the reader goes on
 junk = ["this is not a candump line\n", "(1700000000.5) vcan0 123#0\n", "\x00\x01binary\n",
@@ -103,50 +128,94 @@ check("malformed lines 5" in err and "corrupted 0" in err, "junk summary: " + er
 cut = good[-1][:len(good[-1]) // 2]
 path = write("mon_trunc.log", good[:-1] + [cut])
 rc, out, err = run(["--log", path, "--csv"])
-check(f"mon_trunc.log:{4 * N}: malformed line" in err, "truncated line: " + err)
-check("end of input: incomplete window" in err and "missing IMEST_STAT" in err, "truncated end: " + err)
-check(len(rows(out)) == N, "truncated: rows")
+check(f"mon_trunc.log:{NF * N}: malformed line" in err, "truncated line: " + err)
+check("end of input: incomplete window" in err and "missing IMEST_BOUNDS" in err, "truncated end: " + err)
+check(len(rows(out)) == N and "lost 0," in err, "truncated: rows, and the unrecorded tail is not lost")
 
-# 8. stdin
+# 8. stdin, and --opt=value
 rc, out, err = run(["--log", "-", "--csv"], stdin="".join(good))
 check(rc == 0 and len(rows(out)) == N, "stdin")
+rc, out, err = run(["--log=-", "--csv", "--count=3", "--base-id=0x6A0"], stdin="".join(good))
+check(rc == 0 and len(rows(out)) == 3, f"--opt=value: rc {rc} {err}")
 
-# 9. other base id: nothing is ours
-rc, out, err = run(["--log", clean, "--csv", "--base-id", "0x100"])
-check(len(rows(out)) == 0 and f"foreign {4 * N}" in err, "foreign: " + err)
+# 9. a sender restart is a restart, not hundreds of lost frames
+_, again = publish("mon_again.log", "--count", "5", "--epoch", "1700000100")
+path = write("mon_restart.log", good + again)
+rc, out, err = run(["--log", path, "--csv"])
+check(rc == 0 and len(rows(out)) == N + 5, f"restart: rc {rc}, {len(rows(out))} rows")
+check("sequence number went back to 0: the sender restarted" in err, "restart event: " + err)
+check("lost 0, repeated 0, corrupted 0, estimator gaps 2, restarts 1," in err, "restart summary: " + err)
 
-# 10. extended identifiers
-ext = os.path.join(work, "mon_ext.log")
-subprocess.run([selftest, "--log", ext, "--count", "5", "--base-id", "0x18FF5000"], check=True)
+# 10. extended identifiers, one parser for every tool
+ext, _ = publish("mon_ext.log", "--count", "5", "--base-id", "0x18FF5000")
 with open(ext) as fh:
-    check(" 18FF5003#" in fh.read(), "extended id in log")
-rc, out, err = run(["--log", ext, "--csv", "--base-id", "0x18FF5000"])
-check(len(rows(out)) == 5 and "lost 0," in err, "extended: " + err)
-rc, out, err = run(["--log", ext, "--csv", "--base-id", "0x500", "--ext"])
-check(len(rows(out)) == 0, "extended 0x500 is not 0x18FF5000")
+    check(" 18FF5005#" in fh.read(), "extended id in log")
+for base in ("0x18FF5000", "0x98FF5000", "419385344"):
+    rc, out, err = run(["--log", ext, "--csv", "--base-id", base])
+    check(rc == 0 and len(rows(out)) == 5 and "lost 0," in err, f"extended {base}: " + err)
 
 # 11. --count
 rc, out, err = run(["--log", clean, "--csv", "--count", "5"])
-check(len(rows(out)) == 5, "--count")
+check(rc == 0 and len(rows(out)) == 5, "--count")
+for bad_count in ("0", "-1", "abc", "2x", ""):
+    rc, out, err = run(["--log", clean, "--count", bad_count])
+    check(rc == 2 and "bad --count" in err and out == "", f"--count {bad_count!r}: rc {rc} {err}")
 
-# 12. usage and open errors
-rc, out, err = run([])
-check(rc == 1 and "exactly one of --iface" in err, "no source")
-rc, out, err = run(["--log", clean, "--iface", "vcan0"])
-check(rc == 1, "two sources")
-rc, out, err = run(["--log", clean, "--base-id", "0x7FE"])
-check(rc == 1 and "out of range" in err, "base id range")
-rc, out, err = run(["--log", clean, "--base-id", "zz"])
-check(rc == 1 and "bad --base-id" in err, "base id parse")
+# 12. nothing decoded: exit 1 and say why
+def nothing(args, want, what, stdin=None):
+    rc, out, err = run(args, stdin)
+    check(rc == 1 and "nothing decoded" in err and want in err, f"{what}: rc {rc}: {err}")
+
+
+plain = []
+for line in good:
+    ident, data = line.split()[2].split("#")
+    plain.append("  vcan0  %s   [8]  %s\n" % (ident, " ".join(data[i:i + 2] for i in range(0, 16, 2))))
+nothing(["--log", write("mon_plain.log", plain)], "look like plain candump output", "plain candump")
+nothing(["--log", write("mon_plain.log", plain)], "candump -L", "plain candump remedy")
+nothing(["--log", clean, "--base-id", "0x100"],
+        f"{NF * N} frame(s) read, none with identifiers 0x100..0x105; frames seen: 0x6A0 ({N}),",
+        "wrong base id")
+nothing(["--log", clean, "--base-id", "0x100"], "is --base-id right? 0x6A0 .. +5 look like an imest node: "
+        "--base-id 0x6A0", "wrong base id: the likely base")
+nothing(["--log", clean, "--ext"], "the log has 11-bit (standard) identifiers at that base: drop --ext",
+        "--ext on an 11-bit log")
+small_ext, _ = publish("mon_small_ext.log", "--count", "3", "--base-id", "0x500", "--ext")
+nothing(["--log", small_ext, "--base-id", "0x500"], "29-bit (extended) identifiers at that base: add --ext",
+        "29-bit log without --ext")
+rc, out, err = run(["--log", small_ext, "--base-id", "0x500", "--ext"])
+check(rc == 0 and len(rows(out) or out.splitlines()[1:]) == 3, f"29-bit log with --ext: {err}")
+nothing(["--log", write("mon_empty.log", [])], "the log is empty", "empty log")
+nothing(["--log", "-"], "the log is empty", "empty stdin", stdin="")
+nothing(["--log", write("mon_text.log", ["hello\n", "world\n"])], "2 line(s) read, none a candump -L frame line",
+        "not a log")
+all_bad = [line[:-3] + ("00" if line[-3:-1] != "00" else "11") + "\n" for line in good]
+nothing(["--log", write("mon_allbad.log", all_bad)], "all corrupted (bad checksum or length)", "all corrupted")
+rc, out, err = run(["--log", work])
+check(rc == 1 and "is a directory" in err, f"directory as --log: rc {rc} {err}")
 rc, out, err = run(["--log", os.path.join(work, "does-not-exist.log")])
-check(rc == 2 and "cannot open log" in err and "No such file" in err, "missing log: " + err)
-rc, out, err = run(["--bogus"])
-check(rc == 1 and "unknown" in err, "unknown option")
+check(rc == 1 and "cannot open log" in err and "No such file" in err, "missing log: " + err)
 
-# 13. live on this machine: no CAN in the kernel -> clear message, exit 2
+# 13. usage errors: exit 2
+for args, want in ((["--log", clean, "--iface", "vcan0"], "exactly one of"),
+                   ([], "exactly one of"),
+                   (["--log", clean, "--base-id", "0x7FB"], "beyond the 11-bit range (largest base 0x7FA)"),
+                   (["--log", clean, "--base-id", "0x20000000"], "beyond the 29-bit range"),
+                   (["--log", clean, "--base-id", "zz"], "not an identifier"),
+                   (["--log", clean, "--base-id", "-5"], "negative"),
+                   (["--bogus"], "unknown option"),
+                   (["--log", clean, "--csv=1"], "takes no value"),
+                   (["--log"], "needs a value"),
+                   (["--log", clean, "--timeout", "-1"], "bad --timeout")):
+    rc, out, err = run(args)
+    check(rc == 2 and want in err, f"usage {args}: rc {rc}: {err}")
+rc, out, err = run(["--help"])
+check(rc == 0 and "usage: imest-monitor" in out and "Exit status" in out, "--help")
+
+# 14. live on this machine: no CAN in the kernel -> clear message, exit 1
 rc, out, err = run(["--iface", "vcan0", "--timeout", "1"])
-check((rc == 2 and ("no SocketCAN support" in err or "no such network interface" in err)
-       and out == "") or (rc == 0 and "listening" in err), f"iface error: rc {rc} {err} {out}")
+check((rc == 1 and ("no SocketCAN support" in err or "no such network interface" in err))
+      or (rc == 1 and "listening" in err and "no frame received" in err), f"iface error: rc {rc} {err} {out}")
 
 if fails:
     print("\n".join(fails))

@@ -6,8 +6,9 @@
  * 4096-count encoder, thermal drift) produces one sample per 1/fs; each sample
  * goes through imest_isr_abc() as float32 with the encoder angle wrapped to
  * [0, 2pi); when the ISR call reports a finished window, imest_background()
- * solves it and publishes it over the CAN port (a candump -L log, and a live
- * SocketCAN interface if asked). Alongside, the simulator's truth is averaged
+ * solves it and the run publishes the result over the CAN port
+ * (imest_can_publish: a candump -L log, and a live SocketCAN interface if
+ * asked). Alongside, the simulator's truth is averaged
  * over the same window's samples so every estimate can be compared with it.
  *
  * Experiments (run in parallel threads):
@@ -133,6 +134,7 @@ typedef struct {
 #endif
   int live;
   unsigned long live_sent, live_failed;
+  imest_can_pub_t pub; /* publishes each result through this port */
 } tee_port_t;
 
 static int tee_send(void *ctx, const struct imest_can_frame *f)
@@ -376,8 +378,8 @@ static int job_open(job_t *j, run_t *x)
   j->live = tee.live;
   tee.port.send = tee_send;
   tee.port.ctx = &tee;
-  if (imest_attach_can(&est, &tee.port, IMEST_CAN_DEFAULT_BASE_ID) != IMEST_OK) {
-    snprintf(j->err, sizeof j->err, "%s: imest_attach_can failed", x->name);
+  if (imest_can_pub_init(&tee.pub, &tee.port, IMEST_CAN_DEFAULT_BASE_ID) != IMEST_OK) {
+    snprintf(j->err, sizeof j->err, "%s: imest_can_pub_init failed", x->name);
     return -1;
   }
 
@@ -414,6 +416,7 @@ static void on_window(void *ctx, const imest_result_t *r)
 {
   run_t *x = (run_t *)ctx;
   job_t *j = x->j;
+  (void)imest_can_publish(&x->tee->pub, r); /* refusals are counted by the log port */
   static const truth_t nan_t = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
   const truth_t *t = (r->seq < x->nwin && r->seq < x->win) ? &x->truth[r->seq] : &nan_t;
   fprintf(x->csv,

@@ -107,7 +107,7 @@ def build_windows(raw, exp):
         seq = int(d["seq"])
         m = mon.get(seq)
         row = {"experiment": exp, "seq": seq, "t_end_s": d["t_end_s"]}
-        if m is not None and m.get("frames", "0xF").upper() == "0XF":
+        if m is not None and m.get("frames", "").upper() == "0X3F":  # all 6 frames (port/README.md)
             src = m
             row["via_can"] = 1
             # the bus carries float32: compare with the library's double, rounded

@@ -1,30 +1,50 @@
 /* imest-monitor: decode imest CAN telemetry live from a SocketCAN interface or
- * from a candump -L log, print a table or CSV, and report lost, repeated and
- * corrupted frames (each event on stderr, and a summary at the end). */
+ * from a candump -L log, print a table or CSV, and report lost, repeated,
+ * late and corrupted frames, estimator overruns and sender restarts (each on
+ * stderr, and a summary at the end). When nothing could be decoded it says
+ * what the input held and what is likely wrong, and exits 1.
+ *
+ * Exit codes: 0 windows decoded; 1 unusable input (nothing decoded, cannot
+ * open or read the log, interface error); 2 usage error. */
 #define _GNU_SOURCE 1
 #include <errno.h>
+#include <float.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
+#include <sys/stat.h>
 
 #include "imest/imest.h"
 #include "imest/imest_can.h"
+#include "imest_can_id.h"
 #include "imest_candump.h"
+#include "tool_args.h"
 #ifdef IMEST_MONITOR_SOCKETCAN
 #include "imest_socketcan.h"
 #endif
 
-static const char *const k_frame_name[IMEST_CAN_NFRAMES] = {"IMEST_TR", "IMEST_RS", "IMEST_QUAL",
-                                                            "IMEST_STAT"};
+static const char *const k_frame_name[IMEST_CAN_NFRAMES] = {
+    "IMEST_TR", "IMEST_RS", "IMEST_QUAL", "IMEST_STAT", "IMEST_VERDICT", "IMEST_BOUNDS"};
+#define ALL_FRAMES ((1u << IMEST_CAN_NFRAMES) - 1u)
 
 static volatile sig_atomic_t g_stop;
 
-static void on_signal(int sig) {
+static void on_signal(int sig)
+{
   (void)sig;
   g_stop = 1;
 }
+
+/* Identifiers that were not ours, for the diagnosis when nothing decodes. */
+#define MAX_IDS 64
+typedef struct {
+  uint32_t id[MAX_IDS];
+  unsigned long n[MAX_IDS];
+  unsigned int used;
+  unsigned long more; /* frames of identifiers beyond MAX_IDS distinct ones */
+} id_census_t;
 
 typedef struct {
   int csv;
@@ -34,28 +54,35 @@ typedef struct {
   double win_t;             /* time of the last accepted frame of the open window */
   char where[128];
   imest_can_rx_t rx;
-  unsigned long malformed;
+  unsigned long lines, malformed, plain_candump;
   uint32_t last_tx_failed;
   int have_tx_failed;
+  id_census_t foreign;
 } monitor_t;
 
-static void usage(FILE *f) {
+static void usage(FILE *f)
+{
   fputs("usage: imest-monitor (--iface NAME | --log FILE|-) [--base-id ID] [--ext] [--csv]\n"
         "                     [--count N] [--timeout SEC]\n"
         "  --iface NAME   read live from a SocketCAN interface (e.g. can0, vcan0)\n"
-        "  --log FILE     read a candump -L log ('-' = stdin)\n"
-        "  --base-id ID   base identifier of the node (default 0x6A0); frames at ID..ID+3;\n"
-        "                 values above 0x7FF are 29-bit extended identifiers\n"
-        "  --ext          the base identifier is a 29-bit extended one\n"
+        "  --log FILE     read a candump -L log ('-' = stdin); record one with candump -L\n"
+        "  --base-id ID   base identifier of the node (default 0x6A0); its frames are ID..ID+5.\n"
+        "                 Values above 0x7FF are 29-bit extended identifiers\n"
+        "  --ext          the base identifier is a 29-bit extended one even if it is small\n"
         "  --csv          CSV (header t_s,seq,T_R_s,R_S_ohm,E_I,valid,status,...) instead of a table\n"
-        "  --count N      stop after N windows\n"
+        "  --count N      stop after N windows (N >= 1)\n"
         "  --timeout SEC  live: stop after SEC seconds without any frame (default: never)\n"
-        "Events (lost, repeated, corrupted frames, incomplete windows, sequence gaps) and a\n"
-        "summary go to stderr.\n",
+        "Options take their value as '--opt value' or '--opt=value'. Events (lost, repeated,\n"
+        "corrupted frames, incomplete windows, sequence gaps, restarts) and a summary go to\n"
+        "stderr. A value clamped to its field's range is shown as a bound ('>1.31068').\n"
+        "Exit status: 0 windows decoded, 1 nothing decoded or an input error, 2 usage error.\n",
         f);
 }
 
-static void fmt_or_empty(char *buf, size_t n, int have, const char *fmt, double v) {
+/* --- output ------------------------------------------------------------------ */
+
+static void fmt_or_empty(char *buf, size_t n, int have, const char *fmt, double v)
+{
   if (have) {
     snprintf(buf, n, fmt, v);
   } else {
@@ -63,38 +90,92 @@ static void fmt_or_empty(char *buf, size_t n, int have, const char *fmt, double 
   }
 }
 
-static void print_window(monitor_t *m, const imest_can_window_t *w, double t) {
-  int h_tr = (w->have >> IMEST_CAN_FRAME_TR) & 1u, h_rs = (w->have >> IMEST_CAN_FRAME_RS) & 1u;
-  int h_q = (w->have >> IMEST_CAN_FRAME_QUAL) & 1u, h_st = (w->have >> IMEST_CAN_FRAME_STAT) & 1u;
+/* A value the sender clamped to its field's range is a bound, not a value. */
+static void fmt_value(char *buf, size_t n, int have, const char *fmt, double v, unsigned int sat,
+                      unsigned int sat_bit)
+{
+  if (have && (sat & sat_bit)) {
+    buf[0] = v > 0.0 ? '>' : '<';
+    snprintf(buf + 1, n - 1u, fmt, v);
+  } else {
+    fmt_or_empty(buf, n, have, fmt, v);
+  }
+}
+
+/* The table's relative bounds, in percent ("n/a" when not available). */
+static void fmt_percent(char *buf, size_t n, int have, double v, unsigned int sat, unsigned int sat_bit)
+{
+  if (have && isnan(v)) {
+    snprintf(buf, n, "n/a");
+  } else {
+    fmt_value(buf, n, have, "%.3f%%", 100.0 * v, sat, sat_bit);
+  }
+}
+
+static void fmt_reason(char *buf, size_t n, int have, int reason)
+{
+  if (!have) {
+    buf[0] = '\0';
+  } else if (reason == 255) {
+    snprintf(buf, n, "out_of_range");
+  } else {
+    snprintf(buf, n, "%s", imest_reason_name(reason));
+  }
+}
+
+static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
+{
+  const imest_result_t *r = &w->result;
+  const int h_tr = (w->have >> IMEST_CAN_FRAME_TR) & 1u, h_rs = (w->have >> IMEST_CAN_FRAME_RS) & 1u;
+  const int h_q = (w->have >> IMEST_CAN_FRAME_QUAL) & 1u, h_st = (w->have >> IMEST_CAN_FRAME_STAT) & 1u;
+  const int h_v = (w->have >> IMEST_CAN_FRAME_VERDICT) & 1u;
+  const int h_b = (w->have >> IMEST_CAN_FRAME_BOUNDS) & 1u;
+  const unsigned int sat = w->sat;
   char seq[16], tr[32], rs[32], ei[32], valid[8], status[32], pk1[32], pk2[32];
-  char nr[8], na[8], flags[16], sat[8], txf[16];
+  char nr[8], na[8], flags[16], satb[8], txf[16];
+  char trv[8], rsv[8], trr[32], rsr[32], trb[32], rsb[32], span[32], nw[8];
   if (h_st) {
-    snprintf(seq, sizeof seq, "%lu", (unsigned long)w->seq);
+    snprintf(seq, sizeof seq, "%lu", (unsigned long)r->seq);
     snprintf(txf, sizeof txf, "%lu", (unsigned long)w->tx_failed);
   } else {
     seq[0] = txf[0] = '\0';
   }
-  fmt_or_empty(tr, sizeof tr, h_tr, "%.9g", w->tr_s);
-  fmt_or_empty(ei, sizeof ei, h_tr, "%.4f", w->e_i);
-  fmt_or_empty(rs, sizeof rs, h_rs, "%.9g", w->rs_ohm);
-  fmt_or_empty(pk2, sizeof pk2, h_rs, "%.5f", w->pe_k2_rel);
-  fmt_or_empty(pk1, sizeof pk1, h_q, "%.5f", w->pe_k1_rel);
+  fmt_value(tr, sizeof tr, h_tr, "%.9g", r->tr_s, sat, IMEST_CAN_SAT_TR);
+  fmt_value(ei, sizeof ei, h_tr, "%.4f", r->e_i, sat, IMEST_CAN_SAT_EI);
+  fmt_value(rs, sizeof rs, h_rs, "%.9g", r->rs_ohm, sat, IMEST_CAN_SAT_RS);
+  fmt_value(pk2, sizeof pk2, h_rs, "%.5f", r->pe_k2_rel, sat, IMEST_CAN_SAT_PEK2);
+  fmt_value(pk1, sizeof pk1, h_q, "%.5f", r->pe_k1_rel, sat, IMEST_CAN_SAT_PEK1);
   if (h_q) {
-    snprintf(valid, sizeof valid, "%d", w->valid);
-    snprintf(status, sizeof status, "%s", imest_reason_name(w->status));
-    snprintf(nr, sizeof nr, "%u", w->n_roots);
-    snprintf(na, sizeof na, "%u", w->n_admissible);
-    snprintf(flags, sizeof flags, "0x%04X", w->flags);
-    snprintf(sat, sizeof sat, "0x%02X", w->sat);
+    snprintf(valid, sizeof valid, "%d", r->valid);
+    snprintf(nr, sizeof nr, "%u", r->n_roots);
+    snprintf(na, sizeof na, "%u", r->n_admissible);
+    snprintf(flags, sizeof flags, "0x%04X", r->flags);
+    snprintf(satb, sizeof satb, "0x%02X", sat);
   } else {
-    valid[0] = status[0] = nr[0] = na[0] = flags[0] = sat[0] = '\0';
+    valid[0] = nr[0] = na[0] = flags[0] = satb[0] = '\0';
   }
+  fmt_reason(status, sizeof status, h_q, r->status);
+  snprintf(trv, sizeof trv, h_v ? "%d" : "", r->tr_valid);
+  snprintf(rsv, sizeof rsv, h_v ? "%d" : "", r->rs_valid);
+  fmt_reason(trr, sizeof trr, h_v, r->tr_reason);
+  fmt_reason(rsr, sizeof rsr, h_v, r->rs_reason);
+  fmt_value(span, sizeof span, h_v, "%.3f", r->span_s, sat, IMEST_CAN_SAT_SPAN);
+  snprintf(nw, sizeof nw, h_v ? "%u" : "", r->windows);
   if (m->csv) {
-    printf("%.6f,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%u,0x%X\n", t, seq, tr, rs, ei, valid, status,
-           pk1, pk2, nr, na, flags, sat, txf, w->counter, w->have);
+    fmt_value(trb, sizeof trb, h_b, "%.5f", r->tr_bound_rel, sat, IMEST_CAN_SAT_TRB);
+    fmt_value(rsb, sizeof rsb, h_b, "%.5f", r->rs_bound_rel, sat, IMEST_CAN_SAT_RSB);
+    printf("%.6f,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%u,0x%X,%s,%s,%s,%s,%s,%s,%s,%s\n", t, seq, tr, rs,
+           ei, valid, status, pk1, pk2, nr, na, flags, satb, txf, w->counter, w->have, trv, trr, rsv, rsr,
+           trb, rsb, span, nw);
   } else {
-    printf("%17.6f %8s %13s %13s %7s %8s %8s %5s %-17s %2s/%-2s %6s %5s%s\n", t, seq, tr, rs, ei, pk1,
-           pk2, valid, status, na, nr, flags, txf, w->have == 0xFu ? "" : "  (incomplete)");
+    /* verdict per parameter: "ok", or why not; bounds in % */
+    const char *trw = !h_v ? "" : r->tr_valid ? "ok" : trr;
+    const char *rsw = !h_v ? "" : r->rs_valid ? "ok" : rsr;
+    fmt_percent(trb, sizeof trb, h_b, r->tr_bound_rel, sat, IMEST_CAN_SAT_TRB);
+    fmt_percent(rsb, sizeof rsb, h_b, r->rs_bound_rel, sat, IMEST_CAN_SAT_RSB);
+    printf("%17.6f %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %2s/%-2s %6s %5s%s\n", t, seq, tr,
+           trb, trw, rs, rsb, rsw, ei, pk1, pk2, span, na, nr, flags, txf,
+           w->have == ALL_FRAMES ? "" : "  (incomplete)");
   }
   if (h_st) {
     m->last_tx_failed = w->tx_failed;
@@ -104,115 +185,257 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t) {
   m->windows++;
 }
 
-static void report_missing(const monitor_t *m, const imest_can_window_t *w) {
-  unsigned int i;
+static void print_header(const monitor_t *m)
+{
+  if (m->csv) {
+    puts("t_s,seq,T_R_s,R_S_ohm,E_I,valid,status,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,flags,sat,"
+         "tx_failed,counter,frames,tr_valid,tr_reason,rs_valid,rs_reason,tr_bound_rel,rs_bound_rel,"
+         "span_s,windows");
+  } else {
+    printf("%17s %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %5s %6s %5s\n", "t [s]", "seq",
+           "T_R [s]", "+-T_R", "T_R verdict", "R_S [ohm]", "+-R_S", "R_S verdict", "E_I", "PE_K1",
+           "PE_K2", "span [s]", "adm/r", "flags", "txf");
+  }
+  fflush(stdout);
+}
+
+/* --- events ------------------------------------------------------------------ */
+
+static void report_missing(const monitor_t *m, const imest_can_window_t *w)
+{
   fprintf(stderr, "imest-monitor: %s: incomplete window (counter %u", m->where, w->counter);
-  if (w->have & (1u << IMEST_CAN_FRAME_STAT)) fprintf(stderr, ", seq %lu", (unsigned long)w->seq);
+  if (w->have & (1u << IMEST_CAN_FRAME_STAT)) fprintf(stderr, ", seq %lu", (unsigned long)w->result.seq);
   fputs("): missing", stderr);
-  for (i = 0u; i < IMEST_CAN_NFRAMES; i++) {
+  for (unsigned int i = 0u; i < IMEST_CAN_NFRAMES; i++) {
     if (!(w->have & (1u << i))) fprintf(stderr, " %s", k_frame_name[i]);
   }
   fputc('\n', stderr);
 }
 
-static uint32_t frame_id(const monitor_t *m, unsigned int index) {
-  return ((m->base_id & IMEST_CAN_EFF_MASK) + index) & IMEST_CAN_EFF_MASK;
+static void report_window_events(const monitor_t *m, unsigned int e, const imest_can_rx_event_t *ev,
+                                 const imest_can_window_t *w)
+{
+  if (e & IMEST_CAN_EV_RESTART) {
+    fprintf(stderr, "imest-monitor: %s: sequence number went back to %lu: the sender restarted "
+            "(no loss counted across the restart)\n", m->where, (unsigned long)w->result.seq);
+  }
+  if (e & IMEST_CAN_EV_LOST) {
+    fprintf(stderr, "imest-monitor: %s: lost %lu frame(s) up to the window with counter %u (previous "
+            "window: counter %u)\n", m->where, (unsigned long)ev->lost, w->counter, ev->prev_counter);
+  }
+  if (e & IMEST_CAN_EV_INCOMPLETE) report_missing(m, w);
+  if (e & IMEST_CAN_EV_SEQ_GAP) {
+    fprintf(stderr, "imest-monitor: %s: the estimator dropped %lu window(s) before seq %lu (overrun)\n",
+            m->where, (unsigned long)ev->seq_gap, (unsigned long)w->result.seq);
+  }
 }
 
-static void handle_frame(monitor_t *m, const struct imest_can_frame *f, double t) {
+static void census_add(id_census_t *c, uint32_t id)
+{
+  for (unsigned int i = 0u; i < c->used; i++) {
+    if (c->id[i] == id) {
+      c->n[i]++;
+      return;
+    }
+  }
+  if (c->used < MAX_IDS) {
+    c->id[c->used] = id;
+    c->n[c->used++] = 1u;
+  } else {
+    c->more++;
+  }
+}
+
+static void handle_frame(monitor_t *m, const struct imest_can_frame *f, double t)
+{
   imest_can_window_t w;
   imest_can_rx_event_t ev;
-  double prev_t = m->win_t;
-  unsigned int e = imest_can_rx_feed(&m->rx, f, &w, &ev);
+  const double prev_t = m->win_t;
+  const int rc = imest_can_rx_feed(&m->rx, f, &w, &ev);
+  const unsigned int e = rc < 0 ? 0u : (unsigned int)rc;
   const char *name = ev.index < IMEST_CAN_NFRAMES ? k_frame_name[ev.index] : "?";
-  unsigned long id = (unsigned long)frame_id(m, ev.index);
+  char id[24];
+  imest_can_id_format(f->id, id, sizeof id);
+  if (e & IMEST_CAN_EV_FOREIGN) {
+    census_add(&m->foreign, f->id);
+    return;
+  }
   if (e & IMEST_CAN_EV_CORRUPT) {
     if (ev.dec == IMEST_CAN_DEC_BAD_DLC) {
-      fprintf(stderr, "imest-monitor: %s: corrupted frame 0x%03lX (%s): %u data bytes, expected 8\n",
-              m->where, id, name, f->dlc);
+      fprintf(stderr, "imest-monitor: %s: corrupted frame %s (%s): %u data bytes, expected 8\n", m->where,
+              id, name, f->dlc);
     } else {
-      fprintf(stderr, "imest-monitor: %s: corrupted frame 0x%03lX (%s): checksum mismatch\n", m->where,
-              id, name);
+      fprintf(stderr, "imest-monitor: %s: corrupted frame %s (%s): checksum mismatch\n", m->where, id, name);
     }
     return;
   }
   if (e & IMEST_CAN_EV_REPEATED) {
-    fprintf(stderr, "imest-monitor: %s: repeated frame 0x%03lX (%s), counter %u\n", m->where, id, name,
-            ev.counter);
+    fprintf(stderr, "imest-monitor: %s: repeated frame %s (%s), counter %u\n", m->where, id, name, ev.counter);
     return;
   }
-  if (e & IMEST_CAN_EV_LOST) {
-    fprintf(stderr, "imest-monitor: %s: lost %lu frame(s) 0x%03lX (%s): counter %u -> %u\n", m->where,
-            (unsigned long)ev.lost, id, name, ev.prev_counter, ev.counter);
+  if (e & IMEST_CAN_EV_LATE) {
+    fprintf(stderr, "imest-monitor: %s: late frame %s (%s) of the window with counter %u, already shown\n",
+            m->where, id, name, ev.counter);
+    return;
   }
   if (e & IMEST_CAN_EV_WINDOW) {
-    if (e & IMEST_CAN_EV_INCOMPLETE) {
-      report_missing(m, &w);
-      print_window(m, &w, prev_t);
-    } else {
-      print_window(m, &w, t);
+    report_window_events(m, e, &ev, &w);
+    print_window(m, &w, (e & IMEST_CAN_EV_INCOMPLETE) ? prev_t : t);
+  }
+  m->win_t = t;
+}
+
+/* --- when nothing was decoded: say what the input held ---------------------- */
+
+static void explain_ids(const monitor_t *m)
+{
+  const id_census_t *c = &m->foreign;
+  const uint32_t kind = m->base_id & IMEST_CAN_ID_EXT;
+  const uint32_t base = m->base_id & IMEST_CAN_EFF_MASK;
+  unsigned int order[MAX_IDS];
+  char buf[24];
+  /* most frequent first (insertion sort: at most MAX_IDS entries) */
+  for (unsigned int i = 0u; i < c->used; i++) {
+    unsigned int k = i;
+    while (k > 0u && c->n[order[k - 1u]] < c->n[i]) {
+      order[k] = order[k - 1u];
+      k--;
+    }
+    order[k] = i;
+  }
+  fputs("; frames seen:", stderr);
+  for (unsigned int i = 0u; i < c->used && i < 8u; i++) {
+    fprintf(stderr, "%s %s (%lu)", i ? "," : "", imest_can_id_format(c->id[order[i]], buf, sizeof buf),
+            c->n[order[i]]);
+  }
+  if (c->used > 8u || c->more) fputs(", ...", stderr);
+  /* our numbers, but the other kind of identifier? */
+  for (unsigned int i = 0u; i < c->used; i++) {
+    const uint32_t id = c->id[i];
+    if ((id & IMEST_CAN_ID_EXT) != kind && (id & IMEST_CAN_EFF_MASK) - base < (uint32_t)IMEST_CAN_NFRAMES) {
+      fprintf(stderr, kind ? "; the log has 11-bit (standard) identifiers at that base: drop --ext\n"
+                           : "; the log has 29-bit (extended) identifiers at that base: add --ext\n");
+      return;
     }
   }
-  if (e & IMEST_CAN_EV_SEQ_GAP) {
-    fprintf(stderr, "imest-monitor: %s: the estimator dropped %lu window(s) before seq %lu (overrun)\n",
-            m->where, (unsigned long)ev.seq_gap, (unsigned long)m->rx.last_seq);
+  /* a run of IMEST_CAN_NFRAMES consecutive identifiers of one kind: a node at another base? */
+  for (unsigned int i = 0u; i < c->used; i++) {
+    unsigned int run = 1u;
+    for (unsigned int k = 1u; k < (unsigned int)IMEST_CAN_NFRAMES; k++) {
+      for (unsigned int j = 0u; j < c->used; j++) {
+        if (c->id[j] == c->id[i] + k) {
+          run++;
+          break;
+        }
+      }
+    }
+    if (run == (unsigned int)IMEST_CAN_NFRAMES) {
+      fprintf(stderr, "; is --base-id right? %s .. +%d look like an imest node: --base-id %s\n",
+              imest_can_id_format(c->id[i], buf, sizeof buf), IMEST_CAN_NFRAMES - 1,
+              imest_can_id_format(c->id[i], buf, sizeof buf));
+      return;
+    }
   }
-  if (e & IMEST_CAN_EV_RESTART) {
-    fprintf(stderr, "imest-monitor: %s: sequence number went back to %lu: sender restarted\n", m->where,
-            (unsigned long)m->rx.last_seq);
-  }
-  if (!(e & IMEST_CAN_EV_FOREIGN)) {
-    m->win_t = t;
+  fputs("; is --base-id right?\n", stderr);
+}
+
+/* Nothing decoded: name the likely cause. */
+static void explain_nothing(const monitor_t *m, int live)
+{
+  const imest_can_rx_stats_t *s = &m->rx.st;
+  char a[24], b[24];
+  const uint32_t last = ((m->base_id & ~IMEST_CAN_ID_EXT) + IMEST_CAN_NFRAMES - 1u) | (m->base_id & IMEST_CAN_ID_EXT);
+  imest_can_id_format(m->base_id, a, sizeof a);
+  imest_can_id_format(last, b, sizeof b);
+  fputs("imest-monitor: nothing decoded: ", stderr);
+  if (s->frames == 0u) {
+    if (live) {
+      fputs("no frame received\n", stderr);
+    } else if (m->lines == 0u) {
+      fputs("the log is empty\n", stderr);
+    } else if (m->plain_candump > 0u) {
+      fprintf(stderr, "%lu line(s) read, none in candump -L format; they look like plain candump output "
+              "('can0  6A0   [8]  00 11 ...'): record with 'candump -L' (or 'candump -l')\n", m->lines);
+    } else {
+      fprintf(stderr, "%lu line(s) read, none a candump -L frame line ('(1700000000.000000) can0 "
+              "6A0#0011...'; see the malformed-line messages above)\n", m->lines);
+    }
+  } else if (s->foreign == s->frames) {
+    fprintf(stderr, "%lu frame(s) %s, none with identifiers %s..%s", (unsigned long)s->frames,
+            live ? "received" : "read", a, b);
+    explain_ids(m);
+  } else {
+    fprintf(stderr, "%lu frame(s) at identifiers %s..%s, all corrupted (bad checksum or length): another "
+            "sender at these identifiers, or another telemetry layout?\n",
+            (unsigned long)(s->frames - s->foreign), a, b);
   }
 }
 
-static void finish(monitor_t *m) {
+static int finish(monitor_t *m, int live)
+{
   imest_can_window_t w;
+  imest_can_rx_event_t ev;
   const imest_can_rx_stats_t *s = &m->rx.st;
-  if ((m->count == 0u || m->windows < m->count) && imest_can_rx_flush(&m->rx, &w)) {
-    snprintf(m->where, sizeof m->where, "end of input");
-    report_missing(m, &w);
-    print_window(m, &w, m->win_t);
+  if (m->count == 0u || m->windows < m->count) {
+    const int rc = imest_can_rx_flush(&m->rx, &w, &ev);
+    if (rc > 0) {
+      snprintf(m->where, sizeof m->where, "end of input");
+      report_window_events(m, (unsigned int)rc, &ev, &w);
+      print_window(m, &w, m->win_t);
+    }
   }
   fprintf(stderr,
           "imest-monitor: summary: frames %lu (foreign %lu), windows %lu (incomplete %lu), "
-          "lost %lu, repeated %lu, corrupted %lu, estimator gaps %lu, restarts %lu, "
+          "lost %lu, repeated %lu, corrupted %lu, estimator gaps %lu, restarts %lu, late %lu, "
           "malformed lines %lu, sender tx_failed %s%lu\n",
           (unsigned long)s->frames, (unsigned long)s->foreign, (unsigned long)s->windows,
           (unsigned long)s->incomplete, (unsigned long)s->lost, (unsigned long)s->repeated,
           (unsigned long)s->corrupt, (unsigned long)s->seq_gaps, (unsigned long)s->restarts,
-          m->malformed, m->have_tx_failed ? "" : "n/a ", (unsigned long)m->last_tx_failed);
-}
-
-static void print_header(const monitor_t *m) {
-  if (m->csv) {
-    puts("t_s,seq,T_R_s,R_S_ohm,E_I,valid,status,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,flags,sat,"
-         "tx_failed,counter,frames");
-  } else {
-    printf("%17s %8s %13s %13s %7s %8s %8s %5s %-17s %5s %6s %5s\n", "t [s]", "seq", "T_R [s]",
-           "R_S [ohm]", "E_I", "PE_K1", "PE_K2", "valid", "status", "adm/r", "flags", "txf");
+          (unsigned long)s->late, m->malformed, m->have_tx_failed ? "" : "n/a ",
+          (unsigned long)m->last_tx_failed);
+  if (m->windows == 0u) {
+    explain_nothing(m, live);
+    return TOOL_EXIT_DATA;
   }
-  fflush(stdout);
+  return TOOL_EXIT_OK;
 }
 
-static int run_log(monitor_t *m, const char *path) {
-  FILE *fp = strcmp(path, "-") == 0 ? stdin : fopen(path, "r");
-  const char *label = strcmp(path, "-") == 0 ? "<stdin>" : path;
+/* --- sources ------------------------------------------------------------------ */
+
+/* "  can0  6A0   [8]  00 11 ..." : what plain candump prints (without -L). */
+static int looks_like_plain_candump(const char *line)
+{
+  char ifn[32], id[16];
+  unsigned int dlc;
+  return sscanf(line, " %31s %15[0-9A-Fa-f] [%u]", ifn, id, &dlc) == 3;
+}
+
+static int run_log(monitor_t *m, const char *path)
+{
+  const int is_stdin = strcmp(path, "-") == 0;
+  const char *label = is_stdin ? "<stdin>" : path;
+  FILE *fp = is_stdin ? stdin : fopen(path, "r");
+  struct stat st;
   char *line = NULL;
   size_t cap = 0u;
   ssize_t n;
-  unsigned long lineno = 0u;
   if (fp == NULL) {
     fprintf(stderr, "imest-monitor: cannot open log '%s': %s\n", path, strerror(errno));
-    return 2;
+    return TOOL_EXIT_DATA;
+  }
+  if (fstat(fileno(fp), &st) == 0 && S_ISDIR(st.st_mode)) {
+    fprintf(stderr, "imest-monitor: cannot read log '%s': it is a directory (give a candump -L file)\n", path);
+    if (!is_stdin) fclose(fp);
+    return TOOL_EXIT_DATA;
   }
   print_header(m);
+  errno = 0;
   while (!g_stop && (n = getline(&line, &cap, fp)) >= 0) {
     struct imest_can_frame f;
     double t = 0.0;
     const char *err = NULL;
     int r;
-    lineno++;
+    m->lines++;
     if ((size_t)n != strlen(line)) {
       r = IMEST_CANDUMP_ERROR;
       err = "NUL byte in the line";
@@ -221,43 +444,55 @@ static int run_log(monitor_t *m, const char *path) {
     }
     if (r == IMEST_CANDUMP_EMPTY) continue;
     if (r != IMEST_CANDUMP_OK) {
-      size_t k = strcspn(line, "\r\n");
+      const size_t k = strcspn(line, "\r\n");
       m->malformed++;
-      fprintf(stderr, "imest-monitor: %s:%lu: malformed line: %s: '%.*s'\n", label, lineno, err,
-              (int)(k > 80u ? 80u : k), line);
+      if (looks_like_plain_candump(line)) m->plain_candump++;
+      if (m->malformed <= 20u) {
+        fprintf(stderr, "imest-monitor: %s:%lu: malformed line: %s: '%.*s'\n", label, m->lines, err,
+                (int)(k > 80u ? 80u : k), line);
+      } else if (m->malformed == 21u) {
+        fprintf(stderr, "imest-monitor: %s: more malformed lines (counted in the summary)\n", label);
+      }
       continue;
     }
-    snprintf(m->where, sizeof m->where, "%s:%lu", label, lineno);
+    snprintf(m->where, sizeof m->where, "%s:%lu", label, m->lines);
     handle_frame(m, &f, t);
     if (m->count != 0u && m->windows >= m->count) break;
   }
+  const int read_error = ferror(fp);
+  const int saved = errno;
   free(line);
-  if (fp != stdin) fclose(fp);
-  finish(m);
-  return 0;
+  if (!is_stdin) fclose(fp);
+  if (read_error) {
+    fprintf(stderr, "imest-monitor: cannot read log '%s': %s\n", label, strerror(saved));
+    (void)finish(m, 0);
+    return TOOL_EXIT_DATA;
+  }
+  return finish(m, 0);
 }
 
 #ifdef IMEST_MONITOR_SOCKETCAN
-static int run_iface(monitor_t *m, const char *ifname, double timeout_s) {
+static int run_iface(monitor_t *m, const char *ifname, double timeout_s)
+{
   struct imest_socketcan sc;
-  struct timespec ts;
   double idle = 0.0;
+  char id[24];
   if (imest_socketcan_open(&sc, ifname) != 0) {
     fprintf(stderr, "imest-monitor: %s\n", sc.err);
-    return 2;
+    return TOOL_EXIT_DATA;
   }
   print_header(m);
-  fprintf(stderr, "imest-monitor: listening on %s (base id 0x%lX%s)\n", ifname,
-          (unsigned long)(m->base_id & IMEST_CAN_EFF_MASK), (m->base_id & IMEST_CAN_ID_EXT) ? ", extended" : "");
+  fprintf(stderr, "imest-monitor: listening on %s (base id %s)\n", ifname,
+          imest_can_id_format(m->base_id, id, sizeof id));
   while (!g_stop) {
     struct imest_can_frame f;
     double t = 0.0;
-    int r = imest_socketcan_recv(&sc, &f, 200, &t);
+    const int r = imest_socketcan_recv(&sc, &f, 200, &t);
     if (r < 0) {
       fprintf(stderr, "imest-monitor: %s\n", sc.err);
       imest_socketcan_close(&sc);
-      finish(m);
-      return 2;
+      (void)finish(m, 1);
+      return TOOL_EXIT_DATA;
     }
     if (r == 0) {
       idle += 0.2;
@@ -268,84 +503,87 @@ static int run_iface(monitor_t *m, const char *ifname, double timeout_s) {
       continue;
     }
     idle = 0.0;
-    clock_gettime(CLOCK_REALTIME, &ts);
     snprintf(m->where, sizeof m->where, "%s t=%.6f", ifname, t);
     handle_frame(m, &f, t);
     if (m->count != 0u && m->windows >= m->count) break;
   }
   imest_socketcan_close(&sc);
-  finish(m);
-  return 0;
+  return finish(m, 1);
 }
 #endif
 
-int main(int argc, char **argv) {
+/* --- options ------------------------------------------------------------------ */
+
+/* A count of windows: 1, 2, ... (no sign, no zero). */
+static int parse_count(const char *v, unsigned long *out)
+{
+  char *end = NULL;
+  if (v[0] < '0' || v[0] > '9') return -1;
+  errno = 0;
+  const unsigned long c = strtoul(v, &end, 10);
+  if (errno != 0 || *end != '\0' || c == 0u) return -1;
+  *out = c;
+  return 0;
+}
+
+int main(int argc, char **argv)
+{
   static monitor_t m;
-  const char *iface = NULL;
-  const char *log = NULL;
-  unsigned long base = IMEST_CAN_DEFAULT_BASE_ID;
+  const char *iface = NULL, *log = NULL, *base_text = NULL, *v;
   int ext = 0;
   double timeout_s = 0.0;
-  int i;
+  tool_args_t a;
+  tool_arg_kind_t kind;
   memset(&m, 0, sizeof m);
-  for (i = 1; i < argc; i++) {
-    const char *a = argv[i];
-    const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-    char *end = NULL;
-    if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+  tool_args_init(&a, "imest-monitor", argc, argv);
+  while ((kind = tool_args_next(&a)) != TOOL_ARG_END) {
+    if (kind == TOOL_ARG_OPERAND) {
+      fprintf(stderr, "imest-monitor: unexpected argument '%s' (a log is given with --log; see --help)\n",
+              a.operand);
+      return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "-h") || tool_args_is(&a, "--help")) {
       usage(stdout);
-      return 0;
-    } else if (strcmp(a, "--csv") == 0) {
+      return TOOL_EXIT_OK;
+    } else if (tool_args_is(&a, "--csv")) {
+      if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       m.csv = 1;
-    } else if (strcmp(a, "--ext") == 0) {
+    } else if (tool_args_is(&a, "--ext")) {
+      if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       ext = 1;
-    } else if (v != NULL && strcmp(a, "--iface") == 0) {
-      iface = v;
-      i++;
-    } else if (v != NULL && strcmp(a, "--log") == 0) {
-      log = v;
-      i++;
-    } else if (v != NULL && strcmp(a, "--base-id") == 0) {
-      errno = 0;
-      base = strtoul(v, &end, 0);
-      if (errno != 0 || end == v || *end != '\0') {
-        fprintf(stderr, "imest-monitor: bad --base-id '%s'\n", v);
-        return 1;
+    } else if (tool_args_is(&a, "--iface")) {
+      if ((iface = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--log")) {
+      if ((log = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--base-id")) {
+      if ((base_text = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--count")) {
+      if ((v = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+      if (parse_count(v, &m.count) != 0) {
+        fprintf(stderr, "imest-monitor: bad --count '%s': give a number of windows >= 1\n", v);
+        return TOOL_EXIT_USAGE;
       }
-      i++;
-    } else if (v != NULL && strcmp(a, "--count") == 0) {
-      m.count = strtoul(v, &end, 0);
-      if (end == v || *end != '\0') {
-        fprintf(stderr, "imest-monitor: bad --count '%s'\n", v);
-        return 1;
+    } else if (tool_args_is(&a, "--timeout")) {
+      if (tool_args_number(&a, &timeout_s)) return TOOL_EXIT_USAGE;
+      if (!(timeout_s >= 0.0)) {
+        fprintf(stderr, "imest-monitor: bad --timeout %g: give seconds >= 0\n", timeout_s);
+        return TOOL_EXIT_USAGE;
       }
-      i++;
-    } else if (v != NULL && strcmp(a, "--timeout") == 0) {
-      timeout_s = strtod(v, &end);
-      if (end == v || *end != '\0' || !(timeout_s >= 0.0)) {
-        fprintf(stderr, "imest-monitor: bad --timeout '%s'\n", v);
-        return 1;
-      }
-      i++;
     } else {
-      fprintf(stderr, "imest-monitor: unknown or incomplete option '%s'\n", a);
-      usage(stderr);
-      return 1;
+      return tool_args_unknown(&a);
     }
   }
   if ((iface == NULL) == (log == NULL)) {
-    fprintf(stderr, "imest-monitor: give exactly one of --iface NAME or --log FILE\n");
-    usage(stderr);
-    return 1;
+    fprintf(stderr, "imest-monitor: give exactly one of --iface NAME or --log FILE (see --help)\n");
+    return TOOL_EXIT_USAGE;
   }
-  if (base > 0x7FFul) ext = 1;
-  if ((ext && base > IMEST_CAN_EFF_MASK - (IMEST_CAN_NFRAMES - 1u)) ||
-      (!ext && base > IMEST_CAN_SFF_MASK - (IMEST_CAN_NFRAMES - 1u))) {
-    fprintf(stderr, "imest-monitor: --base-id 0x%lX out of range (base+%d must be a valid identifier)\n",
-            base, IMEST_CAN_NFRAMES - 1);
-    return 1;
+  m.base_id = IMEST_CAN_DEFAULT_BASE_ID | (ext ? IMEST_CAN_ID_EXT : 0u);
+  if (base_text != NULL) {
+    char err[256];
+    if (imest_can_id_parse(base_text, ext, "--ext", &m.base_id, err, sizeof err) != IMEST_OK) {
+      fprintf(stderr, "imest-monitor: bad --base-id %s\n", err);
+      return TOOL_EXIT_USAGE;
+    }
   }
-  m.base_id = (uint32_t)base | (ext ? IMEST_CAN_ID_EXT : 0u);
   imest_can_rx_init(&m.rx, m.base_id);
   signal(SIGINT, on_signal);
   signal(SIGTERM, on_signal);
@@ -355,6 +593,6 @@ int main(int argc, char **argv) {
 #else
   (void)timeout_s;
   fprintf(stderr, "imest-monitor: built without SocketCAN support: use --log\n");
-  return 2;
+  return TOOL_EXIT_USAGE;
 #endif
 }

@@ -77,10 +77,11 @@ typedef struct {
   FILE *f; /* NULL: no log */
 #ifdef IMEST_HAVE_CANDUMP
   struct imest_candump_port port;
+  imest_can_pub_t pub; /* publishes what the background returns, as firmware would */
 #endif
 } can_log_t;
 
-static int can_log_open(can_log_t *c, const replay_opts_t *o, imest_t *est)
+static int can_log_open(can_log_t *c, const replay_opts_t *o)
 {
   memset(c, 0, sizeof *c);
   if (o->candump_path == NULL) return -1;
@@ -94,16 +95,21 @@ static int can_log_open(can_log_t *c, const replay_opts_t *o, imest_t *est)
     fprintf(stderr, "%s: --can-iface '%s' is not a valid interface name\n", k_prog, o->can_iface);
     return TOOL_EXIT_USAGE;
   }
-  if (imest_attach_can(est, &c->port.port, (uint32_t)o->can_id) != IMEST_OK) {
-    fprintf(stderr, "%s: --can-id 0x%lx is not a valid CAN identifier\n", k_prog,
-            o->can_id & ~(unsigned long)IMEST_CAN_ID_EXT);
-    return TOOL_EXIT_USAGE;
-  }
+  (void)imest_can_pub_init(&c->pub, &c->port.port, o->can_id); /* checked by replay_parse */
   return -1;
 #else
-  (void)est;
   fprintf(stderr, "%s: built without the candump port: --candump is not available\n", k_prog);
   return TOOL_EXIT_USAGE;
+#endif
+}
+
+static void can_log_publish(can_log_t *c, const imest_result_t *r)
+{
+#ifdef IMEST_HAVE_CANDUMP
+  if (c->f) (void)imest_can_publish(&c->pub, r); /* a failed write: can_log_close() says so */
+#else
+  (void)c;
+  (void)r;
 #endif
 }
 
@@ -133,10 +139,17 @@ static void print_header(void)
          "H11,H12,H22,hessian_pd,n_roots,n_admissible,slip_ratio,i_rms_a,used_samples,flags\n");
 }
 
-/* drive_window_fn: one output row; ctx = the record's first t [s]. */
+typedef struct {
+  double t0_s;   /* the record's first t [s] */
+  can_log_t *can;
+} row_ctx_t;
+
+/* drive_window_fn: the window's frames to the CAN log, one output row. */
 static void print_row(void *ctx, const imest_result_t *r)
 {
-  const double t0_s = *(const double *)ctx;
+  const row_ctx_t *x = (const row_ctx_t *)ctx;
+  const double t0_s = x->t0_s;
+  can_log_publish(x->can, r);
   printf("%.6f,%.9g,%.9g,%.6g,%d,%s,%u,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%u,%u,%.4g,%.6g,%u,0x%x\n",
          t0_s + r->t_end_s, r->tr_s, r->rs_ohm, r->e_i, r->valid, imest_reason_name(r->status),
          r->seq, r->k1, r->k2, r->pe_k1_rel, r->pe_k2_rel, r->hessian[0][0], r->hessian[0][1],
@@ -219,12 +232,12 @@ int main(int argc, char **argv)
   static imest_t est;
   can_log_t can;
   drive_t d;
-  double t0_s = 0;
+  row_ctx_t row = {0, &can};
   if ((rc = replay_scan(&r, &o, &s)) >= 0 || (rc = configure(&o, &s, &cfg)) >= 0) goto done;
   imest_init(&est, &cfg);
-  if ((rc = can_log_open(&can, &o, &est)) >= 0) goto done;
-  t0_s = s.t0 * s.t_unit_s;
-  drive_init(&d, &est, print_row, &t0_s);
+  if ((rc = can_log_open(&can, &o)) >= 0) goto done;
+  row.t0_s = s.t0 * s.t_unit_s;
+  drive_init(&d, &est, print_row, &row);
   if ((rc = run(&r, &s, &d, &can)) >= 0) goto done;
   int flushed;
   const long rest = run_last_window(&d, &s, &cfg, &can, &flushed);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "imest/imest_can.h"
+#include "imest_can_id.h"
 #include "tool_args.h"
 
 static const char *const k_prog = "imest-replay";
@@ -61,6 +62,7 @@ static void usage(FILE *o)
           "  --can-iface NAME    interface name in that log (default vcan0)\n"
           "  --can-id ID         base CAN identifier (default 0x6A0; above 0x7FF a 29-bit\n"
           "                      extended identifier)\n"
+          "  --can-ext           the base CAN identifier is 29-bit even if it is small\n"
           "other:\n"
           "  --quiet             no notes or summary on stderr\n"
           "  -h, --help          this text\n"
@@ -129,22 +131,6 @@ static int limit_value(tool_args_t *a, double *out)
   return 0;
 }
 
-static int can_id_value(tool_args_t *a, unsigned long *out)
-{
-  const char *v = tool_args_value(a);
-  if (v == NULL) return -1;
-  char *end = NULL;
-  unsigned long id = strtoul(v, &end, 0);
-  if (end == v || *end != '\0' || v[0] == '-') {
-    fprintf(stderr, "%s: --can-id: '%s' is not an identifier\n", k_prog, v);
-    return -1;
-  }
-  /* as imest-monitor's --base-id: above 0x7FF it is a 29-bit identifier */
-  if (id > 0x7FFul && id <= IMEST_CAN_EFF_MASK) id |= IMEST_CAN_ID_EXT;
-  *out = id;
-  return 0;
-}
-
 int replay_parse(int argc, char **argv, replay_opts_t *o)
 {
   memset(o, 0, sizeof *o);
@@ -153,7 +139,8 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
   o->can_id = IMEST_CAN_DEFAULT_BASE_ID;
   o->i_limit = o->u_limit = -1.0;
   o->from_rest = -1;
-  int have_np = 0;
+  int have_np = 0, can_ext = 0;
+  const char *can_id = NULL;
   double d;
   tool_args_t a;
   tool_args_init(&a, k_prog, argc, argv);
@@ -215,7 +202,10 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
     } else if (tool_args_is(&a, "--can-iface")) {
       if ((o->can_iface = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--can-id")) {
-      if (can_id_value(&a, &o->can_id)) return TOOL_EXIT_USAGE;
+      if ((can_id = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--can-ext")) {
+      if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
+      can_ext = 1;
     } else if (tool_args_is(&a, "--quiet")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       o->quiet = 1;
@@ -229,6 +219,13 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
   }
   if (o->path == NULL) {
     fprintf(stderr, "%s: no input file (\"-\" reads stdin; see --help)\n", k_prog);
+    return TOOL_EXIT_USAGE;
+  }
+  /* the same parser as imest-monitor's --base-id (port/canid) */
+  o->can_id = IMEST_CAN_DEFAULT_BASE_ID | (can_ext ? IMEST_CAN_ID_EXT : 0u);
+  char err[256];
+  if (can_id != NULL && imest_can_id_parse(can_id, can_ext, "--can-ext", &o->can_id, err, sizeof err)) {
+    fprintf(stderr, "%s: --can-id %s\n", k_prog, err);
     return TOOL_EXIT_USAGE;
   }
   return -1;

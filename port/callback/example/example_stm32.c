@@ -1,12 +1,14 @@
 /* Example: the transmit hook a firmware on an STM32 (bxCAN, vendor HAL)
  * gives to imest_can_callback_init(). bxCAN has only 3 transmit mailboxes and
- * imest sends 4 frames per window, so the hook puts frames into a small
+ * imest sends 6 frames per window, so the hook puts frames into a small
  * software queue and moves them into free mailboxes; the mailbox-empty
  * interrupt moves the rest. Never blocks: a full queue refuses the frame at
  * once (imest counts it and does not retry). */
 #include "example_stm32.h"
 
 #include <stddef.h>
+
+_Static_assert(EXAMPLE_CAN_TXQ >= IMEST_CAN_NFRAMES, "the queue must hold one window");
 
 static example_can_tx_t *g_tx_for_isr; /* firmware glue: one CAN controller */
 

@@ -1,15 +1,16 @@
 /* Example glue between imest's callback port and an STM32-HAL-style (bxCAN)
  * driver: a small software queue in front of the 3 hardware mailboxes, so
- * the 4 frames of a window are accepted at once; the mailbox-empty interrupt
- * drains the queue. */
+ * the IMEST_CAN_NFRAMES (6) frames of a window are accepted at once; the
+ * mailbox-empty interrupt drains the queue. */
 #ifndef EXAMPLE_STM32_H
 #define EXAMPLE_STM32_H
 
 #include <stdint.h>
 
+#include "imest/imest_can.h"
 #include "stm32_hal_fake.h" /* on the target: "stm32f4xx_hal.h" */
 
-#define EXAMPLE_CAN_TXQ 8u /* power of two, >= 4 (frames per window) */
+#define EXAMPLE_CAN_TXQ 8u /* power of two, >= IMEST_CAN_NFRAMES (frames per window) */
 
 typedef struct {
   uint32_t id;
