@@ -10,12 +10,12 @@
 static imest_t est;
 static imest_result_t res;
 static imest_can_pub_t pub;
-static int probe_send(void *ctx, const struct imest_can_frame *f)
+static int probe_send(void *ctx, const imest_can_frame_t *f)
 {
   (void)ctx;
   return (int)f->data[7]; /* uses the frame, so nothing is optimised away */
 }
-static const struct imest_can_port probe_port = {probe_send, 0};
+static const imest_can_port_t probe_port = {probe_send, 0};
 #endif
 int main(void);
 void fw_mark_b0(void);

@@ -195,7 +195,7 @@ static uint32_t frame_id(uint32_t base_id, unsigned int index)
 }
 
 int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id,
-                   unsigned int counter, uint32_t tx_failed, struct imest_can_frame *f)
+                   unsigned int counter, uint32_t tx_failed, imest_can_frame_t *f)
 {
   unsigned int n = 0u;
   const imest_can_signal_t *t = imest_can_signal_table(&n);
@@ -284,7 +284,7 @@ void imest_can_window_clear(imest_can_window_t *w)
 }
 
 /* Ours? Then which frame, and is it intact? */
-static int classify(const struct imest_can_frame *f, uint32_t base_id, unsigned int *index)
+static int classify(const imest_can_frame_t *f, uint32_t base_id, unsigned int *index)
 {
   const uint32_t ext = base_id & IMEST_CAN_ID_EXT;
   const uint32_t mask = ext ? IMEST_CAN_EFF_MASK : IMEST_CAN_SFF_MASK;
@@ -299,7 +299,7 @@ static int classify(const struct imest_can_frame *f, uint32_t base_id, unsigned 
   return IMEST_CAN_DEC_OK;
 }
 
-int imest_can_decode_frame(const struct imest_can_frame *f, uint32_t base_id,
+int imest_can_decode_frame(const imest_can_frame_t *f, uint32_t base_id,
                            imest_can_window_t *w, unsigned int *index)
 {
   unsigned int idx = 0u;

@@ -7,7 +7,7 @@
 
 #include "imest/imest_can.h"
 
-int imest_can_pub_init(imest_can_pub_t *pub, const struct imest_can_port *port, uint32_t base_id)
+int imest_can_pub_init(imest_can_pub_t *pub, const imest_can_port_t *port, uint32_t base_id)
 {
   if (pub == NULL || port == NULL || port->send == NULL) return IMEST_ERR_NULL;
   if (imest_can_base_id_check(base_id) != IMEST_OK) return IMEST_ERR_ARG;
@@ -20,7 +20,7 @@ int imest_can_pub_init(imest_can_pub_t *pub, const struct imest_can_port *port, 
 
 int imest_can_publish(imest_can_pub_t *pub, const imest_result_t *r)
 {
-  struct imest_can_frame f;
+  imest_can_frame_t f;
   int failed = 0;
   if (pub == NULL || r == NULL || pub->port == NULL || pub->port->send == NULL) return IMEST_ERR_NULL;
   for (unsigned int i = 0u; i < (unsigned int)IMEST_CAN_NFRAMES; i++) {

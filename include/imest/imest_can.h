@@ -65,19 +65,19 @@ extern "C" {
 #define IMEST_CAN_EFF_MASK 0x1FFFFFFFu
 
 /** One classic CAN data frame. */
-struct imest_can_frame {
+typedef struct imest_can_frame {
   uint32_t id;              /**< identifier, | IMEST_CAN_ID_EXT if extended */
   unsigned int dlc;         /**< data length 0..8 (imest sends 8) */
   unsigned char data[8];    /**< one octet (0..255) per element */
-};
+} imest_can_frame_t;
 
 /** A transmit port. send() must not block: it queues the frame (or writes it)
  *  and returns 0, or returns nonzero if it cannot (queue full, bus-off, I/O
  *  error). imest_can_publish() calls it, never the ISR. */
-struct imest_can_port {
-  int (*send)(void *ctx, const struct imest_can_frame *f);
+typedef struct imest_can_port {
+  int (*send)(void *ctx, const imest_can_frame_t *f);
   void *ctx;
-};
+} imest_can_port_t;
 
 /** Frames per window, and their offsets from the base identifier. */
 #define IMEST_CAN_NFRAMES 6
@@ -171,7 +171,7 @@ const imest_can_signal_t *imest_can_signal_table(unsigned int *count);
 
 /** A publisher: caller-owned, one per CAN node. Fields are readable. */
 typedef struct {
-  const struct imest_can_port *port;
+  const imest_can_port_t *port;
   uint32_t base_id;         /**< as given to imest_can_pub_init() */
   uint32_t counter;         /**< rolling counter of the next window (sent mod 256) */
   uint32_t tx_failed;       /**< frames port->send refused since init (also sent in
@@ -185,7 +185,7 @@ typedef struct {
  * @retval IMEST_ERR_NULL  pub, port or port->send is NULL
  * @retval IMEST_ERR_ARG   base_id out of range
  */
-int imest_can_pub_init(imest_can_pub_t *pub, const struct imest_can_port *port, uint32_t base_id);
+int imest_can_pub_init(imest_can_pub_t *pub, const imest_can_port_t *port, uint32_t base_id);
 
 /**
  * Publish one window's result: packs the IMEST_CAN_NFRAMES frames and hands
@@ -227,7 +227,7 @@ unsigned int imest_can_crc8(const unsigned char *data, unsigned int n);
  * @retval IMEST_ERR_ARG   index >= IMEST_CAN_NFRAMES or base_id out of range
  */
 int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id,
-                   unsigned int counter, uint32_t tx_failed, struct imest_can_frame *f);
+                   unsigned int counter, uint32_t tx_failed, imest_can_frame_t *f);
 
 /** Outcomes of imest_can_decode_frame() (non-negative: the call worked). */
 #define IMEST_CAN_DEC_OK       0  /**< decoded into the window */
@@ -243,7 +243,7 @@ int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id
  *         IMEST_CAN_DEC_BAD_CRC  the frame's outcome (w is written only on OK)
  * @retval IMEST_ERR_NULL  f or w is NULL
  */
-int imest_can_decode_frame(const struct imest_can_frame *f, uint32_t base_id,
+int imest_can_decode_frame(const imest_can_frame_t *f, uint32_t base_id,
                            imest_can_window_t *w, unsigned int *index);
 
 /** Clear a decoded window: have = 0, table fields NaN / -1 / 0 as above. */
@@ -334,7 +334,7 @@ int imest_can_rx_init(imest_can_rx_t *rx, uint32_t base_id);
  * @return the event bits (>= 0)
  * @retval IMEST_ERR_NULL  rx or f is NULL
  */
-int imest_can_rx_feed(imest_can_rx_t *rx, const struct imest_can_frame *f,
+int imest_can_rx_feed(imest_can_rx_t *rx, const imest_can_frame_t *f,
                       imest_can_window_t *out, imest_can_rx_event_t *ev);
 
 /**

@@ -3,8 +3,8 @@
 
 #include <stddef.h>
 
-static int cb_send(void *ctx, const struct imest_can_frame *f) {
-  struct imest_can_callback *cb = (struct imest_can_callback *)ctx;
+static int cb_send(void *ctx, const imest_can_frame_t *f) {
+  imest_can_callback_t *cb = (imest_can_callback_t *)ctx;
   int ext;
   uint32_t id;
   if (cb == NULL || f == NULL || cb->tx == NULL || f->dlc > 8u) {
@@ -20,7 +20,7 @@ static int cb_send(void *ctx, const struct imest_can_frame *f) {
   return 0;
 }
 
-int imest_can_callback_init(struct imest_can_callback *cb, imest_can_hal_tx_fn tx, void *hal) {
+int imest_can_callback_init(imest_can_callback_t *cb, imest_can_hal_tx_fn_t tx, void *hal) {
   if (cb == NULL || tx == NULL) {
     return -1;
   }

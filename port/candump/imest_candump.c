@@ -22,7 +22,7 @@ static int iface_ok(const char *s) {
 }
 
 int imest_candump_format(char *buf, size_t n, double t_s, const char *iface,
-                         const struct imest_can_frame *f) {
+                         const imest_can_frame_t *f) {
   static const char hex[] = "0123456789ABCDEF";
   unsigned long long sec;
   unsigned long usec;
@@ -94,7 +94,7 @@ static int hexval(char c) {
   } while (0)
 
 int imest_candump_parse(const char *line, double *t_s, char iface[IMEST_CANDUMP_IFNAMSIZ],
-                        struct imest_can_frame *f, const char **err) {
+                        imest_can_frame_t *f, const char **err) {
   const char *p = line;
   const char *q;
   double sec = 0.0;
@@ -105,7 +105,7 @@ int imest_candump_parse(const char *line, double *t_s, char iface[IMEST_CANDUMP_
   uint32_t id = 0u;
   unsigned int ndig;
   unsigned int nbytes = 0u;
-  struct imest_can_frame fr;
+  imest_can_frame_t fr;
   if (line == NULL || f == NULL) {
     FAIL("internal: NULL argument");
   }
@@ -193,8 +193,8 @@ int imest_candump_parse(const char *line, double *t_s, char iface[IMEST_CANDUMP_
   return IMEST_CANDUMP_OK;
 }
 
-static int candump_send(void *ctx, const struct imest_can_frame *f) {
-  struct imest_candump_port *p = (struct imest_candump_port *)ctx;
+static int candump_send(void *ctx, const imest_can_frame_t *f) {
+  imest_candump_port_t *p = (imest_candump_port_t *)ctx;
   char buf[IMEST_CANDUMP_LINE_MAX];
   if (p == NULL || p->fp == NULL ||
       imest_candump_format(buf, sizeof buf, p->t_s, p->iface, f) < 0 ||
@@ -206,7 +206,7 @@ static int candump_send(void *ctx, const struct imest_can_frame *f) {
   return 0;
 }
 
-int imest_candump_port_open(struct imest_candump_port *p, FILE *fp, const char *iface) {
+int imest_candump_port_open(imest_candump_port_t *p, FILE *fp, const char *iface) {
   if (p == NULL || fp == NULL) {
     return -1;
   }
@@ -225,7 +225,7 @@ int imest_candump_port_open(struct imest_candump_port *p, FILE *fp, const char *
   return 0;
 }
 
-void imest_candump_port_set_time(struct imest_candump_port *p, double t_s) {
+void imest_candump_port_set_time(imest_candump_port_t *p, double t_s) {
   if (p != NULL) {
     p->t_s = t_s;
   }

@@ -32,7 +32,7 @@ extern "C" {
  *  @return characters written (excluding NUL), or -1 if buf is too small or
  *  the frame is invalid (dlc > 8, identifier out of range). */
 int imest_candump_format(char *buf, size_t n, double t_s, const char *iface,
-                         const struct imest_can_frame *f);
+                         const imest_can_frame_t *f);
 
 /** Results of imest_candump_parse(). */
 #define IMEST_CANDUMP_OK    0   /**< a frame */
@@ -46,26 +46,26 @@ int imest_candump_format(char *buf, size_t n, double t_s, const char *iface,
  * @param err   (optional) static message on IMEST_CANDUMP_ERROR
  */
 int imest_candump_parse(const char *line, double *t_s, char iface[IMEST_CANDUMP_IFNAMSIZ],
-                        struct imest_can_frame *f, const char **err);
+                        imest_can_frame_t *f, const char **err);
 
 /** A port that writes every frame as one line to a FILE*. */
-struct imest_candump_port {
-  struct imest_can_port port;   /**< pass &p.port to imest_can_pub_init() */
+typedef struct imest_candump_port {
+  imest_can_port_t port;   /**< pass &p.port to imest_can_pub_init() */
   FILE *fp;
   char iface[IMEST_CANDUMP_IFNAMSIZ];
   double t_s;                   /**< timestamp of the next lines */
   unsigned long lines;          /**< lines written */
   unsigned long failed;         /**< frames that could not be written */
-};
+} imest_candump_port_t;
 
 /** Set up p to write to fp (not closed by this library) with interface name
  *  iface (NULL -> "vcan0"; at most 15 characters, no blanks). Timestamp 0
  *  until imest_candump_port_set_time(). @return 0, or -1 on bad arguments. */
-int imest_candump_port_open(struct imest_candump_port *p, FILE *fp, const char *iface);
+int imest_candump_port_open(imest_candump_port_t *p, FILE *fp, const char *iface);
 
 /** Timestamp of the following lines, e.g. the window's t_end_s (or an epoch
  *  offset + t_end_s). */
-void imest_candump_port_set_time(struct imest_candump_port *p, double t_s);
+void imest_candump_port_set_time(imest_candump_port_t *p, double t_s);
 
 #ifdef __cplusplus
 }

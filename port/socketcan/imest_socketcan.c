@@ -15,14 +15,14 @@
 #include <linux/can.h>
 #include <linux/can/raw.h>
 
-static int fail(struct imest_socketcan *sc, int e, const char *fmt, const char *a) {
+static int fail(imest_socketcan_t *sc, int e, const char *fmt, const char *a) {
   sc->last_errno = e;
   snprintf(sc->err, sizeof sc->err, fmt, a, strerror(e));
   return -e;
 }
 
-static int sc_send(void *ctx, const struct imest_can_frame *f) {
-  struct imest_socketcan *sc = (struct imest_socketcan *)ctx;
+static int sc_send(void *ctx, const imest_can_frame_t *f) {
+  imest_socketcan_t *sc = (imest_socketcan_t *)ctx;
   struct can_frame cf;
   unsigned int i;
   ssize_t n;
@@ -49,7 +49,7 @@ static int sc_send(void *ctx, const struct imest_can_frame *f) {
   return 0;
 }
 
-int imest_socketcan_open(struct imest_socketcan *sc, const char *ifname) {
+int imest_socketcan_open(imest_socketcan_t *sc, const char *ifname) {
   struct sockaddr_can addr;
   struct ifreq ifr;
   unsigned int idx;
@@ -119,7 +119,7 @@ int imest_socketcan_open(struct imest_socketcan *sc, const char *ifname) {
   return 0;
 }
 
-int imest_socketcan_recv(struct imest_socketcan *sc, struct imest_can_frame *f, int timeout_ms,
+int imest_socketcan_recv(imest_socketcan_t *sc, imest_can_frame_t *f, int timeout_ms,
                          double *t_s) {
   struct pollfd pfd;
   struct can_frame cf;
@@ -162,7 +162,7 @@ int imest_socketcan_recv(struct imest_socketcan *sc, struct imest_can_frame *f, 
   }
 }
 
-void imest_socketcan_close(struct imest_socketcan *sc) {
+void imest_socketcan_close(imest_socketcan_t *sc) {
   if (sc != NULL && sc->fd >= 0) {
     close(sc->fd);
     sc->fd = -1;

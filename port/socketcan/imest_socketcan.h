@@ -2,7 +2,7 @@
  * @file imest_socketcan.h
  * @brief Host library (Linux): a CAN port on a SocketCAN CAN_RAW socket.
  *
- *     struct imest_socketcan sc;
+ *     imest_socketcan_t sc;
  *     if (imest_socketcan_open(&sc, "vcan0") != 0) { puts(sc.err); ... }
  *     imest_can_pub_init(&pub, &sc.port, IMEST_CAN_DEFAULT_BASE_ID);
  *     ...
@@ -22,8 +22,8 @@
 extern "C" {
 #endif
 
-struct imest_socketcan {
-  struct imest_can_port port;  /**< pass &sc.port to imest_can_pub_init() */
+typedef struct imest_socketcan {
+  imest_can_port_t port;  /**< pass &sc.port to imest_can_pub_init() */
   int fd;                      /**< CAN_RAW socket, -1 when closed */
   int ifindex;
   char ifname[16];
@@ -31,7 +31,7 @@ struct imest_socketcan {
   char err[256];               /**< human-readable message of the last failure */
   unsigned long sent;
   unsigned long failed;
-};
+} imest_socketcan_t;
 
 /**
  * Open a CAN_RAW socket bound to interface `ifname` (e.g. "can0", "vcan0").
@@ -40,17 +40,17 @@ struct imest_socketcan {
  *   -ENODEV: no such interface, or it is not a CAN interface,
  *   -ENETDOWN: the interface is down.
  */
-int imest_socketcan_open(struct imest_socketcan *sc, const char *ifname);
+int imest_socketcan_open(imest_socketcan_t *sc, const char *ifname);
 
 /** Receive one frame, waiting at most timeout_ms (< 0: forever). Remote,
  *  error and CAN FD frames are skipped. t_s (optional): receive time
  *  (CLOCK_REALTIME, seconds). @return 1 frame, 0 timeout / interrupted,
  *  -errno on error (sc->err set). */
-int imest_socketcan_recv(struct imest_socketcan *sc, struct imest_can_frame *f, int timeout_ms,
+int imest_socketcan_recv(imest_socketcan_t *sc, imest_can_frame_t *f, int timeout_ms,
                          double *t_s);
 
 /** Close the socket (safe to call twice). */
-void imest_socketcan_close(struct imest_socketcan *sc);
+void imest_socketcan_close(imest_socketcan_t *sc);
 
 #ifdef __cplusplus
 }

@@ -15,9 +15,9 @@ static double now_s(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static double run(const char *label, const imsim_config *c, double motor_s) {
-  static imsim sim;
-  imsim_sample s;
+static double run(const char *label, const imsim_config_t *c, double motor_s) {
+  static imsim_t sim;
+  imsim_sample_t s;
   if (imsim_init(&sim, c, &s) != 0) {
     fprintf(stderr, "%s: %s\n", label, imsim_error(&sim));
     return 0.0;
@@ -38,7 +38,7 @@ static double run(const char *label, const imsim_config *c, double motor_s) {
 
 int main(int argc, char **argv) {
   const double motor_s = argc > 1 ? atof(argv[1]) : 60.0;
-  imsim_config c;
+  imsim_config_t c;
   imsim_config_preset(&c, "exp2");
   c.supply = IMSIM_SUPPLY_PWM;
   run("exp2 pwm 10kHz, 12-bit + 1 LSB noise, 4 kHz", &c, motor_s);

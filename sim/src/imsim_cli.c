@@ -1,5 +1,5 @@
 /* imest-sim: writes a simulated induction-motor record as CSV. A thin layer on the imsim API:
- * parse (flags -> imsim_config) and run (simulate, write rows, progress). */
+ * parse (flags -> imsim_config_t) and run (simulate, write rows, progress). */
 #define _POSIX_C_SOURCE 200809L
 #include "imsim_cli.h"
 
@@ -124,7 +124,7 @@ static int inum(const char *s, long *v) {
   return 0;
 }
 
-#define CFG(field) offsetof(imsim_config, field)
+#define CFG(field) offsetof(imsim_config_t, field)
 #define NONE_LO (-INFINITY)
 #define NONE_HI INFINITY
 
@@ -192,10 +192,10 @@ static const int_flag INT_FLAGS[] = {
 };
 
 /* Flags that name one of a few choices (enum fields, stored as int). */
-_Static_assert(sizeof(imsim_supply) == sizeof(int) && sizeof(imsim_vmeas) == sizeof(int) &&
-                   sizeof(imsim_start) == sizeof(int) && sizeof(imsim_ifoc_mode) == sizeof(int) &&
-                   sizeof(imsim_integrator) == sizeof(int) && sizeof(imsim_timing) == sizeof(int) &&
-                   sizeof(imsim_modulation) == sizeof(int),
+_Static_assert(sizeof(imsim_supply_t) == sizeof(int) && sizeof(imsim_vmeas_t) == sizeof(int) &&
+                   sizeof(imsim_start_t) == sizeof(int) && sizeof(imsim_ifoc_mode_t) == sizeof(int) &&
+                   sizeof(imsim_integrator_t) == sizeof(int) && sizeof(imsim_timing_t) == sizeof(int) &&
+                   sizeof(imsim_modulation_t) == sizeof(int),
                "choice flags store enums as int");
 typedef struct {
   const char *flag;
@@ -233,7 +233,7 @@ static const phase_flag PHASE_FLAGS[] = {
 
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 
-static void *field(imsim_config *c, size_t off) { return (char *)c + off; }
+static void *field(imsim_config_t *c, size_t off) { return (char *)c + off; }
 
 /* Flags without a value, and the valued flags handled one by one in parse_valued. */
 static const char *const SWITCH_FLAGS[] = {"--help", "--ideal-sensors", "--no-thermal", "--ifoc-ideal-stage",
@@ -260,7 +260,7 @@ size_t imsim_cli_flags(const char **names, size_t max) {
 const char *imsim_cli_usage(void) { return USAGE; }
 
 /* Flags without a value. Returns 1 if name is one (and applies it), 0 otherwise. */
-static int parse_switch(const char *name, imsim_config *c, imsim_cli_opts *o) {
+static int parse_switch(const char *name, imsim_config_t *c, imsim_cli_opts_t *o) {
   if (strcmp(name, "--help") == 0) o->help = 1;
   else if (strcmp(name, "--ideal-sensors") == 0) c->ideal_sensors = true;
   else if (strcmp(name, "--no-thermal") == 0) c->thermal = false;
@@ -273,7 +273,7 @@ static int parse_switch(const char *name, imsim_config *c, imsim_cli_opts *o) {
 }
 
 /* Flags with a value. Returns 0 (applied), -1 (bad value, message in err) or 1 (unknown). */
-static int parse_valued(const char *name, const char *val, imsim_config *c, imsim_cli_opts *o, char *err,
+static int parse_valued(const char *name, const char *val, imsim_config_t *c, imsim_cli_opts_t *o, char *err,
                         size_t errlen) {
   if (strcmp(name, "--preset") == 0) return 0; /* applied in the first pass */
   if (strcmp(name, "--out") == 0) {
@@ -351,7 +351,7 @@ static int parse_valued(const char *name, const char *val, imsim_config *c, imsi
 }
 
 /* Pass 1: the preset, wherever it stands, so that every other flag overrides it. */
-static int parse_preset(int argc, char **argv, imsim_config *c, char *err, size_t errlen) {
+static int parse_preset(int argc, char **argv, imsim_config_t *c, char *err, size_t errlen) {
   imsim_config_default(c);
   for (int a = 1; a < argc; ++a) {
     const char *arg = argv[a];
@@ -369,7 +369,7 @@ static int parse_preset(int argc, char **argv, imsim_config *c, char *err, size_
   return 0;
 }
 
-int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, char *err, size_t errlen) {
+int imsim_cli_parse(int argc, char **argv, imsim_config_t *c, imsim_cli_opts_t *o, char *err, size_t errlen) {
   o->out = "-";
   o->decimate = 1;
   o->progress = -1;
@@ -405,7 +405,7 @@ int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, c
 /* ---- run -------------------------------------------------------------------------------- */
 
 /* %.9g is exact to ~1e-9 relative, which is what the spec asks for. */
-void imsim_cli_write_row(FILE *f, const imsim_sample *s) {
+void imsim_cli_write_row(FILE *f, const imsim_sample_t *s) {
   fprintf(f,
           "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
           "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
@@ -468,8 +468,8 @@ static FILE *open_output(const char *path) {
 
 /* A bus too low for the reference saturates the inverter, as in a real drive: the run is
    valid, but the voltage is not the commanded one, so say so with the numbers. */
-static void report_clipping(const imsim *sim, const imsim_config *c) {
-  imsim_pwm_stats st;
+static void report_clipping(const imsim_t *sim, const imsim_config_t *c) {
+  imsim_pwm_stats_t st;
   imsim_get_pwm_stats(sim, &st);
   if (st.clipped_half_periods == 0u) return;
   fprintf(stderr,
@@ -482,9 +482,9 @@ static void report_clipping(const imsim *sim, const imsim_config *c) {
 }
 
 /* Simulates c and writes the CSV. Returns the exit status. */
-static int run(const imsim_config *c, const imsim_cli_opts *o) {
-  static imsim sim;
-  imsim_sample smp;
+static int run(const imsim_config_t *c, const imsim_cli_opts_t *o) {
+  static imsim_t sim;
+  imsim_sample_t smp;
   if (imsim_init(&sim, c, &smp) != 0) {
     fprintf(stderr, "imest-sim: %s\n", imsim_error(&sim));
     return 2;
@@ -513,8 +513,8 @@ static int run(const imsim_config *c, const imsim_cli_opts *o) {
 }
 
 int imsim_cli_main(int argc, char **argv) {
-  imsim_config c;
-  imsim_cli_opts o;
+  imsim_config_t c;
+  imsim_cli_opts_t o;
   char err[256];
   if (imsim_cli_parse(argc, argv, &c, &o, err, sizeof err) != 0) {
     fprintf(stderr, "imest-sim: %s\n(try --help)\n", err);

@@ -16,7 +16,7 @@ typedef struct {
   long decimate;     /* write every n-th sample (1 = all) */
   int progress;      /* -1 auto (isatty(stderr)), 0 off, 1 on */
   int help;
-} imsim_cli_opts;
+} imsim_cli_opts_t;
 
 /* The CSV header line (no newline). */
 const char *imsim_cli_header(void);
@@ -29,10 +29,10 @@ size_t imsim_cli_flags(const char **names, size_t max);
 
 /* Parses argv into c (preset applied first, then the other flags in order) and o.
    Returns 0, or -1 with a message in err. */
-int imsim_cli_parse(int argc, char **argv, imsim_config *c, imsim_cli_opts *o, char *err, size_t errlen);
+int imsim_cli_parse(int argc, char **argv, imsim_config_t *c, imsim_cli_opts_t *o, char *err, size_t errlen);
 
 /* Writes one CSV row (with newline). */
-void imsim_cli_write_row(FILE *f, const imsim_sample *s);
+void imsim_cli_write_row(FILE *f, const imsim_sample_t *s);
 
 /* The whole program; returns the process exit status. */
 int imsim_cli_main(int argc, char **argv);

@@ -1,4 +1,4 @@
-/* imsim internals shared by the simulator's source files (not installed, not API).
+/* imsim_t internals shared by the simulator's source files (not installed, not API).
  * One file per concern: config.c (defaults, exp presets), motors.c (drive presets),
  * transform.c, rng.c, thermal.c, load.c, supply.c (V/f reference), taylor.c (exact
  * propagator), rk4.c (reference), integrate.c (one step), pwm.c (inverter), drive.c
@@ -21,7 +21,7 @@
 
 /* ---- complex maths (a + jb = the alpha-beta pair) ---------------------------------------- */
 
-typedef imsim_cpx_ cpx;
+typedef imsim_cpx_t cpx;
 
 static inline cpx cx(double re, double im) {
   cpx r;
@@ -46,13 +46,13 @@ extern const double IMS_INV_K[33];
 /* ---- motor model (eq. (1)) ---------------------------------------------------------------- */
 
 /* Electromagnetic torque at (i, psi). */
-static inline double ims_torque_of(const imsim *s, cpx i, cpx psi) {
+static inline double ims_torque_of(const imsim_t *s, cpx i, cpx psi) {
   return (double)s->c.pole_pairs * s->m_h / s->c.lr_h * (i.im * psi.re - i.re * psi.im);
 }
 
 /* dTe/dt along the model at state (i, psi, w) with input u. */
-static inline double ims_torque_rate(const imsim *s, cpx i, cpx psi, double w, cpx u) {
-  const imsim_config *c = &s->c;
+static inline double ims_torque_rate(const imsim_t *s, cpx i, cpx psi, double w, cpx u) {
+  const imsim_config_t *c = &s->c;
   const double nw = (double)c->pole_pairs * w;
   const cpx di = cadd(cadd(cscale(u, 1.0 / (c->sigma * c->ls_h)), cscale(i, -s->gamma)),
                       cmul(cx(s->beta / s->tr, -s->beta * nw), psi));
@@ -64,21 +64,21 @@ static inline double ims_torque_rate(const imsim *s, cpx i, cpx psi, double w, c
 /* motors.c: the industrial drive presets (on top of imsim_config_default). Returns 0, or -1
    for an unknown name. */
 #define IMS_MOTOR_PRESET_NAMES "4kw|11kw|15kw|37kw|75kw"
-int ims_motor_preset(imsim_config *c, const char *name);
+int ims_motor_preset(imsim_config_t *c, const char *name);
 
 /* load.c: load torque at t. supply.c: reference of the open-loop supplies (alpha-beta amplitude =
    V_ll rms, phase, frequency). */
-double ims_load_at(const imsim *s, double t);
-void ims_vf_ref(const imsim *s, double t, double *amp, double *phase, double *f_hz);
+double ims_load_at(const imsim_t *s, double t);
+void ims_vf_ref(const imsim_t *s, double t, double *amp, double *phase, double *f_hz);
 
 /* thermal.c: present R_S, R_R, T_R and the derived gamma, beta from the temperatures; one
    sample of both first-order thermal models (then the parameters are updated). */
-void ims_update_params(imsim *s);
-void ims_thermal_step(imsim *s);
+void ims_update_params(imsim_t *s);
+void ims_thermal_step(imsim_t *s);
 
 /* rng.c */
-void ims_rng_seed(imsim_rng_ *r, uint64_t *sm);
-double ims_rng_gauss(imsim_rng_ *r);
+void ims_rng_seed(imsim_rng_t *r, uint64_t *sm);
+double ims_rng_gauss(imsim_rng_t *r);
 
 /* ---- integration ---------------------------------------------------------------------------- */
 
@@ -89,7 +89,7 @@ typedef struct {
   int p;           /* Taylor order */
   double we;       /* source rotation (rad/s), src only */
   cpx mom[32];     /* PWM input moments m_k = int_0^h (h-s)^k/k! u(s) ds */
-} step_input;
+} step_input_t;
 
 /* One PWM half carrier period (time from its start). */
 typedef struct {
@@ -99,55 +99,55 @@ typedef struct {
   double td;          /* dead time */
   double cmd_avg[2];  /* commanded average voltage (alpha-beta) */
   double act_avg[2];  /* actual average voltage (alpha-beta, dead time and drops) */
-} pwm_half;
+} pwm_half_t;
 
 /* taylor.c: Taylor order for ||A h|| = rho; norm bound of the augmented A (per second);
    order for the step h_s; exact propagation of the linear electrical part over one step. */
 int ims_taylor_order_rho(double rho);
-double ims_a_norm(const imsim *s, double w, const step_input *in);
-int ims_taylor_order(const imsim *s, double w, const step_input *in);
-void ims_fast_step(imsim *s, const double *hkv, double w_mid, double nwdot, const step_input *in);
+double ims_a_norm(const imsim_t *s, double w, const step_input_t *in);
+int ims_taylor_order(const imsim_t *s, double w, const step_input_t *in);
+void ims_fast_step(imsim_t *s, const double *hkv, double w_mid, double nwdot, const step_input_t *in);
 
 /* rk4.c: the reference integrator's state and one constant-input piece. */
 typedef struct {
   cpx x[7];
   double w, th;
-} ims_full_state;
-void ims_rk4_piece(const imsim *s, ims_full_state *X, double len, cpx u_pwm, const step_input *in, double tl);
+} ims_full_state_t;
+void ims_rk4_piece(const imsim_t *s, ims_full_state_t *X, double len, cpx u_pwm, const step_input_t *in, double tl);
 
 /* integrate.c: one integration step of length h_s with input in (fast or RK4). With PWM on the
    piecewise paths and a non-ideal inverter it sets ph->act_avg from the pieces. */
-void ims_advance(imsim *s, const step_input *in, pwm_half *ph, double tl);
+void ims_advance(imsim_t *s, const step_input_t *in, pwm_half_t *ph, double tl);
 
 /* pwm.c: whether the inverter has device drops / is ideal (no dead time, no drops);
    reference (alpha-beta) -> leg modulation m in [-1, 1] (duty (1 + m)/2) for a bus vdc, true if
    it clipped; one half period g from m: edges, input moments, average voltages (dead time and
    drops decided by the currents at its start); the piecewise path's break points (returns
    their number, <= 8) and the voltage on the piece around tm from the currents at its start. */
-bool ims_inverter_has_drops(const imsim_config *c);
-bool ims_inverter_is_ideal(const imsim_config *c);
-bool ims_pwm_modulate(imsim *s, cpx vref, double vdc, double m[3]);
-void ims_pwm_build(imsim *s, uint64_t g, const double m[3], step_input *in, pwm_half *ph);
-int ims_pwm_breaks(const pwm_half *ph, double h, double b[8]);
-cpx ims_pwm_piece_voltage(const imsim *s, const pwm_half *ph, double tm, const double i_abc[3]);
-bool ims_pwm_may_cross_zero(const imsim *s, const pwm_half *ph);
+bool ims_inverter_has_drops(const imsim_config_t *c);
+bool ims_inverter_is_ideal(const imsim_config_t *c);
+bool ims_pwm_modulate(imsim_t *s, cpx vref, double vdc, double m[3]);
+void ims_pwm_build(imsim_t *s, uint64_t g, const double m[3], step_input_t *in, pwm_half_t *ph);
+int ims_pwm_breaks(const pwm_half_t *ph, double h, double b[8]);
+cpx ims_pwm_piece_voltage(const imsim_t *s, const pwm_half_t *ph, double tm, const double i_abc[3]);
+bool ims_pwm_may_cross_zero(const imsim_t *s, const pwm_half_t *ph);
 
 /* sensors.c: PWM inverter present; firmware timing in force; the DC-bus sample at t. */
-bool ims_is_pwm_stage(const imsim_config *c);
-bool ims_firmware_timing(const imsim_config *c);
-void ims_sample_vdc(imsim *s);
-imsim_vmeas ims_vmeas_of(const imsim_config *c);
-void ims_fill_sample(imsim *s, imsim_sample *o);
+bool ims_is_pwm_stage(const imsim_config_t *c);
+bool ims_firmware_timing(const imsim_config_t *c);
+void ims_sample_vdc(imsim_t *s);
+imsim_vmeas_t ims_vmeas_of(const imsim_config_t *c);
+void ims_fill_sample(imsim_t *s, imsim_sample_t *o);
 
 /* drive.c (firmware timing): duties for [t_0, t_1) at init; the duties of the next sample
    period computed from the present sample (V/f or IFOC; ext: the caller's); the switch to
    them at the end of the step. */
-void ims_drive_init(imsim *s);
-void ims_drive_update(imsim *s);
-void ims_drive_advance(imsim *s);
+void ims_drive_init(imsim_t *s);
+void ims_drive_update(imsim_t *s);
+void ims_drive_advance(imsim_t *s);
 
 /* ifoc.c */
-void ims_ifoc_update(imsim *s);
-cpx ims_ifoc_vref(const imsim *s, double t);
+void ims_ifoc_update(imsim_t *s);
+cpx ims_ifoc_vref(const imsim_t *s, double t);
 
 #endif /* IMSIM_INTERNAL_H */

@@ -30,7 +30,7 @@ static const motor_row MOTORS[] = {
     {"75kw", 75000.0, 0.03552, 0.02092, 0.335e-3, 15.1e-3, 1.25, 485.0, 135.0, 500.0},
 };
 
-int ims_motor_preset(imsim_config *c, const char *name) {
+int ims_motor_preset(imsim_config_t *c, const char *name) {
   const motor_row *m = NULL;
   for (size_t k = 0; k < sizeof MOTORS / sizeof MOTORS[0]; ++k)
     if (strcmp(name, MOTORS[k].name) == 0) m = &MOTORS[k];
@@ -83,7 +83,7 @@ int ims_motor_preset(imsim_config *c, const char *name) {
   c->torque_limit_nm = 2.0 * m->t_nm;
 
   /* thermal: R_th from the rated copper losses of the phasor solution */
-  imsim_steady st;
+  imsim_steady_t st;
   if (imsim_steady_state(c, c->vll_v, c->freq_hz, c->load_nm, &st) == 0) {
     const double m_h = sqrt((1.0 - c->sigma) * c->ls_h * c->lr_h);
     const cpx i = cx(st.i_ab[0], st.i_ab[1]), psi = cx(st.psi_ab[0], st.psi_ab[1]);

@@ -10,14 +10,14 @@
  *   i = 0: no drop, and the dead time does not delay the edge. */
 #include "imsim_internal.h"
 
-bool ims_inverter_has_drops(const imsim_config *c) {
+bool ims_inverter_has_drops(const imsim_config_t *c) {
   return c->v_switch_v != 0.0 || c->r_switch_ohm != 0.0 || c->v_diode_v != 0.0 || c->r_diode_ohm != 0.0;
 }
 
-bool ims_inverter_is_ideal(const imsim_config *c) { return c->dead_time_s == 0.0 && !ims_inverter_has_drops(c); }
+bool ims_inverter_is_ideal(const imsim_config_t *c) { return c->dead_time_s == 0.0 && !ims_inverter_has_drops(c); }
 
 /* Leg voltage (against the negative bus rail) with the upper (high) or lower device pair on. */
-static double leg_level(const imsim_config *c, bool drops, bool high, double i) {
+static double leg_level(const imsim_config_t *c, bool drops, bool high, double i) {
   if (!drops) return high ? c->vdc_v : 0.0;
   if (high) {
     if (i > 0.0) return c->vdc_v - (c->v_switch_v + c->r_switch_ohm * i);
@@ -29,8 +29,8 @@ static double leg_level(const imsim_config *c, bool drops, bool high, double i) 
   return 0.0;
 }
 
-bool ims_pwm_modulate(imsim *s, cpx vref, double vdc, double m[3]) {
-  const imsim_config *c = &s->c;
+bool ims_pwm_modulate(imsim_t *s, cpx vref, double vdc, double m[3]) {
+  const imsim_config_t *c = &s->c;
   double vabc[3];
   const double vab[2] = {vref.re, vref.im};
   imsim_ab_to_abc(vab, vabc);
@@ -58,8 +58,8 @@ bool ims_pwm_modulate(imsim *s, cpx vref, double vdc, double m[3]) {
 
 /* Voltage applied on the piece of the half period around tm, with the phase currents i_abc at
    the piece's start deciding the dead time and the drops. */
-cpx ims_pwm_piece_voltage(const imsim *s, const pwm_half *ph, double tm, const double i_abc[3]) {
-  const imsim_config *c = &s->c;
+cpx ims_pwm_piece_voltage(const imsim_t *s, const pwm_half_t *ph, double tm, const double i_abc[3]) {
+  const imsim_config_t *c = &s->c;
   const bool drops = ims_inverter_has_drops(c);
   cpx u = cx(0.0, 0.0);
   for (int k = 0; k < 3; ++k) {
@@ -74,7 +74,7 @@ cpx ims_pwm_piece_voltage(const imsim *s, const pwm_half *ph, double tm, const d
   return u;
 }
 
-int ims_pwm_breaks(const pwm_half *ph, double h, double b[8]) {
+int ims_pwm_breaks(const pwm_half_t *ph, double h, double b[8]) {
   int n = 0;
   b[n++] = 0.0;
   for (int k = 0; k < 3; ++k) {
@@ -92,8 +92,8 @@ int ims_pwm_breaks(const pwm_half *ph, double h, double b[8]) {
   return n;
 }
 
-void ims_pwm_build(imsim *s, uint64_t g, const double m[3], step_input *in, pwm_half *ph) {
-  const imsim_config *c = &s->c;
+void ims_pwm_build(imsim_t *s, uint64_t g, const double m[3], step_input_t *in, pwm_half_t *ph) {
+  const imsim_config_t *c = &s->c;
   const double h = s->h_s;
   const double vdc = c->vdc_v;
   const bool rising = (g % 2u) == 0u; /* carrier starts at its valley at t = 0 */
@@ -167,8 +167,8 @@ void ims_pwm_build(imsim *s, uint64_t g, const double m[3], step_input *in, pwm_
    the change of f0). The moments path decides the dead time and the drops once per half
    period, which is exact only when no current changes sign; otherwise the half period is
    integrated piecewise. */
-bool ims_pwm_may_cross_zero(const imsim *s, const pwm_half *ph) {
-  const imsim_config *c = &s->c;
+bool ims_pwm_may_cross_zero(const imsim_t *s, const pwm_half_t *ph) {
+  const imsim_config_t *c = &s->c;
   if (ims_inverter_is_ideal(c)) return false;
   const double h = s->h_s, sl = c->sigma * c->ls_h;
   const double nw = (double)c->pole_pairs * s->w;
@@ -179,7 +179,7 @@ bool ims_pwm_may_cross_zero(const imsim *s, const pwm_half *ph) {
   imsim_ab_to_abc(iab, i0);
   imsim_ab_to_abc(fab, d0);
   /* the commanded pattern: breaks at the commanded edges */
-  pwm_half cmd = *ph;
+  pwm_half_t cmd = *ph;
   cmd.td = 0.0;
   double b[8];
   const int nb = ims_pwm_breaks(&cmd, h, b);

@@ -2,9 +2,9 @@
  * states together), one constant-input piece at a time. Slow; used to measure the fast path. */
 #include "imsim_internal.h"
 
-static void full_deriv(const imsim *s, const ims_full_state *X, cpx u_pwm, const step_input *in, double tl,
-                       ims_full_state *d) {
-  const imsim_config *c = &s->c;
+static void full_deriv(const imsim_t *s, const ims_full_state_t *X, cpx u_pwm, const step_input_t *in, double tl,
+                       ims_full_state_t *d) {
+  const imsim_config_t *c = &s->c;
   const double bi = 1.0 / (c->sigma * c->ls_h);
   const double nw = (double)c->pole_pairs * X->w;
   const cpx u = in->src ? X->x[6] : u_pwm;
@@ -25,17 +25,17 @@ static void full_deriv(const imsim *s, const ims_full_state *X, cpx u_pwm, const
   d->th = X->w;
 }
 
-static void full_axpy(ims_full_state *out, const ims_full_state *a, double k, const ims_full_state *b) {
+static void full_axpy(ims_full_state_t *out, const ims_full_state_t *a, double k, const ims_full_state_t *b) {
   for (int q = 0; q < 7; ++q) out->x[q] = cx(a->x[q].re + k * b->x[q].re, a->x[q].im + k * b->x[q].im);
   out->w = a->w + k * b->w;
   out->th = a->th + k * b->th;
 }
 
-void ims_rk4_piece(const imsim *s, ims_full_state *X, double len, cpx u_pwm, const step_input *in, double tl) {
+void ims_rk4_piece(const imsim_t *s, ims_full_state_t *X, double len, cpx u_pwm, const step_input_t *in, double tl) {
   const int n = s->c.rk4_substeps;
   const double hh = len / (double)n;
   for (int it = 0; it < n; ++it) {
-    ims_full_state k1, k2, k3, k4, tmp;
+    ims_full_state_t k1, k2, k3, k4, tmp;
     full_deriv(s, X, u_pwm, in, tl, &k1);
     full_axpy(&tmp, X, 0.5 * hh, &k1);
     full_deriv(s, &tmp, u_pwm, in, tl, &k2);

@@ -26,13 +26,13 @@ static double rng_uniform(uint64_t s[4]) { /* (-1, 1) */
 
 /* Seeds r from the splitmix64 sequence at *sm (which advances), so that successive calls
    give independent streams from one seed. */
-void ims_rng_seed(imsim_rng_ *r, uint64_t *sm) {
+void ims_rng_seed(imsim_rng_t *r, uint64_t *sm) {
   for (int k = 0; k < 4; ++k) r->s[k] = splitmix64(sm);
   r->has_spare = false;
   r->spare = 0.0;
 }
 
-double ims_rng_gauss(imsim_rng_ *r) {
+double ims_rng_gauss(imsim_rng_t *r) {
   if (r->has_spare) {
     r->has_spare = false;
     return r->spare;

@@ -3,8 +3,8 @@
  * record with its truth columns. */
 #include "imsim_internal.h"
 
-static double adc(imsim *s, double x, double range) {
-  const imsim_config *c = &s->c;
+static double adc(imsim_t *s, double x, double range) {
+  const imsim_config_t *c = &s->c;
   const double lsb = 2.0 * range / ldexp(1.0, c->adc_bits);
   if (c->noise_lsb > 0.0) x += c->noise_lsb * lsb * ims_rng_gauss(&s->rng);
   double code = floor(x / lsb + 0.5);
@@ -14,19 +14,19 @@ static double adc(imsim *s, double x, double range) {
   return code * lsb;
 }
 
-bool ims_is_pwm_stage(const imsim_config *c) {
+bool ims_is_pwm_stage(const imsim_config_t *c) {
   return c->supply == IMSIM_SUPPLY_PWM || c->supply == IMSIM_SUPPLY_EXT ||
          (c->supply == IMSIM_SUPPLY_IFOC && !c->ifoc_ideal_stage);
 }
 
-bool ims_firmware_timing(const imsim_config *c) {
+bool ims_firmware_timing(const imsim_config_t *c) {
   return ims_is_pwm_stage(c) && (c->timing == IMSIM_TIMING_FIRMWARE || c->supply == IMSIM_SUPPLY_EXT);
 }
 
 /* The DC bus through a unipolar ADC (0 .. vdc_range_v, same bits and noise as the others, its
    own noise stream). The bus itself is stiff: V_dc is constant. */
-void ims_sample_vdc(imsim *s) {
-  const imsim_config *c = &s->c;
+void ims_sample_vdc(imsim_t *s) {
+  const imsim_config_t *c = &s->c;
   if (!ims_is_pwm_stage(c)) {
     s->vdc_meas = NAN_D;
     return;
@@ -45,13 +45,13 @@ void ims_sample_vdc(imsim *s) {
   s->vdc_meas = code * lsb;
 }
 
-imsim_vmeas ims_vmeas_of(const imsim_config *c) {
+imsim_vmeas_t ims_vmeas_of(const imsim_config_t *c) {
   if (c->vmeas != IMSIM_VMEAS_AUTO) return c->vmeas;
   return ims_is_pwm_stage(c) ? IMSIM_VMEAS_AVG : IMSIM_VMEAS_INST;
 }
 
-void ims_fill_sample(imsim *s, imsim_sample *o) {
-  const imsim_config *c = &s->c;
+void ims_fill_sample(imsim_t *s, imsim_sample_t *o) {
+  const imsim_config_t *c = &s->c;
   const bool aa = !c->ideal_sensors && c->aa_hz > 0.0;
   o->n = s->n;
   o->t = s->t;

@@ -4,23 +4,23 @@
 
 #include "imsim_internal.h"
 
-static int fail(imsim *s, const char *msg) {
+static int fail(imsim_t *s, const char *msg) {
   snprintf(s->err, sizeof s->err, "%s", msg);
   return -1;
 }
 
-const char *imsim_error(const imsim *sim) { return sim->err; }
+const char *imsim_error(const imsim_t *sim) { return sim->err; }
 
-void imsim_get_pwm_stats(const imsim *s, imsim_pwm_stats *out) {
+void imsim_get_pwm_stats(const imsim_t *s, imsim_pwm_stats_t *out) {
   out->half_periods = s->pwm_half_periods;
   out->clipped_half_periods = s->pwm_clipped_half_periods;
   out->vdc_needed_v = s->pwm_vdc_needed;
 }
 
-int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
+int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first) {
   memset(s, 0, sizeof *s);
   s->c = *cfg;
-  imsim_config *c = &s->c;
+  imsim_config_t *c = &s->c;
   if ((unsigned)c->supply > (unsigned)IMSIM_SUPPLY_EXT || (unsigned)c->timing > (unsigned)IMSIM_TIMING_FIRMWARE ||
       (unsigned)c->modulation > (unsigned)IMSIM_MOD_SVPWM)
     return fail(s, "unknown supply, timing or modulation");
@@ -45,7 +45,7 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
     if (!(c->aa_hz >= 0.0)) return fail(s, "aa cut-off must be >= 0");
   }
   if (c->rk4_substeps < 1) return fail(s, "rk4 substeps must be >= 1");
-  const imsim_vmeas vm = ims_vmeas_of(c);
+  const imsim_vmeas_t vm = ims_vmeas_of(c);
   if (vm == IMSIM_VMEAS_AVG && !ims_is_pwm_stage(c)) return fail(s, "voltage measurement 'avg' needs a PWM stage");
   if (vm == IMSIM_VMEAS_INST && ims_is_pwm_stage(c))
     return fail(s, "voltage measurement 'inst' with a PWM stage would record 0 V: every sample instant is a "
@@ -99,7 +99,7 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
     if (c->ifoc_flux_wb > 0.0) {
       s->ifoc_flux = c->ifoc_flux_wb;
     } else {
-      imsim_steady st;
+      imsim_steady_t st;
       const bool have = c->vll_v > 0.0 && c->freq_hz > 0.0;
       if (imsim_steady_state(c, have ? c->vll_v : 230.0, have ? c->freq_hz : 60.0, c->load_nm, &st) != 0)
         return fail(s, "cannot derive the rated flux; set ifoc_flux_wb");
@@ -109,7 +109,7 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
   s->te_ref = NAN_D;
 
   if (c->start == IMSIM_START_STEADY) {
-    imsim_steady st;
+    imsim_steady_t st;
     if (c->supply == IMSIM_SUPPLY_IFOC) return fail(s, "steady start not available with IFOC");
     if (imsim_steady_state(c, c->vll_v, c->freq_hz, c->load_nm, &st) != 0)
       return fail(s, "steady start: load exceeds the breakdown torque");
@@ -140,14 +140,14 @@ int imsim_init(imsim *s, const imsim_config *cfg, imsim_sample *first) {
   }
   ims_sample_vdc(s);
   ims_drive_init(s);
-  imsim_sample tmp;
+  imsim_sample_t tmp;
   ims_fill_sample(s, first != NULL ? first : &tmp);
   s->th_meas_prev = s->th_meas;
   return 0;
 }
 
-void imsim_step(imsim *s, imsim_sample *out) {
-  const imsim_config *c = &s->c;
+void imsim_step(imsim_t *s, imsim_sample_t *out) {
+  const imsim_config_t *c = &s->c;
   const double ts = s->ts_s, h = s->h_s;
   /* 1. thermal: copper losses at t_n drive both first-order models (exact exponential step) */
   if (c->thermal) ims_thermal_step(s);
@@ -160,14 +160,14 @@ void imsim_step(imsim *s, imsim_sample *out) {
 
   const bool aa = !c->ideal_sensors && c->aa_hz > 0.0;
   const bool pwm = ims_is_pwm_stage(c);
-  step_input in;
+  step_input_t in;
   in.aa = aa;
   in.pwm = pwm;
   in.src = !pwm;
   in.we = 0.0;
   in.p = 0;
   in.piecewise = false;
-  pwm_half ph;
+  pwm_half_t ph;
   memset(&ph, 0, sizeof ph);
   for (int k = 0; k < s->k_steps; ++k) {
     const double t0 = s->t + (double)k * h;

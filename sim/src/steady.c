@@ -2,7 +2,7 @@
  * --start steady, the IFOC rated flux, and the presets' checks. */
 #include "imsim_internal.h"
 
-static void steady_at(const imsim_config *c, double m, double tr, double w, double vll, double we,
+static void steady_at(const imsim_config_t *c, double m, double tr, double w, double vll, double we,
                       cpx *i, cpx *psi, double *te) {
   const double sl = c->sigma * c->ls_h;
   const double gamma = c->rs_ohm / sl + (1.0 - c->sigma) / (c->sigma * tr);
@@ -22,7 +22,7 @@ static void steady_at(const imsim_config *c, double m, double tr, double w, doub
   *te = (double)c->pole_pairs * m / c->lr_h * (i->im * psi->re - i->re * psi->im);
 }
 
-int imsim_steady_state(const imsim_config *c, double vll_v, double freq_hz, double load_nm, imsim_steady *out) {
+int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, double load_nm, imsim_steady_t *out) {
   const double m = sqrt((1.0 - c->sigma) * c->ls_h * c->lr_h);
   const double we = 2.0 * PI * freq_hz;
   const double wsync = we / (double)c->pole_pairs;

@@ -35,8 +35,8 @@ int ims_taylor_order_rho(double rho) {
 }
 
 /* Norm bound of the augmented A (per second). */
-double ims_a_norm(const imsim *s, double w, const step_input *in) {
-  const imsim_config *c = &s->c;
+double ims_a_norm(const imsim_t *s, double w, const step_input_t *in) {
+  const imsim_config_t *c = &s->c;
   const double nw = fabs((double)c->pole_pairs * w);
   double norm = s->gamma + s->beta * s->m_h / s->tr + 2.0 * (1.0 / s->tr + nw);
   if (in->aa) norm += (2.0 + SQRT2) * 2.0 * PI * c->aa_hz;
@@ -44,7 +44,7 @@ double ims_a_norm(const imsim *s, double w, const step_input *in) {
   return norm;
 }
 
-int ims_taylor_order(const imsim *s, double w, const step_input *in) {
+int ims_taylor_order(const imsim_t *s, double w, const step_input_t *in) {
   return ims_taylor_order_rho(ims_a_norm(s, w, in) * s->h_s);
 }
 
@@ -76,8 +76,8 @@ static inline void apply_a(const amat *m, const cpx *y, cpx *z) {
    omega frozen at w_mid, plus the leading Magnus correction for omega varying linearly over
    the step: dx = n omega' h^3/12 [A1, A] x_mid, A1 = dA/d(n omega) = [[0, -j beta], [0, j]].
    The input does not enter the correction because A1 B = 0, so it holds for PWM too. */
-void ims_fast_step(imsim *s, const double *hkv, double w_mid, double nwdot, const step_input *in) {
-  const imsim_config *c = &s->c;
+void ims_fast_step(imsim_t *s, const double *hkv, double w_mid, double nwdot, const step_input_t *in) {
+  const imsim_config_t *c = &s->c;
   const double nw = (double)c->pole_pairs * w_mid;
   amat m;
   m.bi = 1.0 / (c->sigma * c->ls_h);

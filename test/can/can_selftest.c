@@ -130,15 +130,15 @@ int main(int argc, char **argv)
   uint32_t base = IMEST_CAN_DEFAULT_BASE_ID;
   int ext = 0;
   double epoch = 1700000000.0;
-  struct imest_candump_port cd;
+  imest_candump_port_t cd;
   FILE *fp = NULL;
   unsigned long failed = 0u;
   imest_can_pub_t pub;
   char err[256];
 #ifdef IMEST_SELFTEST_SOCKETCAN
-  struct imest_socketcan sc;
+  imest_socketcan_t sc;
 #endif
-  const struct imest_can_port *port = NULL;
+  const imest_can_port_t *port = NULL;
   for (int i = 1; i < argc; i++) {
     if (strcmp(argv[i], "--table") == 0) {
       print_table();

@@ -19,7 +19,7 @@ static inline const char *imest_candump_property(const char *line)
 {
   double t = -1.0;
   char iface[IMEST_CANDUMP_IFNAMSIZ];
-  struct imest_can_frame f, g;
+  imest_can_frame_t f, g;
   const char *err = NULL;
   memset(iface, 'x', sizeof iface);
   const int rc = imest_candump_parse(line, &t, iface, &f, &err);

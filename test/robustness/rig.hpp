@@ -53,9 +53,9 @@ inline void expect_sane(const imest_result_t &r, const imest_config_t &cfg, cons
 }
 
 struct Rig {
-  imsim_config sc{};
-  imsim sim{};
-  imsim_sample smp{};
+  imsim_config_t sc{};
+  imsim_t sim{};
+  imsim_sample_t smp{};
   imest_config_t cfg{};
   imest_t est{};
   std::vector<imest_result_t> res;  // in the order the background produced them

@@ -79,7 +79,7 @@ std::string valid_csv(Gen &g) {
 }
 
 std::string valid_candump(Gen &g) {
-  struct imest_can_frame f {};
+  imest_can_frame_t f {};
   f.id = g.pick(2) ? (uint32_t)g.pick(0x800) : ((uint32_t)g.rng() & IMEST_CAN_EFF_MASK) | IMEST_CAN_ID_EXT;
   f.dlc = (uint8_t)g.pick(9);
   for (unsigned k = 0; k < f.dlc; ++k) f.data[k] = (uint8_t)g.pick(256);
@@ -117,7 +117,7 @@ TEST(ParsersRandom, CandumpParserOn100000Lines) {
       ADD_FAILURE() << "line " << n << ": " << bad << ": '" << line << "'";
       if (++err > 5) break;
     }
-    struct imest_can_frame f;
+    imest_can_frame_t f;
     ok += imest_candump_parse(line.c_str(), nullptr, nullptr, &f, nullptr) == IMEST_CANDUMP_OK;
   }
   std::printf("[ parsers  ] candump: 100000 lines, %d parsed as frames\n", ok);

@@ -16,7 +16,7 @@
 #include "imsim_cli.h"
 
 namespace {
-int parse(std::vector<std::string> in, imsim_config &c, imsim_cli_opts &o, std::string *err = nullptr) {
+int parse(std::vector<std::string> in, imsim_config_t &c, imsim_cli_opts_t &o, std::string *err = nullptr) {
   // the parsed options point into argv (as with a real main): keep it alive
   static std::vector<std::string> args;
   args = std::move(in);
@@ -31,8 +31,8 @@ int parse(std::vector<std::string> in, imsim_config &c, imsim_cli_opts &o, std::
 }  // namespace
 
 TEST(SimCli, FlagsSetTheConfig) {
-  imsim_config c;
-  imsim_cli_opts o;
+  imsim_config_t c;
+  imsim_cli_opts_t o;
   ASSERT_EQ(parse({"--duration", "3.5", "--fs", "8000", "--out", "x.csv", "--pole-pairs", "3", "--ls", "0.3",
                    "--lr", "0.31", "--sigma", "0.1", "--rs", "4.5", "--tr", "0.11", "--j", "0.002", "--b", "0.0002",
                    "--supply", "pwm", "--vll", "220", "--freq", "50", "--load-nm", "1.5", "--ideal-sensors"},
@@ -75,8 +75,8 @@ TEST(SimCli, FlagsSetTheConfig) {
 }
 
 TEST(SimCli, PresetAppliesFirstWhateverItsPosition) {
-  imsim_config c;
-  imsim_cli_opts o;
+  imsim_config_t c;
+  imsim_cli_opts_t o;
   ASSERT_EQ(parse({"--vll", "100", "--preset", "exp2", "--seed=7", "--supply=ifoc", "--ifoc-tr", "0.1"}, c, o), 0);
   EXPECT_EQ(c.vll_v, 100);    // explicit flag wins over the preset
   EXPECT_EQ(c.freq_hz, 30);   // from exp2
@@ -92,8 +92,8 @@ TEST(SimCli, PresetAppliesFirstWhateverItsPosition) {
 }
 
 TEST(SimCli, BadFlagsAreRejectedWithAMessage) {
-  imsim_config c;
-  imsim_cli_opts o;
+  imsim_config_t c;
+  imsim_cli_opts_t o;
   std::string e;
   const std::vector<std::vector<std::string>> bad = {
       {"--bogus"},          {"--fs"},          {"--fs", "abc"},      {"--fs", "-5"},   {"--sigma", "1.2"},
@@ -166,8 +166,8 @@ TEST(SimCli, HelpAndReadmeListEveryFlag) {
 #endif
   // every flag the parser lists is accepted by it
   for (const auto &fl : parser) {
-    imsim_config c;
-    imsim_cli_opts o;
+    imsim_config_t c;
+    imsim_cli_opts_t o;
     std::string e;
     const char *argv[] = {"imest-sim", fl.c_str(), "1"};
     char err[256];

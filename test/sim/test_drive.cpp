@@ -17,13 +17,13 @@ std::array<double, 3> zero_sequence_free(const std::array<double, 3> &v) {
 }
 
 // Phase-to-neutral voltage that a drive forms from its duties and bus sample.
-std::array<double, 3> duty_voltage(const imsim_sample &s) {
+std::array<double, 3> duty_voltage(const imsim_sample_t &s) {
   return zero_sequence_free({s.vdc_v * s.duty[0], s.vdc_v * s.duty[1], s.vdc_v * s.duty[2]});
 }
 
 // Mean leg voltage over a PWM period of the inverter model, current of constant sign i:
 // the dead time moves one edge per period by td (against the current), the devices drop.
-double leg_mean(const imsim_config &c, double d, double i) {
+double leg_mean(const imsim_config_t &c, double d, double i) {
   const double td = c.dead_time_s * c.carrier_hz;
   if (i > 0) {
     const double high = c.vdc_v - (c.v_switch_v + c.r_switch_ohm * i), low = -(c.v_diode_v + c.r_diode_ohm * i);
@@ -41,16 +41,16 @@ TEST(SimDrive, DutyVoltageEqualsAppliedVoltSecondsIdealInverter) {
   struct Case {
     const char *what;
     bool moments;
-    imsim_modulation mod;
+    imsim_modulation_t mod;
     double fs;
-    imsim_supply supply;
+    imsim_supply_t supply;
   };
   const Case cases[] = {{"V/f svpwm", true, IMSIM_MOD_SVPWM, 8000, IMSIM_SUPPLY_PWM},
                         {"V/f svpwm segments", false, IMSIM_MOD_SVPWM, 8000, IMSIM_SUPPLY_PWM},
                         {"V/f spwm 2 periods/sample", true, IMSIM_MOD_SPWM, 4000, IMSIM_SUPPLY_PWM},
                         {"IFOC from rest", true, IMSIM_MOD_SVPWM, 8000, IMSIM_SUPPLY_IFOC}};
   for (const auto &cs : cases) {
-    imsim_config c = ideal("4kw");
+    imsim_config_t c = ideal("4kw");
     c.pwm_moments = cs.moments;
     c.modulation = cs.mod;
     c.fs_hz = cs.fs;
@@ -75,8 +75,8 @@ TEST(SimDrive, DutyVoltageEqualsAppliedVoltSecondsIdealInverter) {
     EXPECT_GT(maxv, 100.0) << cs.what;  // a real voltage, not a trivial agreement
     EXPECT_GE(dmin, 0.0) << cs.what;
     EXPECT_LE(dmax, 1.0) << cs.what;
-    imsim_pwm_stats st;
-    static imsim sim;
+    imsim_pwm_stats_t st;
+    static imsim_t sim;
     ASSERT_EQ(imsim_init(&sim, &c, nullptr), 0);
     imsim_get_pwm_stats(&sim, &st);
     EXPECT_EQ(st.clipped_half_periods, 0u) << cs.what;
@@ -88,7 +88,7 @@ TEST(SimDrive, DutyVoltageEqualsAppliedVoltSecondsIdealInverter) {
 // the slopes), for i < 0 the opposite sign; the phase voltage sees it without its zero sequence.
 TEST(SimDrive, DeadTimeAndDropsGiveTheModelsVoltageError) {
   for (const bool moments : {true, false}) {
-    imsim_config c = ideal("4kw");
+    imsim_config_t c = ideal("4kw");
     add_inverter_errors(c);
     c.pwm_moments = moments;
     c.vll_v = 300;  // duties within [0.12, 0.88]: both edges of every period whole
@@ -129,11 +129,11 @@ TEST(SimDrive, DeadTimeAndDropsGiveTheModelsVoltageError) {
 // Firmware timing: a command set after sample k is applied during [t_k+1, t_k+2): it shows in
 // the duty column of row k+1 and in the applied volt-seconds of row k+2, not earlier.
 TEST(SimDrive, ExternalCommandAppliedOneSampleLater) {
-  imsim_config c = ideal("4kw");
+  imsim_config_t c = ideal("4kw");
   c.supply = IMSIM_SUPPLY_EXT;
   c.start = IMSIM_START_REST;
-  static imsim sim;
-  std::vector<imsim_sample> s(8);
+  static imsim_t sim;
+  std::vector<imsim_sample_t> s(8);
   ASSERT_EQ(imsim_init(&sim, &c, &s[0]), 0);
   for (int p = 0; p < 3; ++p) EXPECT_EQ(s[0].duty[p], 0.5);
   imsim_step(&sim, &s[1]);
@@ -156,13 +156,13 @@ TEST(SimDrive, ExternalCommandAppliedOneSampleLater) {
 // R_S I plus the inverter's error, which the PI has to supply.
 TEST(SimDrive, ExternalPiHoldsDcCurrentAtStandstill) {
   for (const bool inverter_errors : {false, true}) {
-    imsim_config c = ideal("4kw");
+    imsim_config_t c = ideal("4kw");
     c.supply = IMSIM_SUPPLY_EXT;
     c.start = IMSIM_START_REST;
     c.load_nm = 0;
     if (inverter_errors) add_inverter_errors(c);
-    static imsim sim;
-    imsim_sample s;
+    static imsim_t sim;
+    imsim_sample_t s;
     ASSERT_EQ(imsim_init(&sim, &c, &s), 0);
     const double i_ref = 5.0;  // A in phase a, -2.5 A in b and c
     const double sl = c.sigma * c.ls_h, wbw = 2 * kPi * 200;
@@ -216,8 +216,8 @@ TEST(SimDrive, ExternalPiHoldsDcCurrentAtStandstill) {
 }
 
 TEST(SimDrive, SetCommandsRefusedOutsideExternalSupply) {
-  imsim_config c = ideal("4kw");
-  static imsim sim;
+  imsim_config_t c = ideal("4kw");
+  static imsim_t sim;
   ASSERT_EQ(imsim_init(&sim, &c, nullptr), 0);
   const double d[3] = {0.5, 0.5, 0.5};
   EXPECT_EQ(imsim_set_duty(&sim, d), -1);
@@ -230,11 +230,11 @@ TEST(SimDrive, SetCommandsRefusedOutsideExternalSupply) {
   EXPECT_EQ(imsim_set_voltage(&sim, bad), -1);
   const double over[3] = {1.5, 0.5, -0.2};  // clipped to [0, 1] and counted
   EXPECT_EQ(imsim_set_duty(&sim, over), 0);
-  imsim_sample s;
+  imsim_sample_t s;
   imsim_step(&sim, &s);
   EXPECT_EQ(s.duty[0], 1.0);
   EXPECT_EQ(s.duty[2], 0.0);
-  imsim_pwm_stats st;
+  imsim_pwm_stats_t st;
   imsim_get_pwm_stats(&sim, &st);
   EXPECT_EQ(st.clipped_half_periods, 2u);
   c.start = IMSIM_START_STEADY;
@@ -244,7 +244,7 @@ TEST(SimDrive, SetCommandsRefusedOutsideExternalSupply) {
 // The bus through its ADC: 12 bit over 0..800 V, 1 LSB noise from its own stream (the phase
 // channels do not change when it is added); exact with ideal sensors; NaN without PWM.
 TEST(SimDrive, BusVoltageSample) {
-  imsim_config c = ideal("4kw");
+  imsim_config_t c = ideal("4kw");
   c.ideal_sensors = false;
   const auto s = run(c, 4000);
   ASSERT_FALSE(s.empty());
@@ -258,7 +258,7 @@ TEST(SimDrive, BusVoltageSample) {
   }
   EXPECT_NEAR(sum / double(s.size()), 560.0, 0.05);
   EXPECT_NEAR(std::sqrt(sum2 / double(s.size())) / lsb, std::sqrt(1.0 + 1.0 / 12), 0.1);
-  imsim_config e = ideal("exp1");
+  imsim_config_t e = ideal("exp1");
   const auto t = run(e, 10);
   EXPECT_TRUE(std::isnan(t[3].vdc_v));
   EXPECT_TRUE(std::isnan(t[3].duty[0]));
@@ -267,10 +267,10 @@ TEST(SimDrive, BusVoltageSample) {
 // Timing refused where it cannot hold: firmware timing samples at a valley once every N
 // carrier periods, and needs the PWM inverter.
 TEST(SimDrive, FirmwareTimingConfigurationChecks) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
   c.timing = IMSIM_TIMING_FIRMWARE;  // 10 kHz carrier, 4 kHz samples: 2.5 periods per sample
-  static imsim sim;
+  static imsim_t sim;
   EXPECT_NE(imsim_init(&sim, &c, nullptr), 0);
   EXPECT_NE(std::string(imsim_error(&sim)).find("integer multiple"), std::string::npos);
   c.fs_hz = 2000;

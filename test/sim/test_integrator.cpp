@@ -10,12 +10,12 @@ namespace {
 struct Err {
   double di, dpsi, dw, dth, imax;
 };
-Err compare(imsim_config fast, double seconds, int ref_substeps) {
-  static imsim a, b;
-  imsim_config ref = fast;
+Err compare(imsim_config_t fast, double seconds, int ref_substeps) {
+  static imsim_t a, b;
+  imsim_config_t ref = fast;
   ref.integrator = IMSIM_INTEGRATOR_RK4;
   ref.rk4_substeps = ref_substeps;
-  imsim_sample x, y;
+  imsim_sample_t x, y;
   Err e{0, 0, 0, 0, 0};
   if (imsim_init(&a, &fast, &x) != 0 || imsim_init(&b, &ref, &y) != 0) return {1e9, 1e9, 1e9, 1e9, 0};
   const long n = long(seconds * fast.fs_hz + 0.5);
@@ -33,7 +33,7 @@ Err compare(imsim_config fast, double seconds, int ref_substeps) {
 }  // namespace
 
 TEST(SimIntegrator, Rk4ReferenceIsConverged) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.integrator = IMSIM_INTEGRATOR_RK4;
   c.rk4_substeps = 8;
   const Err e = compare(c, 0.2, 16);  // RK4 x8 against RK4 x16, DOL start
@@ -45,7 +45,7 @@ TEST(SimIntegrator, Rk4ReferenceIsConverged) {
 // the observed order of convergence (expected 3: omega frozen at its predicted step mean
 // plus the leading Magnus term, Hermite quadrature for the mechanics).
 TEST(SimIntegrator, SineConvergesWithStepSizeThirdOrder) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   double prev = 0;
   for (int sps : {1, 2, 4, 8}) {
     c.steps_per_sample = sps;
@@ -68,7 +68,7 @@ TEST(SimIntegrator, SineConvergesWithStepSizeThirdOrder) {
 // the reference too; they must agree to the integrator tolerance, also with dead time and
 // the AA filter states.
 TEST(SimIntegrator, PwmEventExactAgainstReference) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
   c.pwm_moments = false;
   Err e = compare(c, 0.3, 8);
@@ -81,7 +81,7 @@ TEST(SimIntegrator, PwmEventExactAgainstReference) {
   e = compare(c, 0.3, 8);
   EXPECT_LT(e.di / e.imax, 1e-7) << e.di;
   // exp2 operating point (V/f ramp, load), steady part
-  imsim_config d = ideal("exp2");
+  imsim_config_t d = ideal("exp2");
   d.supply = IMSIM_SUPPLY_PWM;
   d.pwm_moments = false;
   e = compare(d, 3.0, 4);
@@ -93,12 +93,12 @@ TEST(SimIntegrator, PwmEventExactAgainstReference) {
 // with frozen speed but misses part of the torque ripple inside the half period: documented
 // error ~3e-5 relative (DOL start), ~1e-4 A at the exp2 operating point.
 TEST(SimIntegrator, PwmMomentsVariantDocumentedError) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
   c.pwm_moments = true;
   const Err e = compare(c, 0.3, 8);
   EXPECT_LT(e.di / e.imax, 5e-5);
-  imsim_config d = ideal("exp2");
+  imsim_config_t d = ideal("exp2");
   d.supply = IMSIM_SUPPLY_PWM;
   const Err g = compare(d, 3.0, 4);
   EXPECT_LT(g.di, 2e-4);
@@ -109,7 +109,7 @@ TEST(SimIntegrator, PwmMomentsVariantDocumentedError) {
 }
 
 TEST(SimIntegrator, IfocClosedLoopAgainstReference) {
-  imsim_config c = ideal("exp2");
+  imsim_config_t c = ideal("exp2");
   c.supply = IMSIM_SUPPLY_IFOC;
   c.pwm_moments = false;
   const Err e = compare(c, 3.0, 4);
@@ -122,7 +122,7 @@ TEST(SimIntegrator, IfocClosedLoopAgainstReference) {
 // to the integrator tolerance. The default moments variant decides once per half period (the
 // currents at its start): near a current zero crossing it can differ by a dead-time pulse.
 TEST(SimIntegrator, InverterModelAgainstReference) {
-  imsim_config c = ideal("4kw");
+  imsim_config_t c = ideal("4kw");
   add_inverter_errors(c);
   c.pwm_moments = false;
   Err e = compare(c, 0.1, 4);

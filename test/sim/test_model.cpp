@@ -11,7 +11,7 @@ namespace {
 struct Ec {
   double speed_rpm, i_rms, torque;
 };
-Ec equivalent_circuit(const imsim_config &c, double vll, double f, double load) {
+Ec equivalent_circuit(const imsim_config_t &c, double vll, double f, double load) {
   const double m = std::sqrt((1 - c.sigma) * c.ls_h * c.lr_h);
   const double lls = c.ls_h - m, llr = c.lr_h - m, rr = c.lr_h / c.tr_s;
   const double we = 2 * kPi * f, ws = we / c.pole_pairs;
@@ -39,10 +39,10 @@ Ec equivalent_circuit(const imsim_config &c, double vll, double f, double load) 
 }  // namespace
 
 TEST(SimModel, SteadyStateMatchesEquivalentCircuit) {
-  const imsim_config c = ideal();
+  const imsim_config_t c = ideal();
   struct Case { double vll, f, load; } cases[] = {{230, 60, 2.064}, {115, 30, 2.064}, {230, 60, 0.5}, {200, 50, 1.5}};
   for (const auto &k : cases) {
-    imsim_steady st;
+    imsim_steady_t st;
     ASSERT_EQ(imsim_steady_state(&c, k.vll, k.f, k.load, &st), 0);
     const Ec ec = equivalent_circuit(c, k.vll, k.f, k.load);
     EXPECT_NEAR(st.speed_rpm, ec.speed_rpm, 1e-6 * ec.speed_rpm) << k.f << " Hz";
@@ -52,8 +52,8 @@ TEST(SimModel, SteadyStateMatchesEquivalentCircuit) {
 }
 
 TEST(SimModel, NameplateFiguresOfMathSection9) {
-  const imsim_config c = ideal();
-  imsim_steady st;
+  const imsim_config_t c = ideal();
+  imsim_steady_t st;
   ASSERT_EQ(imsim_steady_state(&c, 230, 60, 2.064, &st), 0);
   EXPECT_NEAR(st.speed_rpm, 1760.8, 0.05);
   EXPECT_NEAR(st.i_rms_phase, 1.625, 0.0005);
@@ -65,7 +65,7 @@ TEST(SimModel, NameplateFiguresOfMathSection9) {
 // Time domain: started in the phasor steady state, the simulation must stay there (slip,
 // current amplitude and torque), which checks integrator and steady-state solver together.
 TEST(SimModel, TimeDomainHoldsEquivalentCircuitSteadyState) {
-  imsim_config c = ideal();
+  imsim_config_t c = ideal();
   c.load_nm = 2.064;
   c.start = IMSIM_START_STEADY;
   const Ec ec = equivalent_circuit(c, 230, 60, 2.064);
@@ -79,7 +79,7 @@ TEST(SimModel, TimeDomainHoldsEquivalentCircuitSteadyState) {
 }
 
 TEST(SimModel, DirectOnLineStartOfExp1) {
-  const imsim_config c = ideal("exp1");
+  const imsim_config_t c = ideal("exp1");
   const auto s = run(c, 8000);  // 2 s
   ASSERT_FALSE(s.empty());
   double peak = 0;
@@ -91,7 +91,7 @@ TEST(SimModel, DirectOnLineStartOfExp1) {
   EXPECT_NEAR(peak, 16.4, 0.05);          // docs/METHOD.md §9
   EXPECT_GT(t_at_speed, 0.03);
   EXPECT_LT(t_at_speed, 0.08);            // "at speed in about 50 ms"
-  imsim_steady st;
+  imsim_steady_t st;
   ASSERT_EQ(imsim_steady_state(&c, 230, 60, 0, &st), 0);
   EXPECT_NEAR(s.back().speed_rad_s, st.speed_rad_s, 1e-6);
   EXPECT_DOUBLE_EQ(s[0].t, 0.0);
@@ -102,7 +102,7 @@ TEST(SimModel, DirectOnLineStartOfExp1) {
 // Energy balance: input energy = magnetic + kinetic energy change + copper losses + friction
 // + load work. Densely sampled smooth supply, Simpson quadrature.
 TEST(SimModel, EnergyBalance) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.fs_hz = 40000;
   c.steps_per_sample = 1;
   c.load_nm = 0.8;
@@ -113,11 +113,11 @@ TEST(SimModel, EnergyBalance) {
   ASSERT_FALSE(s.empty());
   const double m = std::sqrt((1 - c.sigma) * c.ls_h * c.lr_h);
   const double sl = c.sigma * c.ls_h;
-  auto p_in = [](const imsim_sample &x) { return x.u_ab_true[0] * x.i_ab_true[0] + x.u_ab_true[1] * x.i_ab_true[1]; };
-  auto p_out = [&](const imsim_sample &x) {
+  auto p_in = [](const imsim_sample_t &x) { return x.u_ab_true[0] * x.i_ab_true[0] + x.u_ab_true[1] * x.i_ab_true[1]; };
+  auto p_out = [&](const imsim_sample_t &x) {
     return x.p_cu_stator_w + x.p_cu_rotor_w + c.b_nms * x.speed_rad_s * x.speed_rad_s + x.load_nm * x.speed_rad_s;
   };
-  auto stored = [&](const imsim_sample &x) {
+  auto stored = [&](const imsim_sample_t &x) {
     return 0.5 * sl * std::norm(iab(x)) + 0.5 * std::norm(psiab(x)) / c.lr_h + 0.5 * c.j_kgm2 * x.speed_rad_s * x.speed_rad_s;
   };
   (void)m;
@@ -130,7 +130,7 @@ TEST(SimModel, EnergyBalance) {
   // Load torque is held over each sample period at its mid-interval value, so at the step
   // sample the recorded load_nm is the new value; integrate piecewise around it.
   const double e_in = simpson(p_in, 0, 4000) + simpson(p_in, 4000, n);
-  auto p_out_before = [&](const imsim_sample &x) { return p_out(x) - (x.t >= 0.1 - 1e-12 ? x.load_nm * x.speed_rad_s : 0.0); };
+  auto p_out_before = [&](const imsim_sample_t &x) { return p_out(x) - (x.t >= 0.1 - 1e-12 ? x.load_nm * x.speed_rad_s : 0.0); };
   const double e_out = simpson(p_out_before, 0, 4000) + simpson(p_out, 4000, n);
   const double de = stored(s.back()) - stored(s.front());
   EXPECT_GT(e_in, 50.0);

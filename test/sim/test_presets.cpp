@@ -18,12 +18,12 @@ TEST(SimPresets, RatedPointNearCatalogue) {
   std::printf("[ presets  ] %-5s %9s %9s %8s %8s %7s %7s %8s %8s\n", "", "n_cat", "n_model", "I_cat", "I_model",
               "T_R", "sigma", "T_bd/T_n", "I0/I_n");
   for (const char *name : kDrives) {
-    imsim_config c;
+    imsim_config_t c;
     ASSERT_EQ(imsim_config_preset(&c, name), 0) << name;
     EXPECT_EQ(c.rated_voltage_v, 400.0);
     EXPECT_EQ(c.rated_freq_hz, 50.0);
     EXPECT_NEAR(c.rated_torque_nm * c.rated_speed_rpm * kPi / 30, c.rated_power_w, 1e-6 * c.rated_power_w);
-    imsim_steady st, s0;
+    imsim_steady_t st, s0;
     ASSERT_EQ(imsim_steady_state(&c, 400.0, 50.0, c.rated_torque_nm, &st), 0) << name;
     ASSERT_EQ(imsim_steady_state(&c, 400.0, 50.0, 0.0, &s0), 0) << name;
     // the equivalent circuit has no iron or stray losses: slip within 2 % of synchronous
@@ -35,7 +35,7 @@ TEST(SimPresets, RatedPointNearCatalogue) {
     double lo = c.rated_torque_nm, hi = 20 * c.rated_torque_nm;
     for (int it = 0; it < 60; ++it) {
       const double mid = 0.5 * (lo + hi);
-      imsim_steady t;
+      imsim_steady_t t;
       (imsim_steady_state(&c, 400.0, 50.0, mid, &t) == 0 ? lo : hi) = mid;
     }
     EXPECT_GT(lo, 2.5 * c.rated_torque_nm) << name;
@@ -49,15 +49,15 @@ TEST(SimPresets, RatedPointNearCatalogue) {
 
 TEST(SimPresets, DefaultDriveRunsAtTheSteadyState) {
   for (const char *name : kDrives) {
-    imsim_config c;
+    imsim_config_t c;
     ASSERT_EQ(imsim_config_preset(&c, name), 0) << name;
     EXPECT_EQ(c.timing, IMSIM_TIMING_FIRMWARE);
     EXPECT_EQ(c.supply, IMSIM_SUPPLY_PWM);
     EXPECT_EQ(c.start, IMSIM_START_STEADY);
-    imsim_steady st;
+    imsim_steady_t st;
     ASSERT_EQ(imsim_steady_state(&c, c.vll_v, c.freq_hz, c.load_nm, &st), 0);
-    static imsim sim;
-    imsim_sample s;
+    static imsim_t sim;
+    imsim_sample_t s;
     ASSERT_EQ(imsim_init(&sim, &c, &s), 0) << imsim_error(&sim);
     const long n = long(0.2 * c.fs_hz);
     double speed = 0, imax = 0;
@@ -66,7 +66,7 @@ TEST(SimPresets, DefaultDriveRunsAtTheSteadyState) {
       speed += s.speed_rad_s * 30 / kPi / double(n);
       for (int p = 0; p < 3; ++p) imax = std::max(imax, std::fabs(s.i_abc_true[p]));
     }
-    imsim_pwm_stats ps;
+    imsim_pwm_stats_t ps;
     imsim_get_pwm_stats(&sim, &ps);
     EXPECT_EQ(ps.clipped_half_periods, 0u) << name;
     EXPECT_LT(ps.vdc_needed_v, c.vdc_v) << name;

@@ -59,7 +59,7 @@ double residual_ratio(const std::vector<Rot> &r, double np, double s, double m, 
 // Model-exact derivatives from the simulated state (eq. (1) differentiated here, independently),
 // rotated with the exact derivative of the rotation.
 TEST(SimRegressor, ExactDerivativesSatisfyYEqualsWK) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.fs_hz = 20000;
   const auto smp = run(c, 4000);  // 0.2 s DOL start
   ASSERT_FALSE(smp.empty());
@@ -70,7 +70,7 @@ TEST(SimRegressor, ExactDerivativesSatisfyYEqualsWK) {
   const double we = 2 * kPi * c.freq_hz;
   std::vector<Rot> rec;
   for (size_t k = 1; k < smp.size(); ++k) {
-    const imsim_sample &s = smp[k];
+    const imsim_sample_t &s = smp[k];
     const cd i = iab(s), psi = psiab(s), u(s.u_ab_true[0], s.u_ab_true[1]);
     const double w = s.speed_rad_s, wd = s.accel_rad_s2, th = s.theta_true;
     const cd j(0, 1);
@@ -102,7 +102,7 @@ TEST(SimRegressor, ExactDerivativesSatisfyYEqualsWK) {
 // and angle: checks that the simulator's trajectory itself obeys the model to the accuracy
 // the estimator can see.
 TEST(SimRegressor, FiniteDifferenceDerivativesOfSimulatedTrajectory) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.fs_hz = 100000;
   c.steps_per_sample = 1;
   const auto smp = run(c, 20000);  // 0.2 s

@@ -9,7 +9,7 @@
 using namespace simtest;
 
 TEST(SimSupply, SineConventionAtSamples) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   const auto s = run(c, 200);
   ASSERT_FALSE(s.empty());
   const double a = std::sqrt(2.0 / 3.0) * 230;
@@ -36,7 +36,7 @@ TEST(SimSupply, TransformsRoundTripPowerInvariant) {
 // reference (regular sampling at the half-period centres), the instantaneous sample is a zero
 // vector, and without dead time the commanded and actual averages coincide.
 TEST(SimSupply, PwmVoltageMeasurementConventions) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
   auto s = run(c, 400);
   ASSERT_FALSE(s.empty());
@@ -54,7 +54,7 @@ TEST(SimSupply, PwmVoltageMeasurementConventions) {
   }
   // the instantaneous sample would sit in a zero vector (0 V): refused, with the alternatives
   c.vmeas = IMSIM_VMEAS_INST;
-  static imsim sim;
+  static imsim_t sim;
   ASSERT_NE(imsim_init(&sim, &c, nullptr), 0);
   EXPECT_NE(std::string(imsim_error(&sim)).find("'avg'"), std::string::npos) << imsim_error(&sim);
   // dead time: the actual average departs from the commanded one by about Vdc*td/T_half
@@ -68,7 +68,7 @@ TEST(SimSupply, PwmVoltageMeasurementConventions) {
 }
 
 TEST(SimSensors, QuantisationClippingAndEncoder) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.ideal_sensors = false;
   c.noise_lsb = 0;
   c.i_range_a = 10;  // clips the DOL start (peak 16.4 A)
@@ -97,7 +97,7 @@ TEST(SimSensors, QuantisationClippingAndEncoder) {
 }
 
 TEST(SimSensors, NoiseLevelAndSeedReproducibility) {
-  imsim_config c;
+  imsim_config_t c;
   imsim_config_preset(&c, "exp1");
   c.vll_v = 0;  // motor at rest, zero currents: the ADC output is pure noise
   c.noise_lsb = 3.0;
@@ -121,7 +121,7 @@ TEST(SimSensors, NoiseLevelAndSeedReproducibility) {
 // AA filter (2nd-order Butterworth): steady-state 60 Hz gain and phase of the measured
 // current against the true current.
 TEST(SimSensors, AntiAliasFilterResponse) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.ideal_sensors = false;
   c.adc_bits = 30;
   c.noise_lsb = 0;
@@ -145,10 +145,10 @@ TEST(SimSensors, AntiAliasFilterResponse) {
 // IFOC: tuned controller keeps |psi_R| at its reference; a detuned T_R (set at run time)
 // moves the flux off the reference.
 TEST(SimIfoc, TunedHoldsFluxDetunedDoesNot) {
-  imsim_config c = ideal("exp2");
+  imsim_config_t c = ideal("exp2");
   c.supply = IMSIM_SUPPLY_IFOC;
-  static imsim sim;
-  imsim_sample s;
+  static imsim_t sim;
+  imsim_sample_t s;
   ASSERT_EQ(imsim_init(&sim, &c, &s), 0);
   for (int k = 0; k < 4000 * 4; ++k) imsim_step(&sim, &s);
   EXPECT_NEAR(s.speed_rad_s * 30 / kPi, 850, 1.0);
@@ -165,14 +165,14 @@ TEST(SimIfoc, TunedHoldsFluxDetunedDoesNot) {
 // A bus too low for the reference clips the modulation; the statistics say how often and
 // which bus the reference needs (sine-triangle: 2 sqrt(2/3) V_ll = 375.6 V at 230 V).
 TEST(SimSupply, PwmClippingIsCounted) {
-  imsim_config c = ideal("exp1");
+  imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
-  static imsim sim;
-  imsim_pwm_stats st;
+  static imsim_t sim;
+  imsim_pwm_stats_t st;
   for (const double vdc : {400.0, 300.0}) {
     c.vdc_v = vdc;
     ASSERT_EQ(imsim_init(&sim, &c, nullptr), 0);
-    imsim_sample s;
+    imsim_sample_t s;
     for (int k = 0; k < 400; ++k) imsim_step(&sim, &s);
     imsim_get_pwm_stats(&sim, &st);
     EXPECT_EQ(st.half_periods, 400u * 5u);

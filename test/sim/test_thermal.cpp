@@ -9,13 +9,13 @@ using namespace simtest;
 // Ideal V/f supply, coarse sampling (500 Hz, 1 ms steps) to keep the test fast; the thermal
 // model only sees the copper losses, which this reproduces.
 TEST(SimThermal, OneHourOfExp2ReachesPaperTargets) {
-  imsim_config c;
+  imsim_config_t c;
   imsim_config_preset(&c, "exp2");
   c.ideal_sensors = true;
   c.fs_hz = 500;
   c.steps_per_sample = 2;
-  static imsim sim;
-  imsim_sample s;
+  static imsim_t sim;
+  imsim_sample_t s;
   ASSERT_EQ(imsim_init(&sim, &c, &s), 0);
   EXPECT_DOUBLE_EQ(s.tr_s, 0.12);
   EXPECT_DOUBLE_EQ(s.rs_ohm, 5.04);
@@ -36,7 +36,7 @@ TEST(SimThermal, OneHourOfExp2ReachesPaperTargets) {
 }
 
 TEST(SimThermal, NoThermalKeepsParametersAndSpeedupScalesTime) {
-  imsim_config c;
+  imsim_config_t c;
   imsim_config_preset(&c, "exp2");
   c.ideal_sensors = true;
   c.fs_hz = 500;

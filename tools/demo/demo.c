@@ -79,7 +79,7 @@ typedef struct {
       load;
 } truth_t;
 
-static void acc_add(acc_t *a, const imsim_sample *s)
+static void acc_add(acc_t *a, const imsim_sample_t *s)
 {
   a->n += 1.0;
   a->tr += s->tr_s;
@@ -127,17 +127,17 @@ static truth_t acc_mean(const acc_t *a)
 /* CAN: candump log, optionally teed to a live SocketCAN interface            */
 
 typedef struct {
-  struct imest_can_port port;
-  struct imest_candump_port log;
+  imest_can_port_t port;
+  imest_candump_port_t log;
 #ifdef IMEST_DEMO_HAVE_SOCKETCAN
-  struct imest_socketcan sc;
+  imest_socketcan_t sc;
 #endif
   int live;
   unsigned long live_sent, live_failed;
   imest_can_pub_t pub; /* publishes each result through this port */
 } tee_port_t;
 
-static int tee_send(void *ctx, const struct imest_can_frame *f)
+static int tee_send(void *ctx, const imest_can_frame_t *f)
 {
   tee_port_t *t = (tee_port_t *)ctx;
   const int rc = t->log.port.send(t->log.port.ctx, f);
@@ -179,7 +179,7 @@ static double now_s(void)
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void sim_config(int id, unsigned long seed, imsim_config *c)
+static void sim_config(int id, unsigned long seed, imsim_config_t *c)
 {
   if (id == EXP1) {
     imsim_config_preset(c, "exp1"); /* 60 Hz, 230 V at standstill, no load */
@@ -198,7 +198,7 @@ static void sim_config(int id, unsigned long seed, imsim_config *c)
   c->seed = seed + (unsigned long)id;
 }
 
-static void est_config(const imsim_config *c, imest_config_t *cfg)
+static void est_config(const imsim_config_t *c, imest_config_t *cfg)
 {
   imest_config_default(cfg);
   cfg->pole_pairs = 2;
@@ -234,15 +234,15 @@ static FILE *open_out(job_t *j, const char *dir, const char *name)
 static int exp1_wave(job_t *j, const char *dir, double tr_id, double rs_id)
 {
   const double dur = j->duration_s;
-  imsim_config cm, ci;
+  imsim_config_t cm, ci;
   sim_config(EXP1, j->opt->seed, &cm);
   ci = cm;
   ci.tr_s = tr_id;
   ci.rs_ohm = rs_id;
   ci.thermal = false;
   ci.ideal_sensors = true;
-  static _Thread_local imsim sm, si;
-  imsim_sample a, b;
+  static _Thread_local imsim_t sm, si;
+  imsim_sample_t a, b;
   if (imsim_init(&sm, &cm, &a) != 0 || imsim_init(&si, &ci, &b) != 0) {
     snprintf(j->err, sizeof j->err, "exp1 identified simulation: %s", imsim_error(&si));
     return -1;
@@ -255,7 +255,7 @@ static int exp1_wave(job_t *j, const char *dir, double tr_id, double rs_id)
   /* encoder speed: difference over +-10 samples (5 ms), as a drive computes it */
   enum { H = 10 };
   double th[2 * H + 1] = {0};
-  imsim_sample hist_a[H + 1], hist_b[H + 1];
+  imsim_sample_t hist_a[H + 1], hist_b[H + 1];
   for (long k = 0; k <= n + H; ++k) {
     if (k > 0) {
       imsim_step(&sm, &a);
@@ -268,7 +268,7 @@ static int exp1_wave(job_t *j, const char *dir, double tr_id, double rs_id)
     hist_a[H] = a;
     hist_b[H] = b;
     if (k < H) continue; /* row for sample k - H; its speed needs theta[k - 2H .. k] */
-    const imsim_sample *ma = &hist_a[0], *mb = &hist_b[0];
+    const imsim_sample_t *ma = &hist_a[0], *mb = &hist_b[0];
     double uab[2], iab[2];
     imsim_abc_to_ab(ma->u_abc, uab);
     imsim_abc_to_ab(ma->i_abc, iab);
@@ -291,9 +291,9 @@ typedef struct {
   job_t *j;
   const char *name;
   char dir[1024];
-  imsim_config c;
-  imsim *sim;
-  imsim_sample s;
+  imsim_config_t c;
+  imsim_t *sim;
+  imsim_sample_t s;
   imest_t *est;
   tee_port_t *tee;
   FILE *log, *csv;
@@ -338,7 +338,7 @@ static void open_live(job_t *j, tee_port_t *tee)
 /* Simulator, estimator, CAN port (candump log, live interface), output files. */
 static int job_open(job_t *j, run_t *x)
 {
-  static _Thread_local imsim sim;
+  static _Thread_local imsim_t sim;
   static _Thread_local imest_t est;
   static _Thread_local tee_port_t tee;
   memset(x, 0, sizeof *x);

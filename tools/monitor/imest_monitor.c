@@ -246,7 +246,7 @@ static void census_add(id_census_t *c, uint32_t id)
   }
 }
 
-static void handle_frame(monitor_t *m, const struct imest_can_frame *f, double t)
+static void handle_frame(monitor_t *m, const imest_can_frame_t *f, double t)
 {
   imest_can_window_t w;
   imest_can_rx_event_t ev;
@@ -431,7 +431,7 @@ static int run_log(monitor_t *m, const char *path)
   print_header(m);
   errno = 0;
   while (!g_stop && (n = getline(&line, &cap, fp)) >= 0) {
-    struct imest_can_frame f;
+    imest_can_frame_t f;
     double t = 0.0;
     const char *err = NULL;
     int r;
@@ -474,7 +474,7 @@ static int run_log(monitor_t *m, const char *path)
 #ifdef IMEST_MONITOR_SOCKETCAN
 static int run_iface(monitor_t *m, const char *ifname, double timeout_s)
 {
-  struct imest_socketcan sc;
+  imest_socketcan_t sc;
   double idle = 0.0;
   char id[24];
   if (imest_socketcan_open(&sc, ifname) != 0) {
@@ -485,7 +485,7 @@ static int run_iface(monitor_t *m, const char *ifname, double timeout_s)
   fprintf(stderr, "imest-monitor: listening on %s (base id %s)\n", ifname,
           imest_can_id_format(m->base_id, id, sizeof id));
   while (!g_stop) {
-    struct imest_can_frame f;
+    imest_can_frame_t f;
     double t = 0.0;
     const int r = imest_socketcan_recv(&sc, &f, 200, &t);
     if (r < 0) {

@@ -76,7 +76,7 @@ static int configure(const replay_opts_t *o, const replay_scan_t *s, imest_confi
 typedef struct {
   FILE *f; /* NULL: no log */
 #ifdef IMEST_HAVE_CANDUMP
-  struct imest_candump_port port;
+  imest_candump_port_t port;
   imest_can_pub_t pub; /* publishes what the background returns, as firmware would */
 #endif
 } can_log_t;

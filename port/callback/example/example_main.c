@@ -13,7 +13,7 @@
 int main(void) {
   static CAN_HandleTypeDef hcan1;
   static example_can_tx_t tx;
-  struct imest_can_callback cb;
+  imest_can_callback_t cb;
   imest_can_pub_t pub; /* the application's, next to its imest_t */
   imest_result_t r;
   unsigned int k;

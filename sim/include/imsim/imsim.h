@@ -12,8 +12,8 @@
  * Host only: never linked into the firmware. No malloc: the caller owns every struct.
  *
  * Usage:
- *   imsim_config c; imsim_config_preset(&c, "exp2"); c.supply = IMSIM_SUPPLY_PWM;
- *   imsim sim; imsim_sample s;
+ *   imsim_config_t c; imsim_config_preset(&c, "exp2"); c.supply = IMSIM_SUPPLY_PWM;
+ *   imsim_t sim; imsim_sample_t s;
  *   if (imsim_init(&sim, &c, &s) != 0) { puts(imsim_error(&sim)); }
  *   ... s holds t = 0 ...
  *   for (;;) { imsim_step(&sim, &s); ... s holds t = T, 2T, ... }
@@ -39,7 +39,7 @@ typedef enum {
   IMSIM_SUPPLY_IFOC = 3, /* IFOC current control driving the PWM inverter (or ideal stage)  */
   IMSIM_SUPPLY_EXT = 4   /* PWM inverter driven by the caller's commands, sample by sample
                             (imsim_set_duty / imsim_set_voltage), with firmware timing     */
-} imsim_supply;
+} imsim_supply_t;
 
 /* When the inverter's duties change (see sim/README.md, Firmware timing). */
 typedef enum {
@@ -47,14 +47,14 @@ typedef enum {
                                delay, duties change every half period (the default)          */
   IMSIM_TIMING_FIRMWARE = 1 /* as a drive's firmware: sample k at a carrier valley, duties
                                computed from it applied during [t_k+1, t_k+2); fs = f_c / N  */
-} imsim_timing;
+} imsim_timing_t;
 
 /* How phase references become leg duties. */
 typedef enum {
   IMSIM_MOD_SPWM = 0, /* sine-triangle, no zero sequence: V_dc >= 2 sqrt(2/3) V_ll (default)  */
   IMSIM_MOD_SVPWM = 1 /* min-max zero-sequence injection (= symmetric space-vector PWM):
                          V_dc >= sqrt(2) V_ll                                                   */
-} imsim_modulation;
+} imsim_modulation_t;
 
 typedef enum {
   IMSIM_VMEAS_AUTO = 0, /* AVG with PWM stages, INST with ideal supplies                      */
@@ -63,17 +63,17 @@ typedef enum {
   IMSIM_VMEAS_AA = 2,   /* measured phase-to-neutral voltage through the AA filter            */
   IMSIM_VMEAS_INST = 3  /* raw instantaneous sample; ideal supplies only (with PWM every sample
                            falls in a zero vector, so imsim_init refuses it)                    */
-} imsim_vmeas;
+} imsim_vmeas_t;
 
-typedef enum { IMSIM_START_REST = 0, IMSIM_START_STEADY = 1 } imsim_start;
-typedef enum { IMSIM_IFOC_SPEED = 0, IMSIM_IFOC_TORQUE = 1 } imsim_ifoc_mode;
+typedef enum { IMSIM_START_REST = 0, IMSIM_START_STEADY = 1 } imsim_start_t;
+typedef enum { IMSIM_IFOC_SPEED = 0, IMSIM_IFOC_TORQUE = 1 } imsim_ifoc_mode_t;
 typedef enum {
   IMSIM_INTEGRATOR_FAST = 0, /* exact Taylor-Horner propagation of the linear electrical part
                                 (event-exact PWM), speed frozen at a predicted mid-step value,
                                 trapezoidal/Hermite mechanics                                  */
   IMSIM_INTEGRATOR_RK4 = 1   /* reference: classic RK4 of the full nonlinear model, split at
                                 every switching instant, rk4_substeps per piece (slow)        */
-} imsim_integrator;
+} imsim_integrator_t;
 
 typedef struct {
   /* Motor (paper's notation). M = sqrt((1 - sigma) L_S L_R), R_R = L_R / T_R (cold values). */
@@ -102,7 +102,7 @@ typedef struct {
   /* Supply. vll_v = line-to-line rms, freq_hz = electrical frequency. The V/f ramp (VF, PWM)
      raises frequency and voltage linearly from 0 over vf_ramp_s (0 = apply at once);
      V_ll(f) = vf_boost_v + (vll_v - vf_boost_v) f / freq_hz. */
-  imsim_supply supply;
+  imsim_supply_t supply;
   double vll_v, freq_hz, vf_ramp_s, vf_boost_v;
 
   /* PWM inverter: regular sampled; with ideal timing the reference is sampled once per half
@@ -112,8 +112,8 @@ typedef struct {
   /* Inverter devices, per leg: a conducting switch drops v_switch_v + r_switch_ohm |i|, a
      conducting freewheeling diode v_diode_v + r_diode_ohm |i| (0 = ideal devices). */
   double v_switch_v, r_switch_ohm, v_diode_v, r_diode_ohm;
-  imsim_modulation modulation;
-  imsim_timing timing;
+  imsim_modulation_t modulation;
+  imsim_timing_t timing;
   bool pwm_moments; /* fast integrator with PWM. true (default, fast): one step per half carrier
                        period, the PWM input entering through its exact moments; the electrical
                        part is exact for the step's speed, the torque ripple inside the step is
@@ -122,7 +122,7 @@ typedef struct {
                        slower). See README. */
 
   /* IFOC (indirect field orientation, slip from the controller's T_R). */
-  imsim_ifoc_mode ifoc_mode;
+  imsim_ifoc_mode_t ifoc_mode;
   bool ifoc_ideal_stage;   /* true: ideal voltage source (ZOH per sample) instead of PWM   */
   double ifoc_tr_s;        /* controller's T_R (<= 0: use the motor's cold tr_s)            */
   double ifoc_flux_wb;     /* rotor flux reference (<= 0: rated flux of the preset)          */
@@ -145,15 +145,15 @@ typedef struct {
   double u_offset_v[3];        /* per-phase sensor offset, added before the ADC [V]         */
   double i_gain_err[3];        /* per-phase relative gain error (0.01 = reads 1 % high)     */
   double aa_hz;                /* 2nd-order Butterworth analog AA filter cut-off; 0 = none  */
-  imsim_vmeas vmeas;
+  imsim_vmeas_t vmeas;
   uint64_t seed;
 
-  imsim_start start;
-  imsim_integrator integrator;
+  imsim_start_t start;
+  imsim_integrator_t integrator;
   int rk4_substeps; /* RK4 steps per constant-input piece */
 
   double duration_s; /* used by the CLI and the benchmark only */
-} imsim_config;
+} imsim_config_t;
 
 typedef struct {
   uint64_t n; /* sample index; t = n / fs */
@@ -184,24 +184,24 @@ typedef struct {
      vdc_v: DC bus sampled at t through its ADC; vdc_true_v: the bus (NaN without PWM). */
   double duty[3];
   double vdc_v, vdc_true_v;
-} imsim_sample;
+} imsim_sample_t;
 
 /* Steady state of the model under a balanced sinusoidal supply (phasor solution of eq. (1)). */
 typedef struct {
   double speed_rad_s, speed_rpm, slip;
   double i_rms_phase, torque_nm, psi_r_wb;
   double i_ab[2], psi_ab[2]; /* alpha-beta state at supply phase 0 (u = vll + j0) */
-} imsim_steady;
+} imsim_steady_t;
 
 /* Private state. Declared here only so that the caller can own the storage (no malloc). */
-typedef struct { double re, im; } imsim_cpx_;
+typedef struct { double re, im; } imsim_cpx_t;
 typedef struct {
   uint64_t s[4]; /* xoshiro256** */
   double spare;  /* second Gaussian of the polar method */
   bool has_spare;
-} imsim_rng_;
+} imsim_rng_t;
 typedef struct {
-  imsim_config c;
+  imsim_config_t c;
   char err[320];
   /* derived constants */
   double m_h, rr0_ohm, ts_s, h_s;
@@ -209,7 +209,7 @@ typedef struct {
   /* present parameters */
   double rs, rr, tr, gamma, beta;
   /* state: 0 i, 1 psi, 2-3 AA(i), 4-5 AA(u), 6 source voltage */
-  imsim_cpx_ x[7];
+  imsim_cpx_t x[7];
   double w, th, t;
   uint64_t n;
   double te, acc; /* torque and acceleration at t */
@@ -225,7 +225,7 @@ typedef struct {
   double v_dq[2], rho, we_ctrl, t_ctrl, te_ref, id_ref, iq_ref;
   double u_zoh[2];
   /* sensors: rng for the phase channels, rng_vdc (own stream) for the bus */
-  imsim_rng_ rng, rng_vdc;
+  imsim_rng_t rng, rng_vdc;
   double i_meas_ab[2]; double th_meas;
   double vdc_meas;
   /* firmware timing: duties applied now and those computed at the last sample */
@@ -236,7 +236,7 @@ typedef struct {
   /* modulation statistics (imsim_get_pwm_stats) */
   uint64_t pwm_half_periods, pwm_clipped_half_periods;
   double pwm_vdc_needed;
-} imsim;
+} imsim_t;
 
 /* What the PWM modulator was asked for: a reference beyond the bus is clipped (the inverter
    saturates, as a real one does); these numbers let the caller say so. */
@@ -244,34 +244,34 @@ typedef struct {
   uint64_t half_periods;         /* PWM half carrier periods simulated so far                  */
   uint64_t clipped_half_periods; /* of which at least one leg's reference exceeded the bus     */
   double vdc_needed_v;           /* bus voltage that the largest reference so far would need  */
-} imsim_pwm_stats;
+} imsim_pwm_stats_t;
 
 /* Fills c with the paper's motor and the exp1 experiment (same as preset "exp1"). */
-void imsim_config_default(imsim_config *c);
+void imsim_config_default(imsim_config_t *c);
 /* name: "exp1", "exp2" (the paper's motor and experiments) or one of the industrial drives
    "4kw", "11kw", "15kw", "37kw", "75kw" (400 V 50 Hz motors on a 560 V, 8 kHz inverter with
    firmware timing, at rated load; see sim/README.md, Presets). Returns 0, or -1 for an
    unknown name (c then holds exp1). */
-int imsim_config_preset(imsim_config *c, const char *name);
+int imsim_config_preset(imsim_config_t *c, const char *name);
 /* The preset names, separated by '|'. */
 const char *imsim_preset_names(void);
 
 /* Validates c, sets up sim, and fills *first (may be NULL) with the t = 0 sample.
    Returns 0, or -1 with a message in imsim_error(sim). */
-int imsim_init(imsim *sim, const imsim_config *c, imsim_sample *first);
-const char *imsim_error(const imsim *sim);
+int imsim_init(imsim_t *sim, const imsim_config_t *c, imsim_sample_t *first);
+const char *imsim_error(const imsim_t *sim);
 
 /* Advances exactly one sample period 1/fs and fills *out with the sample at the new time. */
-void imsim_step(imsim *sim, imsim_sample *out);
+void imsim_step(imsim_t *sim, imsim_sample_t *out);
 
 /* Modulation statistics since imsim_init (all zero without a PWM stage). */
-void imsim_get_pwm_stats(const imsim *sim, imsim_pwm_stats *out);
+void imsim_get_pwm_stats(const imsim_t *sim, imsim_pwm_stats_t *out);
 
 /* Run-time controls. */
-void imsim_set_ifoc_tr(imsim *sim, double tr_s);   /* controller's T_R, takes effect at the next step */
-void imsim_set_speed_ref(imsim *sim, double rpm);  /* IFOC speed reference (no ramp)          */
-void imsim_set_torque_ref(imsim *sim, double nm);  /* IFOC torque-mode reference              */
-void imsim_set_load(imsim *sim, double load_nm);   /* overrides the load profile              */
+void imsim_set_ifoc_tr(imsim_t *sim, double tr_s);   /* controller's T_R, takes effect at the next step */
+void imsim_set_speed_ref(imsim_t *sim, double rpm);  /* IFOC speed reference (no ramp)          */
+void imsim_set_torque_ref(imsim_t *sim, double nm);  /* IFOC torque-mode reference              */
+void imsim_set_load(imsim_t *sim, double load_nm);   /* overrides the load profile              */
 
 /* External commands (supply IMSIM_SUPPLY_EXT), firmware timing: after imsim_init or
    imsim_step has returned the sample at t_k, the caller sets the command computed from it; it
@@ -282,14 +282,14 @@ void imsim_set_load(imsim *sim, double load_nm);   /* overrides the load profile
    ignored), converted to duties with the configured modulation and the bus voltage measured
    at t_k (the sample's vdc_v), clipped at the bus. Both return 0, or -1 if the supply is not
    IMSIM_SUPPLY_EXT or a value is not finite. Clipping is counted in imsim_get_pwm_stats. */
-int imsim_set_duty(imsim *sim, const double duty[3]);
-int imsim_set_voltage(imsim *sim, const double u_abc[3]);
+int imsim_set_duty(imsim_t *sim, const double duty[3]);
+int imsim_set_voltage(imsim_t *sim, const double u_abc[3]);
 
 /* Phasor steady state of the configured motor (cold parameters) at the given supply and load
    (load opposes rotation; viscous friction included). Returns 0, or -1 if the load exceeds
    the breakdown torque. */
-int imsim_steady_state(const imsim_config *c, double vll_v, double freq_hz, double load_nm,
-                       imsim_steady *out);
+int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, double load_nm,
+                       imsim_steady_t *out);
 
 /* Power-invariant transforms (docs/METHOD.md §1). */
 void imsim_abc_to_ab(const double abc[3], double ab[2]);
