@@ -11,7 +11,8 @@ extern "C" {
 #include "parser_property.h"
 }
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
   static std::string path = "/tmp/imest_fuzz_csv_" + std::to_string((long)getpid()) + ".csv";
   FILE *f = std::fopen(path.c_str(), "wb");
   if (f == nullptr) fuzz::fail("cannot write the temporary file");

@@ -15,10 +15,12 @@ extern "C" {
 }
 
 namespace {
-void check(const imest_result_t &r, const imest_config_t &c, uint32_t window_n) {
+void check(const imest_result_t &r, const imest_config_t &c, uint32_t window_n)
+{
   if (r.samples != window_n) fuzz::fail("window with a wrong sample count");
   if (r.used_samples > r.samples) fuzz::fail("used_samples > samples");
-  if (std::isfinite(r.tr_s) && !(r.tr_s >= c.tr_min_s && r.tr_s <= c.tr_max_s)) fuzz::fail("T_R outside the band");
+  if (std::isfinite(r.tr_s) && !(r.tr_s >= c.tr_min_s && r.tr_s <= c.tr_max_s))
+    fuzz::fail("T_R outside the band");
   if (!r.valid) {
     if (r.status == IMEST_OK) fuzz::fail("invalid with status OK");
     return;
@@ -30,9 +32,10 @@ void check(const imest_result_t &r, const imest_config_t &c, uint32_t window_n) 
   if (!(r.rs_ohm >= c.rs_min_ohm && r.rs_ohm <= c.rs_max_ohm)) fuzz::fail("valid with R_S outside the band");
   if (!(r.e_i <= c.max_ei && r.pe_k2_rel <= c.max_pe_k2_rel)) fuzz::fail("valid beyond the quality limits");
 }
-}  // namespace
+} // namespace
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
   fuzz::Reader in{data, size};
   const uint8_t mode = in.byte();
   imest_config_t cfg;
@@ -41,7 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
   cfg.fs_hz = 4000.0f;
-  cfg.window_s = 0.05f;  // 200 samples
+  cfg.window_s = 0.05f; // 200 samples
   cfg.start_at_rest = (mode >> 2) & 1;
   if (mode & 8) cfg.i_limit_a = 20.0f;
   if (mode & 16) cfg.u_limit_v = 400.0f;

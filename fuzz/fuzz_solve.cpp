@@ -10,7 +10,8 @@ extern "C" {
 #include "solve_property.h"
 }
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
   fuzz::Reader in{data, size};
   bg_sums_t s;
   std::memset(&s, 0, sizeof s);

@@ -9,7 +9,8 @@
 
 namespace fuzz {
 
-[[noreturn]] inline void fail(const char *what) {
+[[noreturn]] inline void fail(const char *what)
+{
   std::fprintf(stderr, "PROPERTY VIOLATED: %s\n", what);
   std::abort();
 }
@@ -17,7 +18,8 @@ namespace fuzz {
 struct Reader {
   const uint8_t *p;
   size_t n;
-  template <class T> T get(T dflt) {
+  template <class T> T get(T dflt)
+  {
     if (n < sizeof(T)) return dflt;
     T v;
     std::memcpy(&v, p, sizeof v);
@@ -28,4 +30,4 @@ struct Reader {
   uint8_t byte(uint8_t dflt = 0) { return get<uint8_t>(dflt); }
 };
 
-}  // namespace fuzz
+} // namespace fuzz

@@ -25,18 +25,24 @@
 #define FW_WINDOW_S 0.4f
 #endif
 
-void fw_mark_b0(void); void fw_mark_e0(void);
-void fw_mark_b1(void); void fw_mark_e1(void);
-void fw_mark_b2(void); void fw_mark_e2(void);
-void fw_mark_b3(void); void fw_mark_e3(void);
-void fw_mark_b4(void); void fw_mark_e4(void);
-void fw_mark_b5(void); void fw_mark_e5(void);
+void fw_mark_b0(void);
+void fw_mark_e0(void);
+void fw_mark_b1(void);
+void fw_mark_e1(void);
+void fw_mark_b2(void);
+void fw_mark_e2(void);
+void fw_mark_b3(void);
+void fw_mark_e3(void);
+void fw_mark_b4(void);
+void fw_mark_e4(void);
+void fw_mark_b5(void);
+void fw_mark_e5(void);
 uint32_t fw_standin(uint32_t n);
 uint32_t harness_stack_used(void);
 
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define SYST_CSR    (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR    (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR    (*(volatile uint32_t *)0xE000E018u)
 #define STACK_PAINT 0xC5C5C5C5u
 extern uint32_t __stack_bottom;
 
@@ -68,7 +74,10 @@ static void stat_print(const char *name, const stat_t *s)
 }
 
 /* SysTick ticks elapsed between two CVR reads (down-counter, 24 bit). */
-static uint32_t ticks(uint32_t before, uint32_t after) { return (before - after) & 0xFFFFFFu; }
+static uint32_t ticks(uint32_t before, uint32_t after)
+{
+  return (before - after) & 0xFFFFFFu;
+}
 
 #if FW_WITH_IMEST
 static uint32_t *paint_lo;

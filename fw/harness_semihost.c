@@ -1,10 +1,10 @@
 /* Minimal ARM semihosting: SYS_WRITE0 for output, SYS_EXIT to stop QEMU. */
 #include "harness_semihost.h"
 
-#define SYS_WRITE0 0x04u
-#define SYS_EXIT 0x18u
+#define SYS_WRITE0                   0x04u
+#define SYS_EXIT                     0x18u
 #define ADP_STOPPED_APPLICATION_EXIT 0x20026u
-#define ADP_STOPPED_RUNTIME_ERROR 0x20023u
+#define ADP_STOPPED_RUNTIME_ERROR    0x20023u
 
 static uint32_t sh_call(uint32_t op, const void *arg)
 {
@@ -14,7 +14,10 @@ static uint32_t sh_call(uint32_t op, const void *arg)
   return r0;
 }
 
-void sh_puts(const char *s) { (void)sh_call(SYS_WRITE0, s); }
+void sh_puts(const char *s)
+{
+  (void)sh_call(SYS_WRITE0, s);
+}
 
 void sh_putu(uint64_t v)
 {
@@ -79,6 +82,7 @@ void sh_kv(const char *key, uint64_t v)
 
 void sh_exit(int code)
 {
-  for (;;) (void)sh_call(SYS_EXIT, (const void *)(uintptr_t)(code == 0 ? ADP_STOPPED_APPLICATION_EXIT
-                                                                         : ADP_STOPPED_RUNTIME_ERROR));
+  for (;;)
+    (void)sh_call(SYS_EXIT, (const void *)(uintptr_t)(code == 0 ? ADP_STOPPED_APPLICATION_EXIT
+                                                                : ADP_STOPPED_RUNTIME_ERROR));
 }

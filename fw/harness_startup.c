@@ -11,24 +11,23 @@ int main(void);
 void Reset_Handler(void);
 void Fault_Handler(void);
 
-#define SCB_CPACR (*(volatile uint32_t *)0xE000ED88u)
+#define SCB_CPACR   (*(volatile uint32_t *)0xE000ED88u)
 #define STACK_PAINT 0xC5C5C5C5u
 
 __attribute__((naked, noreturn)) void Reset_Handler(void)
 {
   /* Paint the stack below the current frame before anything uses it. */
-  __asm__ volatile(
-      "ldr r0, =__stack_bottom\n"
-      "ldr r1, =__stack_top\n"
-      "sub r1, r1, #64\n"
-      "ldr r2, =0xC5C5C5C5\n"
-      "1: cmp r0, r1\n"
-      "bhs 2f\n"
-      "str r2, [r0], #4\n"
-      "b 1b\n"
-      "2: ldr r0, =__stack_top\n"
-      "mov sp, r0\n"
-      "b harness_c_start\n");
+  __asm__ volatile("ldr r0, =__stack_bottom\n"
+                   "ldr r1, =__stack_top\n"
+                   "sub r1, r1, #64\n"
+                   "ldr r2, =0xC5C5C5C5\n"
+                   "1: cmp r0, r1\n"
+                   "bhs 2f\n"
+                   "str r2, [r0], #4\n"
+                   "b 1b\n"
+                   "2: ldr r0, =__stack_top\n"
+                   "mov sp, r0\n"
+                   "b harness_c_start\n");
 }
 
 /* Lowest stack address ever written (stack high-water mark). */
@@ -61,10 +60,19 @@ void Fault_Handler(void)
   sh_exit(3);
 }
 
-__attribute__((section(".isr_vector"), used)) static const uintptr_t vectors[16] = {
-    (uintptr_t)&__stack_top,      (uintptr_t)Reset_Handler, (uintptr_t)Fault_Handler,
-    (uintptr_t)Fault_Handler,     (uintptr_t)Fault_Handler, (uintptr_t)Fault_Handler,
-    (uintptr_t)Fault_Handler,     0,                        0,
-    0,                            0,                        (uintptr_t)Fault_Handler,
-    (uintptr_t)Fault_Handler,     0,                        (uintptr_t)Fault_Handler,
-    (uintptr_t)Fault_Handler};
+__attribute__((section(".isr_vector"), used)) static const uintptr_t vectors[16] = {(uintptr_t)&__stack_top,
+                                                                                    (uintptr_t)Reset_Handler,
+                                                                                    (uintptr_t)Fault_Handler,
+                                                                                    (uintptr_t)Fault_Handler,
+                                                                                    (uintptr_t)Fault_Handler,
+                                                                                    (uintptr_t)Fault_Handler,
+                                                                                    (uintptr_t)Fault_Handler,
+                                                                                    0,
+                                                                                    0,
+                                                                                    0,
+                                                                                    0,
+                                                                                    (uintptr_t)Fault_Handler,
+                                                                                    (uintptr_t)Fault_Handler,
+                                                                                    0,
+                                                                                    (uintptr_t)Fault_Handler,
+                                                                                    (uintptr_t)Fault_Handler};

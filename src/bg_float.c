@@ -11,7 +11,8 @@ typedef union {
   uint64_t u;
 } bits64_t;
 
-double bg_pow2(int e) {
+double bg_pow2(int e)
+{
   if (e < -1022) e = -1022;
   if (e > 1023) e = 1023;
   bits64_t b;
@@ -19,18 +20,20 @@ double bg_pow2(int e) {
   return b.d;
 }
 
-int bg_finite(double x) {
+int bg_finite(double x)
+{
   bits64_t b;
   b.d = x;
   return ((unsigned int)(b.u >> 52) & 0x7FFu) != 0x7FFu;
 }
 
-int bg_round_log2(double x) {
+int bg_round_log2(double x)
+{
   bits64_t b;
   int off = 0;
   b.d = x;
   if (((b.u >> 52) & 0x7FFu) == 0u) { /* subnormal: make it normal */
-    b.d = x * 18446744073709551616.0;  /* 2^64 */
+    b.d = x * 18446744073709551616.0; /* 2^64 */
     off = 64;
   }
   const int ex = (int)((b.u >> 52) & 0x7FFu) - 1023;

@@ -17,8 +17,8 @@ extern "C" {
 #define BG_NOINLINE
 #endif
 
-double bg_pow2(int e);           /* 2^e, e clamped to [-1022, 1023] */
-int bg_finite(double x);         /* isfinite by the exponent bits */
+double bg_pow2(int e);   /* 2^e, e clamped to [-1022, 1023] */
+int bg_finite(double x); /* isfinite by the exponent bits */
 /* round(log2(x)) for finite x > 0, exact (mantissa compared with sqrt 2). */
 int bg_round_log2(double x);
 

@@ -40,13 +40,14 @@
 
 typedef struct {
   const bg_tables_t *t;
-  double lt;       /* L~ (scaled level) */
-  double kprof;    /* fallback k where the tables are not usable */
+  double lt;    /* L~ (scaled level) */
+  double kprof; /* fallback k where the tables are not usable */
   unsigned int nev;
 } pe_ctx_t;
 
 /* g(x) = 4 e2 (e0 - L D^2) - e1^2 (< 0 inside the level set); v = tables. */
-BG_NOINLINE static double level_g(pe_ctx_t *c, double x, double v[3]) {
+BG_NOINLINE static double level_g(pe_ctx_t *c, double x, double v[3])
+{
   ++c->nev;
   bg_tables_values(c->t, x, v);
   const double dd = x * x + c->t->cw;
@@ -54,14 +55,16 @@ BG_NOINLINE static double level_g(pe_ctx_t *c, double x, double v[3]) {
 }
 
 /* Profile level function for the crossings: a large positive value where undefined. */
-static double level_fn(pe_ctx_t *c, double x) {
+static double level_fn(pe_ctx_t *c, double x)
+{
   double v[3];
   const double g = level_g(c, x, v);
   return (v[0] > 0.0 && bg_finite(g)) ? g : DBL_MAX;
 }
 
 /* sign = +1: k+(x); sign = -1: -k-(x) (both to be maximised). */
-BG_NOINLINE static double kbound(pe_ctx_t *c, double x, int sign) {
+BG_NOINLINE static double kbound(pe_ctx_t *c, double x, int sign)
+{
   double v[3];
   const double g = level_g(c, x, v);
   double k;
@@ -75,7 +78,8 @@ BG_NOINLINE static double kbound(pe_ctx_t *c, double x, int sign) {
 }
 
 /* Illinois on [x0, x1] with f0 < 0 <= f1 (either order); xs = kappa*. */
-BG_NOINLINE static double illinois(pe_ctx_t *c, double xs, double x0, double f0, double x1, double f1) {
+BG_NOINLINE static double illinois(pe_ctx_t *c, double xs, double x0, double f0, double x1, double f1)
+{
   int retained = 0; /* +1: x0 kept last time, -1: x1 kept last time */
   double x = x1;
   for (int it = 0; it < BG_PE_MAX_ROOT; ++it) {
@@ -102,7 +106,9 @@ BG_NOINLINE static double illinois(pe_ctx_t *c, double xs, double x0, double f0,
 
 /* First crossing of the profile with L on one side of xs; 1 if found (in *xc),
  * 0 if the band edge is reached first (*xc = edge). */
-BG_NOINLINE static int crossing(pe_ctx_t *c, double xs, double fs, double d0, double edge, int dir, double *xc) {
+BG_NOINLINE static int crossing(pe_ctx_t *c, double xs, double fs, double d0, double edge, int dir,
+                                double *xc)
+{
   double xprev = xs, fprev = fs, step = d0;
   for (int j = 0; j < BG_PE_MAX_PROBE; ++j) {
     double x = xs + (double)dir * step;
@@ -127,7 +133,8 @@ BG_NOINLINE static int crossing(pe_ctx_t *c, double xs, double fs, double d0, do
 
 /* Maximum of kbound(., sign) on [a, b] by successive parabolic interpolation
  * from x0 with spacing h (see the file comment). */
-BG_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, double x0, double h) {
+BG_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, double x0, double h)
+{
   if (!(b > a)) return kbound(c, a, sign);
   if (!(h > 0.0) || h > 0.25 * (b - a)) h = 0.25 * (b - a);
   if (x0 < a + h) x0 = a + h;
@@ -144,13 +151,23 @@ BG_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, doub
         u = xa - 1.618 * (xb - xa);
         if (u < a) u = a;
         const double fu = kbound(c, u, sign);
-        xc = xb; fc = fb; xb = xa; fb = fa; xa = u; fa = fu;
+        xc = xb;
+        fc = fb;
+        xb = xa;
+        fb = fa;
+        xa = u;
+        fa = fu;
       } else {
         if (xc >= b) break;
         u = xc + 1.618 * (xc - xb);
         if (u > b) u = b;
         const double fu = kbound(c, u, sign);
-        xa = xb; fa = fb; xb = xc; fb = fc; xc = u; fc = fu;
+        xa = xb;
+        fa = fb;
+        xb = xc;
+        fb = fc;
+        xc = u;
+        fc = fu;
       }
       continue;
     }
@@ -163,10 +180,23 @@ BG_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, doub
     if (fabs(u - xb) <= tol) break;
     const double fu = kbound(c, u, sign);
     if (fu >= fb) { /* u becomes the middle */
-      if (u < xb) { xc = xb; fc = fb; } else { xa = xb; fa = fb; }
-      xb = u; fb = fu;
+      if (u < xb) {
+        xc = xb;
+        fc = fb;
+      } else {
+        xa = xb;
+        fa = fb;
+      }
+      xb = u;
+      fb = fu;
     } else { /* u becomes an outer point */
-      if (u < xb) { xa = u; fa = fu; } else { xc = u; fc = fu; }
+      if (u < xb) {
+        xa = u;
+        fa = fu;
+      } else {
+        xc = u;
+        fc = fu;
+      }
     }
   }
   double f = fb;
@@ -175,12 +205,14 @@ BG_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, doub
   return f;
 }
 
-static double finite_or_unbounded(double v) {
+static double finite_or_unbounded(double v)
+{
   return (bg_finite(v) && v >= 0.0 && v < BG_PE_UNBOUNDED) ? v : BG_PE_UNBOUNDED;
 }
 
 unsigned int bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, const bg_cand_t *best,
-                           bg_solve_out_t *out) {
+                        bg_solve_out_t *out)
+{
   const double x = best->kappa, k = best->k;
   bg_tabval_t v;
   bg_tables_eval(t, x, &v);
@@ -235,8 +267,10 @@ unsigned int bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, const b
   const double x_lo_edge = 1.0 / (cfg->tr_max_s * t->s);
   const double x_hi_edge = 1.0 / (cfg->tr_min_s * t->s);
   double xlo, xhi;
-  if (!crossing(&c, x, fs, d0, (x_lo_edge < x) ? x_lo_edge : x, -1, &xlo)) out->pe_flags |= BG_PE_FLAG_K2_LO_EDGE;
-  if (!crossing(&c, x, fs, d0, (x_hi_edge > x) ? x_hi_edge : x, +1, &xhi)) out->pe_flags |= BG_PE_FLAG_K2_HI_EDGE;
+  if (!crossing(&c, x, fs, d0, (x_lo_edge < x) ? x_lo_edge : x, -1, &xlo))
+    out->pe_flags |= BG_PE_FLAG_K2_LO_EDGE;
+  if (!crossing(&c, x, fs, d0, (x_hi_edge > x) ? x_hi_edge : x, +1, &xhi))
+    out->pe_flags |= BG_PE_FLAG_K2_HI_EDGE;
   const double dxm = (xhi - x > x - xlo) ? xhi - x : x - xlo;
   out->pe_k2 = finite_or_unbounded(dxm * t->s);
 

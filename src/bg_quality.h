@@ -10,7 +10,7 @@
 extern "C" {
 #endif
 
-#define BG_PE_UNBOUNDED 1e30 /* PE reported when it has no finite meaning (H not PD) */
+#define BG_PE_UNBOUNDED       1e30 /* PE reported when it has no finite meaning (H not PD) */
 #define BG_PE_FLAG_K2_LO_EDGE 0x1u /* no crossing below K2*: distance to the band edge reported */
 #define BG_PE_FLAG_K2_HI_EDGE 0x2u /* no crossing above K2*: distance to the band edge reported */
 #define BG_PE_FLAG_DEGENERATE 0x4u /* E* <= 0: indices are 0 */
@@ -19,8 +19,8 @@ extern "C" {
 /* Hessian, positive definiteness, quadratic and exact PE indices at the
  * selected candidate; writes hessian, hessian_pd, pe_k1, pe_k2, pe_quad,
  * pe_flags of out. Returns the number of profile evaluations used. */
-unsigned int bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg,
-                           const bg_cand_t *best, bg_solve_out_t *out);
+unsigned int bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, const bg_cand_t *best,
+                        bg_solve_out_t *out);
 
 #ifdef __cplusplus
 }

@@ -7,7 +7,8 @@
 #include "bg_resultant.h"
 
 /* out[0..na+nb-2] (+)= conv(a[0..na-1], b[0..nb-1]), sign = +1 or -1 */
-static void conv_acc(const double *a, int na, const double *b, int nb, double *out, int clear, double sign) {
+static void conv_acc(const double *a, int na, const double *b, int nb, double *out, int clear, double sign)
+{
   if (clear)
     for (int k = 0; k < na + nb - 1; ++k) out[k] = 0.0;
   for (int i = 0; i < na; ++i) {
@@ -16,7 +17,8 @@ static void conv_acc(const double *a, int na, const double *b, int nb, double *o
   }
 }
 
-void bg_resultant(const bg_tables_t *t, double r[22], int generic) {
+void bg_resultant(const bg_tables_t *t, double r[22], int generic)
+{
   double u[15];  /* a0 bw2 - a1 bw1 */
   double sq[13]; /* a1 a1 */
   conv_acc(t->a0, 8, t->bw2, 8, u, 1, 1.0);

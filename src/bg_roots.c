@@ -76,25 +76,25 @@
 
 #ifdef BG_ROOTS_DOUBLE
 typedef double sreal_t;
-#define SR_TOL (64.0 * DBL_EPSILON)
+#define SR_TOL    (64.0 * DBL_EPSILON)
 #define SR_ABS(x) fabs(x)
 #else
 typedef float sreal_t;
-#define SR_TOL (16.0f * FLT_EPSILON)
+#define SR_TOL    (16.0f * FLT_EPSILON)
 #define SR_ABS(x) fabsf(x)
 #endif
 
-#define NMAX BG_POLY_MAXDEG
-#define REFINE_REL ((sreal_t)9.5367431640625e-07) /* 2^-20 */
+#define NMAX        BG_POLY_MAXDEG
+#define REFINE_REL  ((sreal_t)9.5367431640625e-07) /* 2^-20 */
 #define NEWTON_STOP 9.313225746154785e-10          /* 2^-30 */
-#define DOMAIN_TOP ((sreal_t)1.00390625)           /* 1 + 2^-8: the domains overlap */
+#define DOMAIN_TOP  ((sreal_t)1.00390625)          /* 1 + 2^-8: the domains overlap */
 /* Domains in kappa: (0,1] on p, (1,16] on p(16y), (16,256] on p(256y), each
  * y in (1/16 - 2^-12, 1 + 2^-8], and (256, inf) on q(z/256), q the reversed p. */
-#define DOMAINS ((int)BG_ROOTS_DOMAINS)
+#define DOMAINS     ((int)BG_ROOTS_DOMAINS)
 static const int DOMAIN_EXP[DOMAINS] = {0, 4, 8, 8};
 static const int DOMAIN_REV[DOMAINS] = {0, 0, 0, 1};
 static const double DOMAIN_LO[DOMAINS] = {0.0, 0.062255859375, 0.062255859375, 0.0};
-#define MERGE_REL 1.4551915228366852e-11           /* 2^-36 */
+#define MERGE_REL 1.4551915228366852e-11 /* 2^-36 */
 
 #define CHAIN_CAP (((NMAX) + 1) * ((NMAX) + 2) / 2)
 typedef struct {
@@ -110,23 +110,32 @@ typedef struct {
   short va, vb, depth;
 } ival_t;
 
-static int sgn_s(sreal_t v) { return (v > 0) - (v < 0); }
-static int sgn_d(double v) { return (v > 0.0) - (v < 0.0); }
+static int sgn_s(sreal_t v)
+{
+  return (v > 0) - (v < 0);
+}
+static int sgn_d(double v)
+{
+  return (v > 0.0) - (v < 0.0);
+}
 
-static sreal_t horner_s(const sreal_t *c, int n, sreal_t x) {
+static sreal_t horner_s(const sreal_t *c, int n, sreal_t x)
+{
   sreal_t p = c[n];
   for (int k = n - 1; k >= 0; --k) p = p * x + c[k];
   return p;
 }
 
-double bg_poly_eval(const double *c, int deg, double x) {
+double bg_poly_eval(const double *c, int deg, double x)
+{
   double p = c[deg];
   for (int k = deg - 1; k >= 0; --k) p = p * x + c[k];
   return p;
 }
 
 /* f = p^(order)(x), df = p^(order+1)(x), order 0 (two Horner passes) or 1 (three). */
-BG_NOINLINE static void eval_d(const double *c, int n, int order, double x, double *f, double *df) {
+BG_NOINLINE static void eval_d(const double *c, int n, int order, double x, double *f, double *df)
+{
   double p = c[n], p1 = 0.0, p2 = 0.0;
   if (order == 0) {
     for (int k = n - 1; k >= 0; --k) {
@@ -147,21 +156,24 @@ BG_NOINLINE static void eval_d(const double *c, int n, int order, double x, doub
 }
 
 /* p^(order)(x) alone (order 0: one Horner pass). */
-BG_NOINLINE static double eval_v(const double *c, int n, int order, double x) {
+BG_NOINLINE static double eval_v(const double *c, int n, int order, double x)
+{
   if (order == 0) return bg_poly_eval(c, n, x);
   double f, df;
   eval_d(c, n, 1, x, &f, &df);
   return f;
 }
 
-BG_NOINLINE static double abs_sum_d(const double *c, int n, double x) {
+BG_NOINLINE static double abs_sum_d(const double *c, int n, double x)
+{
   double p = 0.0;
   for (int k = n; k >= 0; --k) p = p * fabs(x) + fabs(c[k]);
   return p;
 }
 
 /* Normalise P_k to max|c| = 1 (optionally negated) and drop small leading terms. */
-BG_NOINLINE static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
+BG_NOINLINE static void chain_normalise(chain_t *ch, int k, sreal_t sign)
+{
   sreal_t *c = CH(ch, k);
   int d = ch->deg[k];
   sreal_t mx = 0;
@@ -175,7 +187,8 @@ BG_NOINLINE static void chain_normalise(chain_t *ch, int k, sreal_t sign) {
   ch->deg[k] = (short)d;
 }
 
-BG_NOINLINE static void chain_build(chain_t *ch, const double *pd, int n) {
+BG_NOINLINE static void chain_build(chain_t *ch, const double *pd, int n)
+{
   for (int k = 0, o = 0; k <= n; ++k) { /* P_k has degree <= n - k */
     ch->off[k] = (short)o;
     o += n - k + 1;
@@ -214,7 +227,8 @@ BG_NOINLINE static void chain_build(chain_t *ch, const double *pd, int n) {
   }
 }
 
-static int sign_changes(const chain_t *ch, sreal_t x, bg_roots_stats_t *st) {
+static int sign_changes(const chain_t *ch, sreal_t x, bg_roots_stats_t *st)
+{
   int v = 0, last = 0;
   ++st->sturm_evals;
   for (int k = 0; k < ch->len; ++k) {
@@ -230,7 +244,8 @@ static int sign_changes(const chain_t *ch, sreal_t x, bg_roots_stats_t *st) {
 /* Safeguarded Newton on p^(order) in [a,b], where the signs at a and b differ
  * (fa is the value at a). */
 BG_NOINLINE static double newton_bracketed(const double *c, int n, int order, double a, double b, double fa,
-                               bg_roots_stats_t *st) {
+                                           bg_roots_stats_t *st)
+{
   double x = 0.5 * (a + b);
   int prev_newton = 0;
   for (int it = 0; it < BG_ROOTS_MAX_POLISH; ++it) {
@@ -258,8 +273,9 @@ BG_NOINLINE static double newton_bracketed(const double *c, int n, int order, do
 
 /* Find a float64 sign change of p^(order) on [a,b] or a widening of it within
  * [lo,hi]; then polish. Returns 1 and *root on success. */
-BG_NOINLINE static int polish_order(const double *c, int n, int order, double a, double b, double lo, double hi,
-                        double *root, bg_roots_stats_t *st) {
+BG_NOINLINE static int polish_order(const double *c, int n, int order, double a, double b, double lo,
+                                    double hi, double *root, bg_roots_stats_t *st)
+{
   double fa = eval_v(c, n, order, a), fb = eval_v(c, n, order, b);
   st->polish_evals += 2;
   if (fa == 0.0) {
@@ -318,7 +334,8 @@ BG_NOINLINE static int polish_order(const double *c, int n, int order, double a,
 }
 
 static int polish(const double *c, int n, double a, double b, double lo, double hi, double *root,
-                  bg_roots_stats_t *st) {
+                  bg_roots_stats_t *st)
+{
   const double ext = (hi - lo) * 0.0625;
   lo = (lo - ext > 0.0) ? lo - ext : 0.0;
   hi = hi + ext;
@@ -337,7 +354,9 @@ static int polish(const double *c, int n, double a, double b, double lo, double 
 
 /* Refine one interval (count >= 1) in chain precision and polish it in float64.
  * Returns 0 (rejected), 1 (float64 sign change: odd multiplicity) or 2 (even). */
-BG_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root, bg_roots_stats_t *st) {
+BG_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root,
+                              bg_roots_stats_t *st)
+{
   const double lo = (double)iv.a, hi = (double)iv.b;
   sreal_t a = iv.a, b = iv.b;
   const sreal_t *p0 = CH(ch, 0);
@@ -392,7 +411,8 @@ BG_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t
  * (0, 2^-16 .. 2^-1, 0.75, TOP: BG_ROOTS_RESCUE_CELLS cells) and every grid cell with a sign
  * change and no root yet is solved by the bracketed float64 Newton. */
 BG_NOINLINE static int parity_rescue(const double *pd, int n, double ylo, double *out, int *odd, int nout,
-                         bg_roots_stats_t *st) {
+                                     bg_roots_stats_t *st)
+{
   const double top = (double)DOMAIN_TOP;
   const double ftop = bg_poly_eval(pd, n, top);
   double flo = pd[0];
@@ -427,7 +447,8 @@ BG_NOINLINE static int parity_rescue(const double *pd, int n, double ylo, double
 }
 
 /* Roots of pd (float64, normalised, degree n >= 1, pd[0] != 0) in (ylo, 1 + 2^-8]. */
-static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double *out, bg_roots_stats_t *st) {
+static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double *out, bg_roots_stats_t *st)
+{
   ival_t stack[BG_ROOTS_MAX_DEPTH + 2];
   int odd[NMAX];
   int top = 0, nout = 0, splits = 0;
@@ -482,7 +503,8 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double
 
 /* Insert x into the ascending roots[0..*nr-1] (at most max), dropping it if a
  * root within MERGE_REL lies next to it; when full, the largest is dropped. */
-BG_NOINLINE static void merge_root(double x, double *roots, int *nr, int max, bg_roots_stats_t *st) {
+BG_NOINLINE static void merge_root(double x, double *roots, int *nr, int max, bg_roots_stats_t *st)
+{
   if (!(x > 0.0) || !bg_finite(x)) {
     ++st->rejected;
     return;
@@ -500,7 +522,8 @@ BG_NOINLINE static void merge_root(double x, double *roots, int *nr, int max, bg
   if (*nr < max) ++*nr;
 }
 
-int bg_roots_positive_ex(const double *c, int deg, double *roots, int max, bg_roots_stats_t *st) {
+int bg_roots_positive_ex(const double *c, int deg, double *roots, int max, bg_roots_stats_t *st)
+{
   bg_roots_stats_t dummy;
   if (st == 0) st = &dummy;
   st->sturm_evals = st->bisect_steps = st->polish_evals = st->chain_len = 0;
@@ -548,6 +571,7 @@ int bg_roots_positive_ex(const double *c, int deg, double *roots, int max, bg_ro
   return nr;
 }
 
-int bg_roots_positive(const double *c, int deg, double *roots, int max) {
+int bg_roots_positive(const double *c, int deg, double *roots, int max)
+{
   return bg_roots_positive_ex(c, deg, roots, max, 0);
 }

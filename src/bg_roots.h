@@ -18,21 +18,20 @@ extern "C" {
  * Returns the number of roots written to roots[] (ascending, at most max), or
  * -1 for a non-finite or all-zero polynomial or a bad deg. */
 typedef struct {
-  unsigned int sturm_evals;   /* evaluations of the sign-change count V(x) */
-  unsigned int bisect_steps;  /* sign or count bisection steps (chain precision) */
-  unsigned int polish_evals;  /* float64 polynomial evaluations in the polish */
-  unsigned int chain_len;     /* longest Sturm chain built (number of polynomials) */
-  unsigned int unresolved;    /* clusters that could not be separated (reported once) */
-  unsigned int rejected;      /* isolated intervals whose float64 check failed */
-  unsigned int merged;        /* duplicates merged (a root found from both sides of 1) */
-  unsigned int rescues;       /* domains where the float64 parity check triggered the grid rescue */
-  double max_chain_rel;       /* largest |polished - chain-precision estimate| / root, in the
+  unsigned int sturm_evals;  /* evaluations of the sign-change count V(x) */
+  unsigned int bisect_steps; /* sign or count bisection steps (chain precision) */
+  unsigned int polish_evals; /* float64 polynomial evaluations in the polish */
+  unsigned int chain_len;    /* longest Sturm chain built (number of polynomials) */
+  unsigned int unresolved;   /* clusters that could not be separated (reported once) */
+  unsigned int rejected;     /* isolated intervals whose float64 check failed */
+  unsigned int merged;       /* duplicates merged (a root found from both sides of 1) */
+  unsigned int rescues;      /* domains where the float64 parity check triggered the grid rescue */
+  double max_chain_rel;      /* largest |polished - chain-precision estimate| / root, in the
                                  domain variable: what the chain precision alone would give */
 } bg_roots_stats_t;
 
 int bg_roots_positive(const double *c, int deg, double *roots, int max);
-int bg_roots_positive_ex(const double *c, int deg, double *roots, int max,
-                                 bg_roots_stats_t *st);
+int bg_roots_positive_ex(const double *c, int deg, double *roots, int max, bg_roots_stats_t *st);
 
 /* Horner evaluation of sum_k c[k] x^k (float64). */
 double bg_poly_eval(const double *c, int deg, double x);

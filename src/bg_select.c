@@ -14,14 +14,16 @@
  * The admissible candidate with the least E_w is selected (first one on a tie). */
 #include "bg_select.h"
 
-static int centred_ok(const bg_sums_t *in) {
+static int centred_ok(const bg_sums_t *in)
+{
   if (!in->centred || !bg_finite(in->ree)) return 0;
   for (int i = 0; i < 8; ++i)
     if (!bg_finite(in->c0[i]) || !bg_finite(in->rwe[i])) return 0;
   return 1;
 }
 
-double bg_e_centred(const bg_sums_t *in, double k1, double k2) {
+double bg_e_centred(const bg_sums_t *in, double k1, double k2)
+{
   const double ik = 1.0 / k2, ik2 = ik * ik;
   const double K[8] = {k1, k2, k2 * k2, k1 * k2, ik, k1 * ik, k1 * ik2, ik2};
   double d[8];
@@ -37,7 +39,8 @@ double bg_e_centred(const bg_sums_t *in, double k1, double k2) {
 }
 
 int bg_select(const bg_tables_t *t, const double *kappa, int n, const bg_solve_cfg_t *cfg,
-                 const bg_sums_t *in, bg_cand_t *best, bg_cand_t *cand, unsigned int *n_admissible) {
+              const bg_sums_t *in, bg_cand_t *best, bg_cand_t *cand, unsigned int *n_admissible)
+{
   int ib = -1;
   unsigned int nad = 0;
   const int centred = centred_ok(in);
@@ -63,9 +66,9 @@ int bg_select(const bg_tables_t *t, const double *kappa, int n, const bg_solve_c
     c->k2 = x * t->s;
     c->tr_s = 1.0 / c->k2;
     c->rs_ohm = cfg->sigma * cfg->ls_h * c->k1 - (1.0 - cfg->sigma) * cfg->ls_h * c->k2;
-    c->admissible = bg_finite(c->k1) && bg_finite(c->k2) && bg_finite(c->tr_s) &&
-                    bg_finite(c->rs_ohm) && a1 > 0.0 && c->k1 > 0.0 && c->k2 > 0.0 &&
-                    c->tr_s >= cfg->tr_min_s && c->tr_s <= cfg->tr_max_s;
+    c->admissible = bg_finite(c->k1) && bg_finite(c->k2) && bg_finite(c->tr_s) && bg_finite(c->rs_ohm) &&
+                    a1 > 0.0 && c->k1 > 0.0 && c->k2 > 0.0 && c->tr_s >= cfg->tr_min_s &&
+                    c->tr_s <= cfg->tr_max_s;
     if (c->admissible && centred) c->e = bg_e_centred(in, c->k1, c->k2);
     c->ew = c->e * w;
     c->admissible = c->admissible && bg_finite(c->e) && bg_finite(c->ew) && c->e >= floor_e;

@@ -19,13 +19,15 @@
 #include "bg_quality.h"
 #include "bg_resultant.h"
 
-static int cfg_ok(const bg_solve_cfg_t *cfg) {
+static int cfg_ok(const bg_solve_cfg_t *cfg)
+{
   return bg_finite(cfg->sigma) && cfg->sigma > 0.0 && cfg->sigma < 1.0 && bg_finite(cfg->ls_h) &&
          cfg->ls_h > 0.0 && bg_finite(cfg->tr_min_s) && bg_finite(cfg->tr_max_s) && cfg->tr_min_s > 0.0 &&
          cfg->tr_max_s > cfg->tr_min_s && bg_finite(cfg->weight_c) && cfg->weight_c >= 0.0;
 }
 
-double bg_solve_weight_c(const bg_sums_t *in) {
+double bg_solve_weight_c(const bg_sums_t *in)
+{
   if (in == 0) return 0.0;
   const double r44 = in->rw[3][3], r66 = in->rw[5][5];
   if (!(bg_finite(r44) && bg_finite(r66) && r44 > 0.0 && r66 >= 0.0)) return 0.0;
@@ -33,8 +35,8 @@ double bg_solve_weight_c(const bg_sums_t *in) {
   return bg_finite(c) ? c : 0.0;
 }
 
-int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *out,
-                   bg_solve_stats_t *stats) {
+int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *out, bg_solve_stats_t *stats)
+{
   bg_solve_stats_t local;
   if (stats == 0) stats = &local;
   stats->quality_evals = 0;
@@ -91,10 +93,9 @@ int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *
   stats->quality_evals = bg_quality(&t, cfg, c, out);
   out->work += stats->quality_evals;
 
-  const int finite = bg_finite(out->e_i) && bg_finite(out->hessian[0][0]) &&
-                     bg_finite(out->hessian[0][1]) && bg_finite(out->hessian[1][1]) &&
-                     bg_finite(out->pe_k1) && bg_finite(out->pe_k2) && bg_finite(out->pe_quad[0]) &&
-                     bg_finite(out->pe_quad[1]);
+  const int finite = bg_finite(out->e_i) && bg_finite(out->hessian[0][0]) && bg_finite(out->hessian[0][1]) &&
+                     bg_finite(out->hessian[1][1]) && bg_finite(out->pe_k1) && bg_finite(out->pe_k2) &&
+                     bg_finite(out->pe_quad[0]) && bg_finite(out->pe_quad[1]);
   if (!finite) {
     out->hessian_pd = 0;
     return out->status = IMEST_REASON_NUMERIC;
@@ -102,6 +103,7 @@ int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *
   return out->status = IMEST_OK;
 }
 
-int bg_solve(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *out) {
+int bg_solve(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *out)
+{
   return bg_solve_ex(in, cfg, out, 0);
 }

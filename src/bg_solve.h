@@ -48,22 +48,22 @@ typedef struct {
 } bg_solve_cfg_t;
 
 typedef struct {
-  int status;                 /* IMEST_OK, IMEST_REASON_NUMERIC or IMEST_REASON_NO_ROOT */
-  unsigned int n_roots;       /* positive roots of the resultant */
-  unsigned int n_admissible;  /* of which K1 > 0 and T_R in band */
+  int status;                /* IMEST_OK, IMEST_REASON_NUMERIC or IMEST_REASON_NO_ROOT */
+  unsigned int n_roots;      /* positive roots of the resultant */
+  unsigned int n_admissible; /* of which K1 > 0 and T_R in band */
   double roots_k2[IMEST_MAX_ROOTS];
-  double k1, k2;              /* selected minimiser */
+  double k1, k2; /* selected minimiser */
   double tr_s, rs_ohm;
-  double e;                   /* the paper's E_p^2 at the minimiser (unscaled) */
-  double e_i;                 /* sqrt(E_p^2 / R_y) */
-  double e_w;                 /* the minimised cost E_w at the minimiser (= e if weight_c = 0) */
-  double hessian[2][2];       /* of E_w (the minimised cost), unscaled, in (K1, K2) */
+  double e;             /* the paper's E_p^2 at the minimiser (unscaled) */
+  double e_i;           /* sqrt(E_p^2 / R_y) */
+  double e_w;           /* the minimised cost E_w at the minimiser (= e if weight_c = 0) */
+  double hessian[2][2]; /* of E_w (the minimised cost), unscaled, in (K1, K2) */
   int hessian_pd;
-  double pe_k1, pe_k2;        /* parametric error indices (absolute), docs/METHOD.md §7, of E_w */
-  double pe_quad[2];          /* quadratic approximations sqrt(0.5 E (H^-1)_ii) */
+  double pe_k1, pe_k2;              /* parametric error indices (absolute), docs/METHOD.md §7, of E_w */
+  double pe_quad[2];                /* quadratic approximations sqrt(0.5 E (H^-1)_ii) */
   double scale_s, scale_g, scale_c; /* the power-of-two scalings used */
-  unsigned int pe_flags;      /* BG_PE_FLAG_* (bg_quality.h): how the PE indices were obtained */
-  unsigned int work;          /* iterations used (Sturm evaluations + bisection + polish +
+  unsigned int pe_flags;            /* BG_PE_FLAG_* (bg_quality.h): how the PE indices were obtained */
+  unsigned int work;                /* iterations used (Sturm evaluations + bisection + polish +
                                  quality evaluations); bounded, see bg_solve.c */
 } bg_solve_out_t;
 
@@ -82,12 +82,10 @@ typedef struct {
 } bg_solve_stats_t;
 
 /* bg_solve with optional instrumentation (stats may be NULL). */
-int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *out,
-                bg_solve_stats_t *stats);
+int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *out, bg_solve_stats_t *stats);
 
 #ifdef __cplusplus
 }
 #endif
-
 
 #endif /* IMEST_BG_SOLVE_H */

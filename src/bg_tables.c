@@ -13,13 +13,14 @@
 static const int EXP_E[8] = {1, 0, 0, 1, 0, 1, 1, 0};
 static const int EXP_F[8] = {0, 1, 2, 1, -1, -1, -2, -2};
 
-
-static double *table_of(bg_tables_t *t, int order) {
+static double *table_of(bg_tables_t *t, int order)
+{
   return (order == 2) ? t->e2 : (order == 1) ? t->e1 : t->e0;
 }
 
 /* bw[j] = (j-5) t[j-1] + cw (j+1) t[j+1], j = 0..len (t has len entries). */
-BG_NOINLINE static void weighted_b(const double *tab, int len, double cw, double *bw) {
+BG_NOINLINE static void weighted_b(const double *tab, int len, double cw, double *bw)
+{
   for (int j = 0; j <= len; ++j) {
     double v = (j >= 1) ? (double)(j - 5) * tab[j - 1] : 0.0;
     if (cw != 0.0 && j + 1 < len) v += cw * (double)(j + 1) * tab[j + 1];
@@ -27,20 +28,23 @@ BG_NOINLINE static void weighted_b(const double *tab, int len, double cw, double
   }
 }
 
-void bg_tables_weight(bg_tables_t *t, double weight_c) {
+void bg_tables_weight(bg_tables_t *t, double weight_c)
+{
   t->cw = weight_c * bg_pow2(-2 * t->sexp);
   weighted_b(t->e2, 7, t->cw, t->bw2);
   weighted_b(t->e1, 8, t->cw, t->bw1);
   weighted_b(t->e0, 9, t->cw, t->bw0);
 }
 
-BG_NOINLINE static void p_coefficients(bg_tables_t *t) {
+BG_NOINLINE static void p_coefficients(bg_tables_t *t)
+{
   for (int m = 0; m < 7; ++m) t->a1[m] = 2.0 * t->e2[m];
   for (int m = 0; m < 8; ++m) t->a0[m] = t->e1[m];
   bg_tables_weight(t, 0.0);
 }
 
-BG_NOINLINE void bg_tables_scaled(const bg_sums_t *in, int sexp, int gexp, int cexp, bg_tables_t *t) {
+BG_NOINLINE void bg_tables_scaled(const bg_sums_t *in, int sexp, int gexp, int cexp, bg_tables_t *t)
+{
   t->sexp = sexp;
   t->gexp = gexp;
   t->cexp = cexp;
@@ -74,19 +78,22 @@ BG_NOINLINE void bg_tables_scaled(const bg_sums_t *in, int sexp, int gexp, int c
   p_coefficients(t);
 }
 
-static int all_finite(const double *v, int n) {
+static int all_finite(const double *v, int n)
+{
   for (int i = 0; i < n; ++i)
     if (!bg_finite(v[i])) return 0;
   return 1;
 }
 
-int bg_tables_build(const bg_sums_t *in, double tr_nominal_s, bg_tables_t *t) {
+int bg_tables_build(const bg_sums_t *in, double tr_nominal_s, bg_tables_t *t)
+{
   if (!all_finite(&in->rw[0][0], 64) || !all_finite(in->rwy, 8) || !bg_finite(in->ry) || !(in->ry > 0.0)) {
     bg_tables_scaled(in, 0, 0, 0, t); /* defined content; caller reports NUMERIC */
     return IMEST_REASON_NUMERIC;
   }
   /* s = 2^round(log2(1/T_R0)); a bad nominal falls back to 0.1 s (s = 8). */
-  const double trn = (bg_finite(tr_nominal_s) && tr_nominal_s > 1e-9 && tr_nominal_s < 1e9) ? tr_nominal_s : 0.1;
+  const double trn =
+      (bg_finite(tr_nominal_s) && tr_nominal_s > 1e-9 && tr_nominal_s < 1e9) ? tr_nominal_s : 0.1;
   const int sx = bg_round_log2(1.0 / trn);
   const int cexp = bg_round_log2(in->ry);
 
@@ -116,7 +123,8 @@ int bg_tables_build(const bg_sums_t *in, double tr_nominal_s, bg_tables_t *t) {
   return IMEST_OK;
 }
 
-void bg_tables_values(const bg_tables_t *t, double x, double v[3]) {
+void bg_tables_values(const bg_tables_t *t, double x, double v[3])
+{
   double p2 = t->e2[6], p1 = t->e1[7], p0 = t->e0[8];
   p1 = p1 * x + t->e1[6];
   p0 = p0 * x + t->e0[7];
@@ -131,7 +139,8 @@ void bg_tables_values(const bg_tables_t *t, double x, double v[3]) {
   v[2] = p0;
 }
 
-void bg_tables_eval(const bg_tables_t *t, double kappa, bg_tabval_t *v) {
+void bg_tables_eval(const bg_tables_t *t, double kappa, bg_tabval_t *v)
+{
   /* Horner with first and second derivatives, one pass per table. */
   const double *tab[3] = {t->e2, t->e1, t->e0};
   static const int len[3] = {7, 8, 9};

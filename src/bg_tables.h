@@ -20,11 +20,11 @@ extern "C" {
  * bw_t(kappa) = kappa b_t(kappa) + cw t'(kappa), b_t[m] = (m-4) t[m] the
  * paper's. With cw = 0, p2w = kappa p2 exactly (bw_t[m+1] = b_t[m], bw_t[0] = 0). */
 typedef struct {
-  int sexp, gexp, cexp;       /* s = 2^sexp, g = 2^gexp, c = 2^cexp */
+  int sexp, gexp, cexp; /* s = 2^sexp, g = 2^gexp, c = 2^cexp */
   double s, g, c;
-  double cw;                  /* weight c_w / s^2 (0: the paper's cost) */
-  double e2[7], e1[8], e0[9]; /* E~ = kappa^-4 sum_m (e2[m] k^2 + e1[m] k + e0[m]) kappa^m */
-  double a1[7], a0[8];        /* p1 = a1(kappa) k + a0(kappa) */
+  double cw;                      /* weight c_w / s^2 (0: the paper's cost) */
+  double e2[7], e1[8], e0[9];     /* E~ = kappa^-4 sum_m (e2[m] k^2 + e1[m] k + e0[m]) kappa^m */
+  double a1[7], a0[8];            /* p1 = a1(kappa) k + a0(kappa) */
   double bw2[8], bw1[9], bw0[10]; /* p2w = bw2 k^2 + bw1 k + bw0 */
 } bg_tables_t;
 

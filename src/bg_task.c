@@ -24,7 +24,7 @@ int imest_background(imest_t *s, imest_result_t *out)
   out->samples = w->samples;
   out->used_samples = w->used;
   out->overruns = s->overruns;
-  out->flags = w->flags;
+  out->flags = (unsigned int)(w->flags & 0xFFFFu); /* every IMEST_FLAG_ fits 16 bits (int may be 16) */
   /* every window before this one was complete (a flushed one ends a run) */
   out->t_end_s = ((double)w->seq * (double)s->window_n + (double)w->samples - 1.0) / (double)s->fs;
   out->span_s = (double)w->samples / (double)s->fs;

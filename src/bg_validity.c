@@ -17,8 +17,7 @@ static int first_flag_reason(unsigned int flags, uint32_t used, uint32_t samples
   return IMEST_REASON_NONE;
 }
 
-void bg_judge(const imest_t *s, const bg_window_stats_t *st, const bg_solve_out_t *so,
-                 imest_result_t *r)
+void bg_judge(const imest_t *s, const bg_window_stats_t *st, const bg_solve_out_t *so, imest_result_t *r)
 {
   int status = first_flag_reason(r->flags, r->used_samples, r->samples);
 

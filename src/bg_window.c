@@ -11,8 +11,7 @@
 /* 7-column index -> 8-column (K) index */
 static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
 
-void bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out,
-                       bg_window_stats_t *st)
+void bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out, bg_window_stats_t *st)
 {
   double z[8][8];
   for (unsigned int i = 0; i < 8u; ++i) {

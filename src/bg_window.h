@@ -10,16 +10,15 @@
 
 /* What the judge needs from a window besides the solve. */
 typedef struct {
-  double i_rms_a;     /* rms |i| (alpha/beta amplitude) */
-  double w_mean;      /* mean mechanical speed [rad/s] */
-  double slip_rate;   /* mean rotation rate of the rotor-frame current [rad/s]:
+  double i_rms_a;   /* rms |i| (alpha/beta amplitude) */
+  double w_mean;    /* mean mechanical speed [rad/s] */
+  double slip_rate; /* mean rotation rate of the rotor-frame current [rad/s]:
                          the slip frequency in steady state */
 } bg_window_stats_t;
 
 /* One window's ISR sums -> full 8x8 float64 sums (undoes the centring and
  * rebuilds column 3), and the window's statistics. */
-void bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out,
-                    bg_window_stats_t *st);
+void bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out, bg_window_stats_t *st);
 
 /* c0 (7-column centring vector) from K1, K2. */
 void bg_centre_from_k(imest_real_t c0[7], double k1, double k2, double m);

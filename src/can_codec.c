@@ -144,7 +144,10 @@ static uint32_t enc_scaled(double x, uint32_t scale, uint32_t na, unsigned int *
   return (uint32_t)r;
 }
 
-static uint32_t clamp_u(uint32_t v, uint32_t max) { return v > max ? max : v; }
+static uint32_t clamp_u(uint32_t v, uint32_t max)
+{
+  return v > max ? max : v;
+}
 
 /* Raw value of signal s. sat_all: the saturation bits of the whole window
  * (for SAT signals); *sat collects the bits this signal sets. */
@@ -153,27 +156,19 @@ static uint32_t encode(const imest_can_signal_t *s, const imest_result_t *r, uin
 {
   const uint32_t ones = all_ones(s->len);
   switch ((imest_can_kind_t)s->kind) {
-  case IMEST_CAN_F32:
-    return enc_f32(*(const double *)field_of(r, s), sat, s->mask);
-  case IMEST_CAN_SCALED:
-    return enc_scaled(*(const double *)field_of(r, s), s->scale, ones, sat, s->mask);
-  case IMEST_CAN_COUNT:
-    return clamp_u((uint32_t)*(const unsigned int *)field_of(r, s), ones);
-  case IMEST_CAN_U32:
-    return clamp_u(*(const uint32_t *)field_of(r, s), ones);
+  case IMEST_CAN_F32: return enc_f32(*(const double *)field_of(r, s), sat, s->mask);
+  case IMEST_CAN_SCALED: return enc_scaled(*(const double *)field_of(r, s), s->scale, ones, sat, s->mask);
+  case IMEST_CAN_COUNT: return clamp_u((uint32_t) * (const unsigned int *)field_of(r, s), ones);
+  case IMEST_CAN_U32: return clamp_u(*(const uint32_t *)field_of(r, s), ones);
   case IMEST_CAN_ENUM: {
     const int v = *(const int *)field_of(r, s);
     if (v < 0) return ones;
     return clamp_u((uint32_t)v, ones); /* out of range: all ones */
   }
-  case IMEST_CAN_BOOL:
-    return *(const int *)field_of(r, s) != 0 ? 1u : 0u;
-  case IMEST_CAN_FLAG:
-    return (*(const unsigned int *)field_of(r, s) & s->mask) ? 1u : 0u;
-  case IMEST_CAN_SAT:
-    return (sat_all & s->mask) ? 1u : 0u;
-  case IMEST_CAN_TXFAIL:
-    return clamp_u(tx_failed, ones);
+  case IMEST_CAN_BOOL: return *(const int *)field_of(r, s) != 0 ? 1u : 0u;
+  case IMEST_CAN_FLAG: return (*(const unsigned int *)field_of(r, s) & s->mask) ? 1u : 0u;
+  case IMEST_CAN_SAT: return (sat_all & s->mask) ? 1u : 0u;
+  case IMEST_CAN_TXFAIL: return clamp_u(tx_failed, ones);
   }
   return 0u;
 }
@@ -194,8 +189,8 @@ static uint32_t frame_id(uint32_t base_id, unsigned int index)
   return ((base_id & ~IMEST_CAN_ID_EXT) + index) | ext;
 }
 
-int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id,
-                   unsigned int counter, uint32_t tx_failed, imest_can_frame_t *f)
+int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id, unsigned int counter,
+                   uint32_t tx_failed, imest_can_frame_t *f)
 {
   unsigned int n = 0u;
   const imest_can_signal_t *t = imest_can_signal_table(&n);
@@ -209,7 +204,8 @@ int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id
   for (unsigned int i = 0u; i < 8u; i++) f->data[i] = 0u;
   for (unsigned int k = 0u; k < n; k++) {
     unsigned int unused = 0u;
-    if (t[k].frame == index) put_bits(f->data, t[k].start, t[k].len, encode(&t[k], r, tx_failed, sat_all, &unused));
+    if (t[k].frame == index)
+      put_bits(f->data, t[k].start, t[k].len, encode(&t[k], r, tx_failed, sat_all, &unused));
   }
   put_bits(f->data, IMEST_CAN_COUNTER_START, 8u, counter & 0xFFu);
   put_bits(f->data, IMEST_CAN_CRC_START, 8u, frame_crc(index, f->data));
@@ -241,31 +237,17 @@ static void decode(const imest_can_signal_t *s, uint32_t raw, imest_can_window_t
 {
   void *p = field_in(&w->result, s);
   switch ((imest_can_kind_t)s->kind) {
-  case IMEST_CAN_F32:
-    *(double *)p = dec_f32(raw);
-    break;
+  case IMEST_CAN_F32: *(double *)p = dec_f32(raw); break;
   case IMEST_CAN_SCALED:
     *(double *)p = raw == all_ones(s->len) ? nan64() : (double)raw / (double)s->scale;
     break;
-  case IMEST_CAN_COUNT:
-    *(unsigned int *)p = (unsigned int)raw;
-    break;
-  case IMEST_CAN_U32:
-    *(uint32_t *)p = raw;
-    break;
+  case IMEST_CAN_COUNT: *(unsigned int *)p = (unsigned int)raw; break;
+  case IMEST_CAN_U32: *(uint32_t *)p = raw; break;
   case IMEST_CAN_ENUM:
-  case IMEST_CAN_BOOL:
-    *(int *)p = (int)raw;
-    break;
-  case IMEST_CAN_FLAG:
-    set_bit((unsigned int *)p, s->mask, raw);
-    break;
-  case IMEST_CAN_SAT:
-    set_bit(&w->sat, s->mask, raw);
-    break;
-  case IMEST_CAN_TXFAIL:
-    w->tx_failed = raw;
-    break;
+  case IMEST_CAN_BOOL: *(int *)p = (int)raw; break;
+  case IMEST_CAN_FLAG: set_bit((unsigned int *)p, s->mask, raw); break;
+  case IMEST_CAN_SAT: set_bit(&w->sat, s->mask, raw); break;
+  case IMEST_CAN_TXFAIL: w->tx_failed = raw; break;
   }
 }
 
@@ -299,8 +281,8 @@ static int classify(const imest_can_frame_t *f, uint32_t base_id, unsigned int *
   return IMEST_CAN_DEC_OK;
 }
 
-int imest_can_decode_frame(const imest_can_frame_t *f, uint32_t base_id,
-                           imest_can_window_t *w, unsigned int *index)
+int imest_can_decode_frame(const imest_can_frame_t *f, uint32_t base_id, imest_can_window_t *w,
+                           unsigned int *index)
 {
   unsigned int idx = 0u;
   unsigned int n = 0u;

@@ -26,7 +26,8 @@ int imest_can_publish(imest_can_pub_t *pub, const imest_result_t *r)
   for (unsigned int i = 0u; i < (unsigned int)IMEST_CAN_NFRAMES; i++) {
     /* packed right before sending, so IMEST_STAT carries the failures of this
      * window's earlier frames too */
-    if (imest_can_pack(r, i, pub->base_id, (unsigned int)(pub->counter & 0xFFu), pub->tx_failed, &f) != IMEST_OK) {
+    if (imest_can_pack(r, i, pub->base_id, (unsigned int)(pub->counter & 0xFFu), pub->tx_failed, &f) !=
+        IMEST_OK) {
       return IMEST_ERR_ARG; /* base_id changed behind our back */
     }
     if (pub->port->send(pub->port->ctx, &f) != 0) {

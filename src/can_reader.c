@@ -125,8 +125,8 @@ static void event_clear(imest_can_rx_event_t *e)
   e->dec = IMEST_CAN_DEC_FOREIGN;
 }
 
-int imest_can_rx_feed(imest_can_rx_t *rx, const imest_can_frame_t *f,
-                      imest_can_window_t *out, imest_can_rx_event_t *ev)
+int imest_can_rx_feed(imest_can_rx_t *rx, const imest_can_frame_t *f, imest_can_window_t *out,
+                      imest_can_rx_event_t *ev)
 {
   imest_can_rx_event_t e;
   imest_can_window_t probe;

@@ -12,18 +12,20 @@
 
 /* The field's offset in imest_result_t, checked at compile time against the
  * C type the kind reads (no match in _Generic = a compile error). */
-#define R_ ((imest_result_t *)0)
-#define AT_(f) (unsigned short)offsetof(imest_result_t, f)
-#define FIELD_F32(f) _Generic(R_->f, double: AT_(f))
-#define FIELD_SCALED(f) _Generic(R_->f, double: AT_(f))
-#define FIELD_COUNT(f) _Generic(R_->f, unsigned int: AT_(f))
-#define FIELD_U32(f) _Generic(R_->f, uint32_t: AT_(f))
-#define FIELD_ENUM(f) _Generic(R_->f, int: AT_(f))
-#define FIELD_BOOL(f) _Generic(R_->f, int: AT_(f))
-#define FIELD_FLAG(f) _Generic(R_->f, unsigned int: AT_(f))
-#define FIELD_SAT(f) 0u    /* not a result field: the codec's saturation bits */
+#define R_              ((imest_result_t *)0)
+#define AT_(f)          (unsigned short)offsetof(imest_result_t, f)
+#define FIELD_F32(f)    _Generic(R_->f, double : AT_(f))
+#define FIELD_SCALED(f) _Generic(R_->f, double : AT_(f))
+#define FIELD_COUNT(f)  _Generic(R_->f, unsigned int : AT_(f))
+#define FIELD_U32(f)    _Generic(R_->f, uint32_t : AT_(f))
+#define FIELD_ENUM(f)   _Generic(R_->f, int : AT_(f))
+#define FIELD_BOOL(f)   _Generic(R_->f, int : AT_(f))
+#define FIELD_FLAG(f)   _Generic(R_->f, unsigned int : AT_(f))
+#define FIELD_SAT(f)    0u /* not a result field: the codec's saturation bits */
 #define FIELD_TXFAIL(f) 0u /* not a result field: the publisher's count */
 
+/* The table reads like the DBC: one signal per line, columns aligned. */
+// clang-format off
 #define SIG(frame, start, len, kind, scale, field, mask) \
   {scale, FIELD_##kind(field), mask, IMEST_CAN_FRAME_##frame, start, len, IMEST_CAN_##kind}
 
@@ -63,6 +65,7 @@ static const imest_can_signal_t k_signals[] = {
     SIG(BOUNDS,  32,  1, SAT,    1u,     none,         IMEST_CAN_SAT_TRB),       /* Sat_TR_bound */
     SIG(BOUNDS,  33,  1, SAT,    1u,     none,         IMEST_CAN_SAT_RSB),       /* Sat_RS_bound */
 };
+// clang-format on
 
 const imest_can_signal_t *imest_can_signal_table(unsigned int *count)
 {

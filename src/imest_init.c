@@ -5,13 +5,13 @@
 
 #include "bg_window.h"
 
-#define IMEST_PI_D 3.14159265358979323846
+#define IMEST_PI_D    3.14159265358979323846
 #define IMEST_SQRT2_D 1.41421356237309504880
 
 void imest_config_default(imest_config_t *cfg)
 {
   if (cfg == NULL) return;
-  cfg->pole_pairs = 0;      /* motor constants: the caller must set them */
+  cfg->pole_pairs = 0; /* motor constants: the caller must set them */
   cfg->ls_h = 0.0f;
   cfg->sigma = 0.0f;
   cfg->fs_hz = 4000.0f;
@@ -38,7 +38,10 @@ void imest_config_default(imest_config_t *cfg)
   cfg->speed_limit_rad_s = 3000.0f;
 }
 
-static int finite_pos(float x) { return isfinite(x) && x > 0.0f; }
+static int finite_pos(float x)
+{
+  return isfinite(x) && x > 0.0f;
+}
 
 int imest_config_check(const imest_config_t *cfg, const char **field)
 {
@@ -48,36 +51,55 @@ int imest_config_check(const imest_config_t *cfg, const char **field)
     return IMEST_ERR_NULL;
   }
   const double fs = (double)cfg->fs_hz;
-  if (cfg->pole_pairs < 1u || cfg->pole_pairs > 64u) bad = "pole_pairs";
-  else if (!finite_pos(cfg->ls_h)) bad = "ls_h";
-  else if (!(cfg->sigma > 0.0f && cfg->sigma < 1.0f)) bad = "sigma";
-  else if (!finite_pos(cfg->fs_hz) || cfg->fs_hz > 1.0e6f) bad = "fs_hz";
+  if (cfg->pole_pairs < 1u || cfg->pole_pairs > 64u)
+    bad = "pole_pairs";
+  else if (!finite_pos(cfg->ls_h))
+    bad = "ls_h";
+  else if (!(cfg->sigma > 0.0f && cfg->sigma < 1.0f))
+    bad = "sigma";
+  else if (!finite_pos(cfg->fs_hz) || cfg->fs_hz > 1.0e6f)
+    bad = "fs_hz";
   else if (!finite_pos(cfg->window_s) || (double)cfg->window_s * fs < 64.0 ||
-           (double)cfg->window_s * fs > 4.0e8) bad = "window_s";
-  else if (!finite_pos(cfg->filter_hz) || (double)cfg->filter_hz >= 0.4 * fs) bad = "filter_hz";
+           (double)cfg->window_s * fs > 4.0e8)
+    bad = "window_s";
+  else if (!finite_pos(cfg->filter_hz) || (double)cfg->filter_hz >= 0.4 * fs)
+    bad = "filter_hz";
   else if (!(cfg->aa_hz == 0.0f || (finite_pos(cfg->aa_hz) && (double)cfg->aa_hz < 0.45 * fs)))
     bad = "aa_hz";
-  else if (!(isfinite(cfg->u_delay_s) && cfg->u_delay_s >= 0.0f &&
-             (double)cfg->u_delay_s * fs <= 1.0 + 1e-6)) bad = "u_delay_s";
-  else if (!(isfinite(cfg->dc_block_hz) && cfg->dc_block_hz >= 0.0f &&
-             (double)cfg->dc_block_hz < 0.01 * fs)) bad = "dc_block_hz";
-  else if (!(isfinite(cfg->warmup_s) && cfg->warmup_s >= 0.0f &&
-             cfg->warmup_s <= cfg->window_s * 100.0f)) bad = "warmup_s";
-  else if (!finite_pos(cfg->tr_nominal_s)) bad = "tr_nominal_s";
-  else if (!finite_pos(cfg->tr_min_s)) bad = "tr_min_s";
-  else if (!(finite_pos(cfg->tr_max_s) && cfg->tr_max_s > cfg->tr_min_s)) bad = "tr_max_s";
-  else if (!(isfinite(cfg->rs_min_ohm) && cfg->rs_min_ohm >= 0.0f)) bad = "rs_min_ohm";
-  else if (!(isfinite(cfg->rs_max_ohm) && cfg->rs_max_ohm > cfg->rs_min_ohm)) bad = "rs_max_ohm";
-  else if (!finite_pos(cfg->max_pe_k2_rel)) bad = "max_pe_k2_rel";
-  else if (!finite_pos(cfg->max_ei)) bad = "max_ei";
-  else if (!(isfinite(cfg->min_current_a) && cfg->min_current_a >= 0.0f)) bad = "min_current_a";
-  else if (!(isfinite(cfg->min_slip_ratio) && cfg->min_slip_ratio >= 0.0f)) bad = "min_slip_ratio";
-  else if (!(isfinite(cfg->i_limit_a) && cfg->i_limit_a >= 0.0f)) bad = "i_limit_a";
-  else if (!(isfinite(cfg->u_limit_v) && cfg->u_limit_v >= 0.0f)) bad = "u_limit_v";
-  else if (!finite_pos(cfg->i_absurd_a)) bad = "i_absurd_a";
-  else if (!finite_pos(cfg->u_absurd_v)) bad = "u_absurd_v";
-  else if (!finite_pos(cfg->speed_limit_rad_s) ||
-           (double)cfg->speed_limit_rad_s >= 3.0 * fs) bad = "speed_limit_rad_s";
+  else if (!(isfinite(cfg->u_delay_s) && cfg->u_delay_s >= 0.0f && (double)cfg->u_delay_s * fs <= 1.0 + 1e-6))
+    bad = "u_delay_s";
+  else if (!(isfinite(cfg->dc_block_hz) && cfg->dc_block_hz >= 0.0f && (double)cfg->dc_block_hz < 0.01 * fs))
+    bad = "dc_block_hz";
+  else if (!(isfinite(cfg->warmup_s) && cfg->warmup_s >= 0.0f && cfg->warmup_s <= cfg->window_s * 100.0f))
+    bad = "warmup_s";
+  else if (!finite_pos(cfg->tr_nominal_s))
+    bad = "tr_nominal_s";
+  else if (!finite_pos(cfg->tr_min_s))
+    bad = "tr_min_s";
+  else if (!(finite_pos(cfg->tr_max_s) && cfg->tr_max_s > cfg->tr_min_s))
+    bad = "tr_max_s";
+  else if (!(isfinite(cfg->rs_min_ohm) && cfg->rs_min_ohm >= 0.0f))
+    bad = "rs_min_ohm";
+  else if (!(isfinite(cfg->rs_max_ohm) && cfg->rs_max_ohm > cfg->rs_min_ohm))
+    bad = "rs_max_ohm";
+  else if (!finite_pos(cfg->max_pe_k2_rel))
+    bad = "max_pe_k2_rel";
+  else if (!finite_pos(cfg->max_ei))
+    bad = "max_ei";
+  else if (!(isfinite(cfg->min_current_a) && cfg->min_current_a >= 0.0f))
+    bad = "min_current_a";
+  else if (!(isfinite(cfg->min_slip_ratio) && cfg->min_slip_ratio >= 0.0f))
+    bad = "min_slip_ratio";
+  else if (!(isfinite(cfg->i_limit_a) && cfg->i_limit_a >= 0.0f))
+    bad = "i_limit_a";
+  else if (!(isfinite(cfg->u_limit_v) && cfg->u_limit_v >= 0.0f))
+    bad = "u_limit_v";
+  else if (!finite_pos(cfg->i_absurd_a))
+    bad = "i_absurd_a";
+  else if (!finite_pos(cfg->u_absurd_v))
+    bad = "u_absurd_v";
+  else if (!finite_pos(cfg->speed_limit_rad_s) || (double)cfg->speed_limit_rad_s >= 3.0 * fs)
+    bad = "speed_limit_rad_s";
   if (field) *field = bad;
   return bad ? IMEST_ERR_CONFIG : IMEST_OK;
 }
@@ -207,7 +229,10 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   return IMEST_OK;
 }
 
-uint32_t imest_overruns(const imest_t *s) { return s ? s->overruns : 0u; }
+uint32_t imest_overruns(const imest_t *s)
+{
+  return s ? s->overruns : 0u;
+}
 
 const char *imest_err_name(int err)
 {

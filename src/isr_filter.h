@@ -17,8 +17,8 @@ static inline imest_real_t isr_dc_block(imest_real_t a, imest_real_t *mean, imes
 
 /* One sample through a bilinear second-order low-pass section
  * c0 (1 + 2 z^-1 + z^-2) / (1 + d1 z^-1 + d2 z^-2), transposed DF-II. */
-static inline imest_real_t isr_lp2(imest_real_t c0, imest_real_t d1, imest_real_t d2,
-                                   imest_real_t *sa, imest_real_t *sb, imest_real_t x)
+static inline imest_real_t isr_lp2(imest_real_t c0, imest_real_t d1, imest_real_t d2, imest_real_t *sa,
+                                   imest_real_t *sb, imest_real_t x)
 {
   const imest_real_t t = c0 * x;
   const imest_real_t y = t + *sa;
@@ -59,8 +59,8 @@ static inline isr_deriv_t isr_filter_deriv(const imest_t *s, imest_chan_t *c, im
  * float32 unwrapped angle would lose resolution). Since differencing commutes
  * with the filter, omega and domega/dt at n-1 are the mean and the difference
  * of two consecutive filtered increments. */
-static inline void isr_filter_speed(const imest_t *s, imest_chan_t *c, imest_real_t w_raw,
-                                    imest_real_t *w, imest_real_t *dw)
+static inline void isr_filter_speed(const imest_t *s, imest_chan_t *c, imest_real_t w_raw, imest_real_t *w,
+                                    imest_real_t *dw)
 {
   const imest_real_t wf = isr_bw3(&s->bw, c, w_raw);
   *w = RL(0.5) * (wf + c->y1);
@@ -69,8 +69,7 @@ static inline void isr_filter_speed(const imest_t *s, imest_chan_t *c, imest_rea
 }
 
 /* Digital model of a 2nd-order analog anti-alias filter (transposed DF-II). */
-static inline imest_real_t isr_aa(const imest_sos_t *f, imest_real_t *s1, imest_real_t *s2,
-                                  imest_real_t x)
+static inline imest_real_t isr_aa(const imest_sos_t *f, imest_real_t *s1, imest_real_t *s2, imest_real_t x)
 {
   return isr_lp2(f->c0, f->d1, f->d2, s1, s2, x);
 }

@@ -6,8 +6,8 @@
 
 #include "imest/imest.h"
 
-#define RL(x) ((imest_real_t)(x))
-#define IMEST_PI_R RL(3.14159265358979323846)
+#define RL(x)       ((imest_real_t)(x))
+#define IMEST_PI_R  RL(3.14159265358979323846)
 #define IMEST_2PI_R RL(6.28318530717958647692)
 
 /* Compiler barrier for the ISR/background hand-off. Override on multi-core or
@@ -16,7 +16,9 @@
 #if defined(__GNUC__) || defined(__clang__)
 #define IMEST_BARRIER() __asm__ volatile("" ::: "memory")
 #else
-#define IMEST_BARRIER() do { } while (0)
+#define IMEST_BARRIER()                                                                                      \
+  do {                                                                                                       \
+  } while (0)
 #endif
 #endif
 
@@ -27,15 +29,27 @@
 /* the float64 reference build's copy of imest.h (src/CMakeLists.txt) defines
  * IMEST_REF64_REAL_DOUBLE; the public header does not */
 #ifdef IMEST_REF64_REAL_DOUBLE
-static inline imest_real_t isr_abs(imest_real_t x) { return __builtin_fabs(x); }
+static inline imest_real_t isr_abs(imest_real_t x)
+{
+  return __builtin_fabs(x);
+}
 #else
-static inline imest_real_t isr_abs(imest_real_t x) { return __builtin_fabsf(x); }
+static inline imest_real_t isr_abs(imest_real_t x)
+{
+  return __builtin_fabsf(x);
+}
 #endif
 #else
-static inline imest_real_t isr_abs(imest_real_t x) { return x < RL(0) ? -x : x; }
+static inline imest_real_t isr_abs(imest_real_t x)
+{
+  return x < RL(0) ? -x : x;
+}
 #endif
 
 /* 1 if |x| <= lim (false for NaN and +-Inf). */
-static inline int isr_within(imest_real_t x, imest_real_t lim) { return (x <= lim) & (x >= -lim); }
+static inline int isr_within(imest_real_t x, imest_real_t lim)
+{
+  return (x <= lim) & (x >= -lim);
+}
 
 #endif

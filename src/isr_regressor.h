@@ -9,7 +9,7 @@
 /* Rotor-frame signals at one instant (all referred to sample n-1). */
 typedef struct {
   isr_deriv_t ix, iy, ux, uy;
-  imest_real_t w, dw;        /* mechanical speed and acceleration */
+  imest_real_t w, dw; /* mechanical speed and acceleration */
 } isr_signals_t;
 
 /* z[r][0..6] = W row r, z[r][7] = e row r. */
@@ -18,7 +18,7 @@ static inline void isr_regressor(const imest_t *s, const isr_signals_t *g, const
 {
   const imest_real_t ix = g->ix.x, iy = g->iy.x, dix = g->ix.dx, diy = g->iy.dx;
   const imest_real_t d2ix = g->ix.d2x, d2iy = g->iy.d2x;
-  const imest_real_t vx = g->ux.x * s->inv_s, vy = g->uy.x * s->inv_s;   /* u / (sigma L_S) */
+  const imest_real_t vx = g->ux.x * s->inv_s, vy = g->uy.x * s->inv_s; /* u / (sigma L_S) */
   const imest_real_t dvx = g->ux.dx * s->inv_s, dvy = g->uy.dx * s->inv_s;
   const imest_real_t nw = s->n * g->w, nwp = s->n * g->dw;
   const imest_real_t nw2 = nw * nw, nw3 = nw2 * nw, nwnwp = nw * nwp;
@@ -50,10 +50,10 @@ static inline void isr_regressor(const imest_t *s, const isr_signals_t *g, const
   /* y, then centred: e = y - W c0 (docs/METHOD.md §10: keeps float32 sums accurate) */
   const imest_real_t yx = d2ix - nw * diy - nwp * iy - m * nw2 * ix - dvx;
   const imest_real_t yy = d2iy + nw * dix + nwp * ix - m * nw2 * iy - dvy;
-  zx[7] = yx - (zx[0] * c0[0] + zx[1] * c0[1] + zx[2] * c0[2] + zx[3] * c0[3] +
-                zx[4] * c0[4] + zx[5] * c0[5] + zx[6] * c0[6]);
-  zy[7] = yy - (zy[0] * c0[0] + zy[1] * c0[1] + zy[2] * c0[2] + zy[3] * c0[3] +
-                zy[4] * c0[4] + zy[5] * c0[5] + zy[6] * c0[6]);
+  zx[7] = yx - (zx[0] * c0[0] + zx[1] * c0[1] + zx[2] * c0[2] + zx[3] * c0[3] + zx[4] * c0[4] +
+                zx[5] * c0[5] + zx[6] * c0[6]);
+  zy[7] = yy - (zy[0] * c0[0] + zy[1] * c0[1] + zy[2] * c0[2] + zy[3] * c0[3] + zy[4] * c0[4] +
+                zy[5] * c0[5] + zy[6] * c0[6]);
 }
 
 #endif

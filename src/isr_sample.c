@@ -41,7 +41,7 @@ static int isr_close_window(imest_t *s)
   w->samples = s->k;
   s->seq++;
   if (s->published == s->released) {
-    IMEST_BARRIER();            /* window contents before the index */
+    IMEST_BARRIER();                  /* window contents before the index */
     s->published = s->published + 1u; /* the ISR now fills the other buffer */
     isr_open_window(s, &s->win[s->published & 1u], 0u);
     return 1;
@@ -59,8 +59,8 @@ static int isr_close_window(imest_t *s)
 /* Common part once alpha/beta are known. in_range: every electrical input
  * was strictly inside its ADC limit (the absurd-value limit when no ADC limit
  * is configured); NaN fails that test too. */
-static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t ia,
-                    imest_real_t ib, imest_real_t th, int in_range)
+static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t ia, imest_real_t ib,
+                    imest_real_t th, int in_range)
 {
   imest_window_t *w = &s->win[s->published & 1u];
   uint32_t fault = 0;
@@ -68,13 +68,13 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
   /* Only an out-of-range sample pays for telling saturation from garbage:
    * NaN and Inf fail every comparison. */
   if (!in_range) {
-    const int plausible = isr_within(ua, s->u_abs) & isr_within(ub, s->u_abs) &
-                          isr_within(ia, s->i_abs) & isr_within(ib, s->i_abs);
+    const int plausible = isr_within(ua, s->u_abs) & isr_within(ub, s->u_abs) & isr_within(ia, s->i_abs) &
+                          isr_within(ib, s->i_abs);
     fault = plausible ? IMEST_FLAG_ADC_SAT : IMEST_FLAG_INPUT_FAULT;
   }
   if (!isr_within(th, RL(1.0e8))) fault |= IMEST_FLAG_INPUT_FAULT;
   if (fault & IMEST_FLAG_INPUT_FAULT) {
-    th = s->th_prev;            /* keep the last good angle */
+    th = s->th_prev; /* keep the last good angle */
   }
   const uint32_t first = !s->started;
   const imest_real_t dth = first ? RL(0) : isr_wrap_pi(th - s->th_prev);
@@ -163,8 +163,8 @@ int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a, f
   const imest_real_t ua = (imest_real_t)u_alpha_v, ub = (imest_real_t)u_beta_v;
   const imest_real_t ia = (imest_real_t)i_alpha_a, ib = (imest_real_t)i_beta_a;
   /* the limits apply to whatever quantities the caller passes */
-  const int in_range = (isr_abs(ia) < s->i_lim) & (isr_abs(ib) < s->i_lim) &
-                       (isr_abs(ua) < s->u_lim) & (isr_abs(ub) < s->u_lim);
+  const int in_range = (isr_abs(ia) < s->i_lim) & (isr_abs(ib) < s->i_lim) & (isr_abs(ua) < s->u_lim) &
+                       (isr_abs(ub) < s->u_lim);
   return isr_step(s, ua, ub, ia, ib, (imest_real_t)theta_rad, in_range);
 }
 

@@ -29,11 +29,9 @@ static inline void isr_sincos(imest_real_t x, imest_real_t *s_out, imest_real_t 
   const imest_real_t q = x * RL(0.63661977236758134308); /* 2/pi */
   const int32_t k = (int32_t)(q + (q >= RL(0) ? RL(0.5) : RL(-0.5)));
   /* two-step Cody-Waite reduction keeps r accurate for |x| up to a few 100 rad */
-  const imest_real_t r = (x - (imest_real_t)k * RL(1.5703125)) -
-                         (imest_real_t)k * RL(4.83826794896619231e-4);
+  const imest_real_t r = (x - (imest_real_t)k * RL(1.5703125)) - (imest_real_t)k * RL(4.83826794896619231e-4);
   const imest_real_t r2 = r * r;
-  const imest_real_t sp =
-      r * (RL(1) + r2 * (RL(-1.0 / 6) + r2 * (RL(1.0 / 120) + r2 * RL(-1.0 / 5040))));
+  const imest_real_t sp = r * (RL(1) + r2 * (RL(-1.0 / 6) + r2 * (RL(1.0 / 120) + r2 * RL(-1.0 / 5040))));
   const imest_real_t cp =
       RL(1) + r2 * (RL(-0.5) + r2 * (RL(1.0 / 24) + r2 * (RL(-1.0 / 720) + r2 * RL(1.0 / 40320))));
   const uint32_t quad = (uint32_t)k & 3u;
@@ -44,8 +42,8 @@ static inline void isr_sincos(imest_real_t x, imest_real_t *s_out, imest_real_t 
 }
 
 /* Rotation by the electrical angle phi (eq. 2): x = c*a + s*b, y = -s*a + c*b. */
-static inline void isr_rotate(imest_real_t s, imest_real_t c, imest_real_t a, imest_real_t b,
-                              imest_real_t *x, imest_real_t *y)
+static inline void isr_rotate(imest_real_t s, imest_real_t c, imest_real_t a, imest_real_t b, imest_real_t *x,
+                              imest_real_t *y)
 {
   *x = c * a + s * b;
   *y = c * b - s * a;

@@ -39,8 +39,7 @@ void qemu_plugin_register_vcpu_tb_trans_cb(qemu_plugin_id_t id, qemu_plugin_vcpu
 size_t qemu_plugin_tb_n_insns(const struct qemu_plugin_tb *tb);
 struct qemu_plugin_insn *qemu_plugin_tb_get_insn(const struct qemu_plugin_tb *tb, size_t idx);
 uint64_t qemu_plugin_insn_vaddr(const struct qemu_plugin_insn *insn);
-void qemu_plugin_register_vcpu_insn_exec_cb(struct qemu_plugin_insn *insn,
-                                            qemu_plugin_vcpu_udata_cb_t cb,
+void qemu_plugin_register_vcpu_insn_exec_cb(struct qemu_plugin_insn *insn, qemu_plugin_vcpu_udata_cb_t cb,
                                             enum qemu_plugin_cb_flags flags, void *userdata);
 void qemu_plugin_register_atexit_cb(qemu_plugin_id_t id, qemu_plugin_udata_cb_t cb, void *userdata);
 void qemu_plugin_outs(const char *string);
@@ -48,8 +47,8 @@ void qemu_plugin_outs(const char *string);
 PLUGIN_EXPORT int qemu_plugin_version = 1;
 /* -------------------------------------------------------------------------- */
 
-#define NCHAN 6
-#define MAXCALLS 16384
+#define NCHAN      6
+#define MAXCALLS   16384
 #define CODE_LIMIT 0x00400000u /* profile addresses below 4 MiB (code memory) */
 
 static uint64_t mark_b[NCHAN], mark_e[NCHAN];
@@ -109,10 +108,8 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
     uint64_t pc = qemu_plugin_insn_vaddr(insn);
     /* A marker's callback runs before its own instruction is counted. */
     if (is_mark(pc))
-      qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark, QEMU_PLUGIN_CB_NO_REGS,
-                                             (void *)(uintptr_t)pc);
-    qemu_plugin_register_vcpu_insn_exec_cb(insn, on_insn, QEMU_PLUGIN_CB_NO_REGS,
-                                           (void *)(uintptr_t)pc);
+      qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark, QEMU_PLUGIN_CB_NO_REGS, (void *)(uintptr_t)pc);
+    qemu_plugin_register_vcpu_insn_exec_cb(insn, on_insn, QEMU_PLUGIN_CB_NO_REGS, (void *)(uintptr_t)pc);
   }
 }
 
@@ -126,8 +123,8 @@ static void at_exit(qemu_plugin_id_t id, void *ud)
   } else {
     for (int c = 0; c < NCHAN; c++) {
       if (!calls[c]) continue;
-      fprintf(f, "chan %d calls %" PRIu64 " min %" PRIu64 " max %" PRIu64 " sum %" PRIu64 "\n", c,
-              calls[c], vmin[c], vmax[c], vsum[c]);
+      fprintf(f, "chan %d calls %" PRIu64 " min %" PRIu64 " max %" PRIu64 " sum %" PRIu64 "\n", c, calls[c],
+              vmin[c], vmax[c], vsum[c]);
     }
     for (int c = 0; c < NCHAN; c++)
       for (uint64_t k = 0; k < calls[c] && k < MAXCALLS; k++)
@@ -146,10 +143,12 @@ static void at_exit(qemu_plugin_id_t id, void *ud)
   }
 }
 
-static uint64_t num(const char *s) { return strtoull(s, NULL, 0); }
+static uint64_t num(const char *s)
+{
+  return strtoull(s, NULL, 0);
+}
 
-PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *info, int argc,
-                                      char **argv)
+PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *info, int argc, char **argv)
 {
   (void)info;
   for (int i = 0; i < argc; i++) {

@@ -93,10 +93,10 @@ extern "C" {
  *  (IMEST_OK) or a non-negative count on success, a negative imest_err_t on
  *  error; each function documents its values with @retval. */
 typedef enum {
-  IMEST_OK = 0,           /**< success */
-  IMEST_ERR_NULL = -1,    /**< a pointer argument was NULL */
-  IMEST_ERR_CONFIG = -2,  /**< a config field is out of range; imest_config_check() names it */
-  IMEST_ERR_ARG = -3      /**< an argument is out of range (an index, an identifier) */
+  IMEST_OK = 0,          /**< success */
+  IMEST_ERR_NULL = -1,   /**< a pointer argument was NULL */
+  IMEST_ERR_CONFIG = -2, /**< a config field is out of range; imest_config_check() names it */
+  IMEST_ERR_ARG = -3     /**< an argument is out of range (an index, an identifier) */
 } imest_err_t;
 
 /** Short lower-case name of an error ("ok", "null_argument", "bad_config", "bad_argument"). */
@@ -106,20 +106,20 @@ const char *imest_err_name(int err);
  *  .rs_reason), most fundamental first. The values are stable: they travel on
  *  CAN (tools/imest.dbc). */
 typedef enum {
-  IMEST_REASON_NONE = 0,              /**< valid */
-  IMEST_REASON_WARMUP = 10,           /**< filters were still settling (start or after a fault) */
-  IMEST_REASON_INPUT_FAULT = 11,      /**< non-finite or absurd sample (NaN, Inf, beyond limits) */
-  IMEST_REASON_ADC_SATURATION = 12,   /**< a current or voltage sample reached the ADC limit */
-  IMEST_REASON_ENCODER_FAULT = 13,    /**< angle step beyond the speed limit (glitch, jump) */
-  IMEST_REASON_NO_CURRENT = 14,       /**< stator current below min_current_a: nothing to identify */
-  IMEST_REASON_STANDSTILL = 15,       /**< rotor (nearly) at rest without AC excitation */
-  IMEST_REASON_ZERO_SLIP = 16,        /**< rotor currents ~0 (no load, constant speed): T_R unobservable */
-  IMEST_REASON_NUMERIC = 17,          /**< non-finite window sums or polynomial */
-  IMEST_REASON_NO_ROOT = 18,          /**< no stationary point with K1 > 0 and T_R in [tr_min, tr_max] */
-  IMEST_REASON_NOT_MINIMUM = 19,      /**< Hessian at the selected point not positive definite */
-  IMEST_REASON_POORLY_DETERMINED = 20,/**< relative parametric error index of K2 too large */
-  IMEST_REASON_HIGH_RESIDUAL = 21,    /**< E_I above max_ei: the data do not fit the model */
-  IMEST_REASON_RS_OUT_OF_RANGE = 22   /**< R_S outside [rs_min_ohm, rs_max_ohm] */
+  IMEST_REASON_NONE = 0,               /**< valid */
+  IMEST_REASON_WARMUP = 10,            /**< filters were still settling (start or after a fault) */
+  IMEST_REASON_INPUT_FAULT = 11,       /**< non-finite or absurd sample (NaN, Inf, beyond limits) */
+  IMEST_REASON_ADC_SATURATION = 12,    /**< a current or voltage sample reached the ADC limit */
+  IMEST_REASON_ENCODER_FAULT = 13,     /**< angle step beyond the speed limit (glitch, jump) */
+  IMEST_REASON_NO_CURRENT = 14,        /**< stator current below min_current_a: nothing to identify */
+  IMEST_REASON_STANDSTILL = 15,        /**< rotor (nearly) at rest without AC excitation */
+  IMEST_REASON_ZERO_SLIP = 16,         /**< rotor currents ~0 (no load, constant speed): T_R unobservable */
+  IMEST_REASON_NUMERIC = 17,           /**< non-finite window sums or polynomial */
+  IMEST_REASON_NO_ROOT = 18,           /**< no stationary point with K1 > 0 and T_R in [tr_min, tr_max] */
+  IMEST_REASON_NOT_MINIMUM = 19,       /**< Hessian at the selected point not positive definite */
+  IMEST_REASON_POORLY_DETERMINED = 20, /**< relative parametric error index of K2 too large */
+  IMEST_REASON_HIGH_RESIDUAL = 21,     /**< E_I above max_ei: the data do not fit the model */
+  IMEST_REASON_RS_OUT_OF_RANGE = 22    /**< R_S outside [rs_min_ohm, rs_max_ohm] */
 } imest_reason_t;
 
 /** Short lower-case name of a reason ("ok", "warmup", "zero_slip", ...). */
@@ -140,65 +140,65 @@ const char *imest_reason_name(int reason);
 /** Configuration. Fill with imest_config_default(), then set the motor. */
 typedef struct {
   /* Motor constants (known, from the data sheet or a commissioning test). */
-  unsigned int pole_pairs;  /**< n_p */
-  float ls_h;               /**< stator inductance L_S [H] */
-  float sigma;              /**< total leakage factor 1 - M^2/(L_S L_R) */
+  unsigned int pole_pairs; /**< n_p */
+  float ls_h;              /**< stator inductance L_S [H] */
+  float sigma;             /**< total leakage factor 1 - M^2/(L_S L_R) */
 
   /* Sampling. */
-  float fs_hz;              /**< sample rate of the ISR call [Hz] (default 4000) */
-  float window_s;           /**< window length [s] (default 1.0) */
+  float fs_hz;    /**< sample rate of the ISR call [Hz] (default 4000) */
+  float window_s; /**< window length [s] (default 1.0) */
 
   /* Front end. */
-  float filter_hz;          /**< Butterworth-3 cut-off [Hz] (default 100: works for
+  float filter_hz;   /**< Butterworth-3 cut-off [Hz] (default 100: works for
                                  run-up and steady state with 12-bit sensors) */
-  float aa_hz;              /**< if the analog current/voltage channels have a 2nd-order
+  float aa_hz;       /**< if the analog current/voltage channels have a 2nd-order
                                  anti-alias filter, its cut-off [Hz]; the angle is
                                  then passed through a digital model of it so all
                                  channels see the same delay (0 = none, default) */
-  float u_delay_s;          /**< how much the voltage samples lag the current samples [s],
+  float u_delay_s;   /**< how much the voltage samples lag the current samples [s],
                                  0 .. 1/fs_hz (default 0). E.g. a phase voltage
                                  reconstructed from the duty cycles of the PWM period that
                                  just ended lags by half a carrier period (50 us at 10 kHz):
                                  uncompensated, that biases R_S by about +5 % at 30 Hz. The
                                  currents and the angle are delayed to match (linear
                                  interpolation). */
-  float dc_block_hz;        /**< cut-off [Hz] of a first-order high-pass applied alike to the
+  float dc_block_hz; /**< cut-off [Hz] of a first-order high-pass applied alike to the
                                  alpha/beta voltages and currents before the rotation: it
                                  removes sensor offsets (default 1; 0 = off). Applied to
                                  both, it leaves the motor's equations intact at constant
                                  speed; see README "Method" (sensor offsets). The first start
                                  (unless start_at_rest) waits 5 time constants more for it:
                                  0.8 s at 1 Hz. */
-  float warmup_s;           /**< samples discarded after start/fault while the filters
+  float warmup_s;    /**< samples discarded after start/fault while the filters
                                  settle [s] (default 0: derived from filter_hz) */
-  int start_at_rest;        /**< nonzero: the first sample follows a zero history
+  int start_at_rest; /**< nonzero: the first sample follows a zero history
                                  (drive just enabled, motor at rest, no current),
                                  so no warm-up is needed at start (default 0) */
 
   /* Solve and selection. */
-  float tr_nominal_s;       /**< nominal T_R, used for scaling and the first centring
+  float tr_nominal_s; /**< nominal T_R, used for scaling and the first centring
                                  (default 0.1 s) */
-  float tr_min_s;           /**< admissible T_R band [s] (default 1 ms .. 10 s) */
+  float tr_min_s;     /**< admissible T_R band [s] (default 1 ms .. 10 s) */
   float tr_max_s;
-  float rs_min_ohm;         /**< admissible R_S band [ohm] (default 0 .. 1e3) */
+  float rs_min_ohm; /**< admissible R_S band [ohm] (default 0 .. 1e3) */
   float rs_max_ohm;
 
   /* Validity (see README "When is a window valid"). */
-  float max_pe_k2_rel;      /**< largest relative parametric error index of K2 (default 0.1) */
-  float max_ei;             /**< largest residual error index E_I (default 3.0: a sanity bound; the
+  float max_pe_k2_rel;  /**< largest relative parametric error index of K2 (default 0.1) */
+  float max_ei;         /**< largest residual error index E_I (default 3.0: a sanity bound; the
                                  PE index is the evidence of trust, README) */
-  float min_current_a;      /**< least rms stator current (alpha/beta amplitude) [A] (default 0.05) */
-  float min_slip_ratio;     /**< least slip excitation: mean rotation rate of the rotor-frame
+  float min_current_a;  /**< least rms stator current (alpha/beta amplitude) [A] (default 0.05) */
+  float min_slip_ratio; /**< least slip excitation: mean rotation rate of the rotor-frame
                                  current x tr_nominal_s, i.e. slip frequency x T_R in steady
                                  state (default 0.1, i.e. rotor current >= ~10 % of the
                                  magnetising current; rated load is about 1) */
 
   /* Input plausibility (per sample, ISR). */
-  float i_limit_a;          /**< |phase current| >= this counts as ADC saturation (0 = off) */
-  float u_limit_v;          /**< |phase voltage| >= this counts as ADC saturation (0 = off) */
-  float i_absurd_a;         /**< |current| beyond this (or non-finite) is an input fault (default 1e4) */
-  float u_absurd_v;         /**< |voltage| beyond this (or non-finite) is an input fault (default 1e5) */
-  float speed_limit_rad_s;  /**< |mechanical angle step| * fs beyond this is an encoder fault
+  float i_limit_a;         /**< |phase current| >= this counts as ADC saturation (0 = off) */
+  float u_limit_v;         /**< |phase voltage| >= this counts as ADC saturation (0 = off) */
+  float i_absurd_a;        /**< |current| beyond this (or non-finite) is an input fault (default 1e4) */
+  float u_absurd_v;        /**< |voltage| beyond this (or non-finite) is an input fault (default 1e5) */
+  float speed_limit_rad_s; /**< |mechanical angle step| * fs beyond this is an encoder fault
                                  (default 3000 rad/s, about 28 600 rpm) */
 } imest_config_t;
 
@@ -224,39 +224,39 @@ int imest_config_check(const imest_config_t *cfg, const char **field);
  *  keeps its number when it is not valid: only the verdict says whether to
  *  use it. */
 typedef struct {
-  uint32_t seq;             /**< window sequence number (0, 1, 2, ...; gaps = dropped windows) */
-  uint32_t samples;         /**< samples in the window */
-  uint32_t used_samples;    /**< samples accumulated (not warm-up, not faulty) */
-  uint32_t overruns;        /**< windows dropped since init (background too slow) */
-  int valid;                /**< 1: T_R and R_S can both be trusted (tr_valid && rs_valid) */
-  int status;               /**< IMEST_REASON_NONE, else the first reason (tr_reason if T_R is
+  uint32_t seq;              /**< window sequence number (0, 1, 2, ...; gaps = dropped windows) */
+  uint32_t samples;          /**< samples in the window */
+  uint32_t used_samples;     /**< samples accumulated (not warm-up, not faulty) */
+  uint32_t overruns;         /**< windows dropped since init (background too slow) */
+  int valid;                 /**< 1: T_R and R_S can both be trusted (tr_valid && rs_valid) */
+  int status;                /**< IMEST_REASON_NONE, else the first reason (tr_reason if T_R is
                                  not valid, else rs_reason): imest_reason_t */
-  int tr_valid;             /**< 1: T_R can be trusted (feed it to the IFOC) */
-  int tr_reason;            /**< why T_R is not valid (imest_reason_t; NONE if tr_valid) */
-  int rs_valid;             /**< 1: R_S can be trusted */
-  int rs_reason;            /**< why R_S is not valid (imest_reason_t; NONE if rs_valid) */
-  unsigned int flags;       /**< IMEST_FLAG_* bits */
-  double t_end_s;           /**< time of the window's last sample since init [s] */
-  double span_s;            /**< time the estimate is drawn from [s]: the window length,
+  int tr_valid;              /**< 1: T_R can be trusted (feed it to the IFOC) */
+  int tr_reason;             /**< why T_R is not valid (imest_reason_t; NONE if tr_valid) */
+  int rs_valid;              /**< 1: R_S can be trusted */
+  int rs_reason;             /**< why R_S is not valid (imest_reason_t; NONE if rs_valid) */
+  unsigned int flags;        /**< IMEST_FLAG_* bits */
+  double t_end_s;            /**< time of the window's last sample since init [s] */
+  double span_s;             /**< time the estimate is drawn from [s]: the window length,
                                  longer when consecutive windows were combined */
-  unsigned int windows;     /**< windows combined into this estimate (1: this one alone) */
-  double tr_s;              /**< rotor time constant T_R [s] (NaN if no candidate) */
-  double rs_ohm;            /**< stator resistance R_S [ohm] */
-  double tr_bound_rel;      /**< error bound of T_R, relative (NaN if not computed) */
-  double rs_bound_rel;      /**< error bound of R_S, relative (NaN if not computed) */
-  double k1;                /**< K1 = gamma [1/s] */
-  double k2;                /**< K2 = 1/T_R [1/s] */
-  double e;                 /**< E_p^2 at the minimum (units of y^2 * samples) */
-  double e_i;               /**< residual error index sqrt(E/R_y) */
-  double hessian[2][2];     /**< d2E/dK^2 at the minimum, K = (K1, K2) */
-  double pe_k1;             /**< parametric error index of K1 (absolute, 1/s) */
-  double pe_k2;             /**< parametric error index of K2 (absolute, 1/s) */
-  double pe_k1_rel;         /**< pe_k1 / K1 */
-  double pe_k2_rel;         /**< pe_k2 / K2 */
-  double slip_ratio;        /**< slip excitation (slip frequency x tr_nominal_s), see min_slip_ratio */
-  double i_rms_a;           /**< rms stator current over the window (alpha/beta amplitude) */
-  unsigned int n_roots;     /**< positive roots of the resultant */
-  unsigned int n_admissible;/**< roots with K1 > 0 and T_R in band */
+  unsigned int windows;      /**< windows combined into this estimate (1: this one alone) */
+  double tr_s;               /**< rotor time constant T_R [s] (NaN if no candidate) */
+  double rs_ohm;             /**< stator resistance R_S [ohm] */
+  double tr_bound_rel;       /**< error bound of T_R, relative (NaN if not computed) */
+  double rs_bound_rel;       /**< error bound of R_S, relative (NaN if not computed) */
+  double k1;                 /**< K1 = gamma [1/s] */
+  double k2;                 /**< K2 = 1/T_R [1/s] */
+  double e;                  /**< E_p^2 at the minimum (units of y^2 * samples) */
+  double e_i;                /**< residual error index sqrt(E/R_y) */
+  double hessian[2][2];      /**< d2E/dK^2 at the minimum, K = (K1, K2) */
+  double pe_k1;              /**< parametric error index of K1 (absolute, 1/s) */
+  double pe_k2;              /**< parametric error index of K2 (absolute, 1/s) */
+  double pe_k1_rel;          /**< pe_k1 / K1 */
+  double pe_k2_rel;          /**< pe_k2 / K2 */
+  double slip_ratio;         /**< slip excitation (slip frequency x tr_nominal_s), see min_slip_ratio */
+  double i_rms_a;            /**< rms stator current over the window (alpha/beta amplitude) */
+  unsigned int n_roots;      /**< positive roots of the resultant */
+  unsigned int n_admissible; /**< roots with K1 > 0 and T_R in band */
   double roots_k2[IMEST_MAX_ROOTS]; /**< the positive roots, ascending */
 } imest_result_t;
 
@@ -273,10 +273,10 @@ typedef float imest_real_t;
 
 /** One window's sums, as handed from the ISR to the background. */
 typedef struct {
-  imest_real_t sum[IMEST_NACC];   /**< folded block sums */
-  imest_real_t blk[IMEST_NACC];   /**< the current (unfolded) block of each entry */
-  imest_real_t c0[7];             /**< centring vector used for this window (y - W c0 accumulated) */
-  imest_real_t rot;               /**< sum of the angle steps of the used samples [rad] */
+  imest_real_t sum[IMEST_NACC]; /**< folded block sums */
+  imest_real_t blk[IMEST_NACC]; /**< the current (unfolded) block of each entry */
+  imest_real_t c0[7];           /**< centring vector used for this window (y - W c0 accumulated) */
+  imest_real_t rot;             /**< sum of the angle steps of the used samples [rad] */
   uint32_t seq;
   uint32_t samples;
   uint32_t used;
@@ -287,14 +287,14 @@ typedef struct {
  *  Bilinear low-pass sections have binomial numerators, so only their gains
  *  are stored. */
 typedef struct {
-  imest_real_t b0, a1;            /**< section 1: b0 (1 + z^-1) / (1 + a1 z^-1) */
-  imest_real_t c0, d1, d2;        /**< section 2: c0 (1 + 2 z^-1 + z^-2) / (1 + d1 z^-1 + d2 z^-2) */
+  imest_real_t b0, a1;     /**< section 1: b0 (1 + z^-1) / (1 + a1 z^-1) */
+  imest_real_t c0, d1, d2; /**< section 2: c0 (1 + 2 z^-1 + z^-2) / (1 + d1 z^-1 + d2 z^-2) */
 } imest_bw3_t;
 
 /** Filter state of one channel: 3 section states and the last two outputs. */
 typedef struct {
   imest_real_t s1, s2a, s2b;
-  imest_real_t y1, y2;            /**< x_f[n-1], x_f[n-2] */
+  imest_real_t y1, y2; /**< x_f[n-1], x_f[n-2] */
 } imest_chan_t;
 
 /** 2nd-order analog anti-alias model applied to the speed channel (bilinear:
@@ -306,34 +306,34 @@ typedef struct {
 /** Estimator instance. All fields are private; sizes are what the ISR needs. */
 typedef struct {
   /* constants derived at init */
-  imest_real_t fs, inv2t, invt2;        /* fs, 1/(2T), 1/T^2 */
-  imest_real_t n, m, inv_s;             /* n_p, M*beta, 1/(sigma L_S) */
+  imest_real_t fs, inv2t, invt2;                    /* fs, 1/(2T), 1/T^2 */
+  imest_real_t n, m, inv_s;                         /* n_p, M*beta, 1/(sigma L_S) */
   imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max; /* dth_max: largest angle step [rad] */
   uint32_t window_n, warmup_n;
-  uint32_t aa_on;                       /* anti-alias model in use */
+  uint32_t aa_on; /* anti-alias model in use */
   imest_bw3_t bw;
   imest_sos_t aa;
   /* ISR state */
-  imest_chan_t ch[5];            /* u_x, u_y, i_x, i_y, omega */
-  imest_real_t aa_s1, aa_s2;            /* anti-alias model state (speed) */
-  imest_real_t dly;                     /* u_delay_s * fs: currents/angle delay (fraction) */
+  imest_chan_t ch[5];                     /* u_x, u_y, i_x, i_y, omega */
+  imest_real_t aa_s1, aa_s2;              /* anti-alias model state (speed) */
+  imest_real_t dly;                       /* u_delay_s * fs: currents/angle delay (fraction) */
   imest_real_t ia_prev, ib_prev, wr_prev; /* previous alpha/beta current, raw speed */
-  imest_real_t th_prev;                 /* previous mechanical angle (as given) */
-  imest_real_t dcb_a;                   /* offset high-pass: mean-tracking gain per sample */
-  imest_real_t dcb[4];                  /* tracked means of u_alpha, u_beta, i_alpha, i_beta */
-  uint32_t k;                    /* sample index in the current window */
-  uint32_t warm;                 /* warm-up samples still to discard */
-  uint32_t seq;                  /* sequence number of the window being filled */
-  uint32_t started;              /* first sample seen */
-  volatile uint32_t published;   /* ISR -> background: count of buffers handed over; the
+  imest_real_t th_prev;                   /* previous mechanical angle (as given) */
+  imest_real_t dcb_a;                     /* offset high-pass: mean-tracking gain per sample */
+  imest_real_t dcb[4];                    /* tracked means of u_alpha, u_beta, i_alpha, i_beta */
+  uint32_t k;                             /* sample index in the current window */
+  uint32_t warm;                          /* warm-up samples still to discard */
+  uint32_t seq;                           /* sequence number of the window being filled */
+  uint32_t started;                       /* first sample seen */
+  volatile uint32_t published;            /* ISR -> background: count of buffers handed over; the
                                     ISR fills win[published & 1] */
-  volatile uint32_t released;    /* background -> ISR: count of buffers released */
-  volatile uint32_t overruns;    /* windows dropped */
+  volatile uint32_t released;             /* background -> ISR: count of buffers released */
+  volatile uint32_t overruns;             /* windows dropped */
   imest_window_t win[2];
   /* background-only state */
   float sigma, ls_h, tr_nominal_s, tr_min_s, tr_max_s, rs_min_ohm, rs_max_ohm;
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
-  float last_k1, last_k2;        /* last valid estimate: centring of later windows */
+  float last_k1, last_k2; /* last valid estimate: centring of later windows */
 } imest_t;
 
 /* ----------------------------------------------------------------------------
@@ -365,8 +365,8 @@ int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], fl
  *  scales u and i alike, which leaves T_R and R_S unchanged but changes E,
  *  min_current_a and the saturation check, which then apply to alpha/beta).
  *  @retval 1, 0  as imest_isr_abc() */
-int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a,
-                 float i_beta_a, float theta_rad);
+int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a, float i_beta_a,
+                 float theta_rad);
 
 /** End the current window now, shorter than window_s (a drive that stops, a
  *  recording that ends): it is handed to the background like a completed one

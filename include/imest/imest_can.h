@@ -60,15 +60,15 @@ extern "C" {
 /** Identifier flag: set in imest_can_frame.id (and in a base id) for a
  *  29-bit extended identifier; clear for an 11-bit standard one. Same value
  *  as Linux's CAN_EFF_FLAG. */
-#define IMEST_CAN_ID_EXT 0x80000000u
+#define IMEST_CAN_ID_EXT   0x80000000u
 #define IMEST_CAN_SFF_MASK 0x000007FFu
 #define IMEST_CAN_EFF_MASK 0x1FFFFFFFu
 
 /** One classic CAN data frame. */
 typedef struct imest_can_frame {
-  uint32_t id;              /**< identifier, | IMEST_CAN_ID_EXT if extended */
-  unsigned int dlc;         /**< data length 0..8 (imest sends 8) */
-  unsigned char data[8];    /**< one octet (0..255) per element */
+  uint32_t id;           /**< identifier, | IMEST_CAN_ID_EXT if extended */
+  unsigned int dlc;      /**< data length 0..8 (imest sends 8) */
+  unsigned char data[8]; /**< one octet (0..255) per element */
 } imest_can_frame_t;
 
 /** A transmit port. send() must not block: it queues the frame (or writes it)
@@ -80,34 +80,34 @@ typedef struct imest_can_port {
 } imest_can_port_t;
 
 /** Frames per window, and their offsets from the base identifier. */
-#define IMEST_CAN_NFRAMES 6
-#define IMEST_CAN_FRAME_TR      0  /**< base+0: T_R, E_I */
-#define IMEST_CAN_FRAME_RS      1  /**< base+1: R_S, relative PE index of K2 */
-#define IMEST_CAN_FRAME_QUAL    2  /**< base+2: PE K1, status, valid, bits, roots */
-#define IMEST_CAN_FRAME_STAT    3  /**< base+3: sequence number, failed sends */
-#define IMEST_CAN_FRAME_VERDICT 4  /**< base+4: per-parameter verdicts, span, windows */
-#define IMEST_CAN_FRAME_BOUNDS  5  /**< base+5: relative error bounds */
+#define IMEST_CAN_NFRAMES       6
+#define IMEST_CAN_FRAME_TR      0 /**< base+0: T_R, E_I */
+#define IMEST_CAN_FRAME_RS      1 /**< base+1: R_S, relative PE index of K2 */
+#define IMEST_CAN_FRAME_QUAL    2 /**< base+2: PE K1, status, valid, bits, roots */
+#define IMEST_CAN_FRAME_STAT    3 /**< base+3: sequence number, failed sends */
+#define IMEST_CAN_FRAME_VERDICT 4 /**< base+4: per-parameter verdicts, span, windows */
+#define IMEST_CAN_FRAME_BOUNDS  5 /**< base+5: relative error bounds */
 
 /** Suggested base identifier (free in the CANopen predefined connection set);
  *  tools/imest.dbc is written for it. Nodes are best spaced
  *  IMEST_CAN_ID_STRIDE apart (node n: 0x6A0 + 8 n), which leaves room for
  *  frames added later. */
 #define IMEST_CAN_DEFAULT_BASE_ID 0x6A0u
-#define IMEST_CAN_ID_STRIDE 8u
+#define IMEST_CAN_ID_STRIDE       8u
 
 /** Saturation bits (imest_can_window_t.sat; carried in IMEST_QUAL, and in
  *  IMEST_VERDICT / IMEST_BOUNDS for their own fields): the value was outside
  *  its field's range and was clamped to the nearest end (float32 fields:
  *  +-FLT_MAX; infinities are sent as infinities). A receiver must show a
  *  clamped value as a bound ("> 1.31068"), never as the value. */
-#define IMEST_CAN_SAT_TR     0x01u
-#define IMEST_CAN_SAT_RS     0x02u
-#define IMEST_CAN_SAT_EI     0x04u
-#define IMEST_CAN_SAT_PEK1   0x08u
-#define IMEST_CAN_SAT_PEK2   0x10u
-#define IMEST_CAN_SAT_SPAN   0x20u
-#define IMEST_CAN_SAT_TRB    0x40u
-#define IMEST_CAN_SAT_RSB    0x80u
+#define IMEST_CAN_SAT_TR   0x01u
+#define IMEST_CAN_SAT_RS   0x02u
+#define IMEST_CAN_SAT_EI   0x04u
+#define IMEST_CAN_SAT_PEK1 0x08u
+#define IMEST_CAN_SAT_PEK2 0x10u
+#define IMEST_CAN_SAT_SPAN 0x20u
+#define IMEST_CAN_SAT_TRB  0x40u
+#define IMEST_CAN_SAT_RSB  0x80u
 
 /**
  * Check a base identifier: an 11-bit standard identifier, or a 29-bit extended
@@ -126,39 +126,39 @@ int imest_can_base_id_check(uint32_t base_id);
  *  values are unsigned, Intel byte order; "all ones" is the raw value with
  *  every bit of the signal set (65535 for 16 bits). */
 typedef enum {
-  IMEST_CAN_F32 = 0,  /**< double field <-> IEEE-754 binary32 (32 bits). NaN and
+  IMEST_CAN_F32 = 0, /**< double field <-> IEEE-754 binary32 (32 bits). NaN and
                            +-inf are carried; finite values beyond +-FLT_MAX are
                            clamped and set the signal's saturation bit */
-  IMEST_CAN_SCALED,   /**< double field >= 0 <-> raw / scale, raw 0 .. all ones - 1;
+  IMEST_CAN_SCALED,  /**< double field >= 0 <-> raw / scale, raw 0 .. all ones - 1;
                            all ones = not available (NaN); negative or too large:
                            clamped to 0 / all ones - 1 with the saturation bit */
-  IMEST_CAN_COUNT,    /**< unsigned int field (at most 16 bits), saturating at all ones */
-  IMEST_CAN_U32,      /**< uint32_t field, saturating at all ones */
-  IMEST_CAN_ENUM,     /**< int field holding an imest_reason_t; a value outside
+  IMEST_CAN_COUNT,   /**< unsigned int field (at most 16 bits), saturating at all ones */
+  IMEST_CAN_U32,     /**< uint32_t field, saturating at all ones */
+  IMEST_CAN_ENUM,    /**< int field holding an imest_reason_t; a value outside
                            0 .. all ones - 1 is sent as all ones (out of range) */
-  IMEST_CAN_BOOL,     /**< int field, 1 bit: nonzero -> 1 */
-  IMEST_CAN_FLAG,     /**< 1 bit: bit `mask` (IMEST_FLAG_*) of the unsigned int field */
-  IMEST_CAN_SAT,      /**< 1 bit: saturation bit `mask` (IMEST_CAN_SAT_*) of the window */
-  IMEST_CAN_TXFAIL    /**< the publisher's failed-send count, saturating at all ones */
+  IMEST_CAN_BOOL,    /**< int field, 1 bit: nonzero -> 1 */
+  IMEST_CAN_FLAG,    /**< 1 bit: bit `mask` (IMEST_FLAG_*) of the unsigned int field */
+  IMEST_CAN_SAT,     /**< 1 bit: saturation bit `mask` (IMEST_CAN_SAT_*) of the window */
+  IMEST_CAN_TXFAIL   /**< the publisher's failed-send count, saturating at all ones */
 } imest_can_kind_t;
 
 /** One signal. The name of each signal is in tools/imest.dbc (the C side
  *  needs none); test/can matches the two by frame and start bit. */
 typedef struct {
-  uint32_t scale;           /**< IMEST_CAN_SCALED: raw counts per physical unit,
+  uint32_t scale;       /**< IMEST_CAN_SCALED: raw counts per physical unit,
                                  physical = raw / scale (the DBC factor is 1/scale); else 1 */
-  unsigned short field;     /**< offsetof(imest_result_t, <field>) (F32 .. FLAG) */
-  unsigned short mask;      /**< F32/SCALED: its IMEST_CAN_SAT_* bit; FLAG: the
+  unsigned short field; /**< offsetof(imest_result_t, <field>) (F32 .. FLAG) */
+  unsigned short mask;  /**< F32/SCALED: its IMEST_CAN_SAT_* bit; FLAG: the
                                  IMEST_FLAG_* bit; SAT: the IMEST_CAN_SAT_* bit it carries */
-  unsigned char frame;      /**< IMEST_CAN_FRAME_* */
-  unsigned char start;      /**< start bit (DBC numbering, Intel: bit k = bit k%8 of octet k/8) */
-  unsigned char len;        /**< bits */
-  unsigned char kind;       /**< imest_can_kind_t */
+  unsigned char frame;  /**< IMEST_CAN_FRAME_* */
+  unsigned char start;  /**< start bit (DBC numbering, Intel: bit k = bit k%8 of octet k/8) */
+  unsigned char len;    /**< bits */
+  unsigned char kind;   /**< imest_can_kind_t */
 } imest_can_signal_t;
 
 /** Rolling counter and CRC: the same bits in every frame. */
 #define IMEST_CAN_COUNTER_START 48u
-#define IMEST_CAN_CRC_START 56u
+#define IMEST_CAN_CRC_START     56u
 
 /** The signal table (counter and CRC excluded), ordered by frame and start bit.
  *  @param count  receives the number of signals (may be NULL)
@@ -172,9 +172,9 @@ const imest_can_signal_t *imest_can_signal_table(unsigned int *count);
 /** A publisher: caller-owned, one per CAN node. Fields are readable. */
 typedef struct {
   const imest_can_port_t *port;
-  uint32_t base_id;         /**< as given to imest_can_pub_init() */
-  uint32_t counter;         /**< rolling counter of the next window (sent mod 256) */
-  uint32_t tx_failed;       /**< frames port->send refused since init (also sent in
+  uint32_t base_id;   /**< as given to imest_can_pub_init() */
+  uint32_t counter;   /**< rolling counter of the next window (sent mod 256) */
+  uint32_t tx_failed; /**< frames port->send refused since init (also sent in
                                  IMEST_STAT, saturating at 65535 there) */
 } imest_can_pub_t;
 
@@ -207,11 +207,11 @@ int imest_can_publish(imest_can_pub_t *pub, const imest_result_t *r);
  *  (reasons) or 0, and their frame's bit is clear in `have`. Fields of
  *  imest_result_t that are not on the bus (k1, hessian, roots ...) are 0. */
 typedef struct {
-  imest_result_t result;    /**< T_R, R_S, verdicts, indices, flags, seq, ... */
-  unsigned int have;        /**< bit i: frame base+i received and CRC-valid */
-  unsigned int counter;     /**< rolling counter (0..255) */
-  unsigned int sat;         /**< IMEST_CAN_SAT_* of the frames received */
-  uint32_t tx_failed;       /**< sender's failed-send count (saturates at 65535) */
+  imest_result_t result; /**< T_R, R_S, verdicts, indices, flags, seq, ... */
+  unsigned int have;     /**< bit i: frame base+i received and CRC-valid */
+  unsigned int counter;  /**< rolling counter (0..255) */
+  unsigned int sat;      /**< IMEST_CAN_SAT_* of the frames received */
+  uint32_t tx_failed;    /**< sender's failed-send count (saturates at 65535) */
 } imest_can_window_t;
 
 /** CRC-8 SAE J1850 (poly 0x1D, init 0xFF, final xor 0xFF; check("123456789") = 0x4B)
@@ -226,14 +226,14 @@ unsigned int imest_can_crc8(const unsigned char *data, unsigned int n);
  * @retval IMEST_ERR_NULL  r or f is NULL
  * @retval IMEST_ERR_ARG   index >= IMEST_CAN_NFRAMES or base_id out of range
  */
-int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id,
-                   unsigned int counter, uint32_t tx_failed, imest_can_frame_t *f);
+int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id, unsigned int counter,
+                   uint32_t tx_failed, imest_can_frame_t *f);
 
 /** Outcomes of imest_can_decode_frame() (non-negative: the call worked). */
-#define IMEST_CAN_DEC_OK       0  /**< decoded into the window */
-#define IMEST_CAN_DEC_FOREIGN  1  /**< not one of ours (identifier outside base..base+5) */
-#define IMEST_CAN_DEC_BAD_DLC  2  /**< ours, but not 8 data bytes */
-#define IMEST_CAN_DEC_BAD_CRC  3  /**< ours, checksum mismatch */
+#define IMEST_CAN_DEC_OK      0 /**< decoded into the window */
+#define IMEST_CAN_DEC_FOREIGN 1 /**< not one of ours (identifier outside base..base+5) */
+#define IMEST_CAN_DEC_BAD_DLC 2 /**< ours, but not 8 data bytes */
+#define IMEST_CAN_DEC_BAD_CRC 3 /**< ours, checksum mismatch */
 
 /**
  * Check one frame and decode the signals it carries into *w (sets bit `index`
@@ -243,8 +243,8 @@ int imest_can_pack(const imest_result_t *r, unsigned int index, uint32_t base_id
  *         IMEST_CAN_DEC_BAD_CRC  the frame's outcome (w is written only on OK)
  * @retval IMEST_ERR_NULL  f or w is NULL
  */
-int imest_can_decode_frame(const imest_can_frame_t *f, uint32_t base_id,
-                           imest_can_window_t *w, unsigned int *index);
+int imest_can_decode_frame(const imest_can_frame_t *f, uint32_t base_id, imest_can_window_t *w,
+                           unsigned int *index);
 
 /** Clear a decoded window: have = 0, table fields NaN / -1 / 0 as above. */
 void imest_can_window_clear(imest_can_window_t *w);
@@ -254,64 +254,68 @@ void imest_can_window_clear(imest_can_window_t *w);
  * ------------------------------------------------------------------------- */
 
 /** Event bits of imest_can_rx_feed(). */
-#define IMEST_CAN_EV_FOREIGN    0x001u /**< frame not ours: ignored */
-#define IMEST_CAN_EV_CORRUPT    0x002u /**< ours, bad CRC or DLC: dropped (not counted lost) */
-#define IMEST_CAN_EV_REPEATED   0x004u /**< ours, same counter as the last of its id: dropped */
-#define IMEST_CAN_EV_LOST       0x008u /**< with EV_WINDOW: ev.lost frames never arrived,
+#define IMEST_CAN_EV_FOREIGN  0x001u /**< frame not ours: ignored */
+#define IMEST_CAN_EV_CORRUPT  0x002u /**< ours, bad CRC or DLC: dropped (not counted lost) */
+#define IMEST_CAN_EV_REPEATED 0x004u /**< ours, same counter as the last of its id: dropped */
+#define IMEST_CAN_EV_LOST                                                                                    \
+  0x008u                               /**< with EV_WINDOW: ev.lost frames never arrived,
                                             up to and in the returned window */
 #define IMEST_CAN_EV_WINDOW     0x010u /**< a window is returned in *out (complete or not) */
 #define IMEST_CAN_EV_INCOMPLETE 0x020u /**< ... and it lacks frames */
-#define IMEST_CAN_EV_SEQ_GAP    0x040u /**< with EV_WINDOW: the sequence number skipped
+#define IMEST_CAN_EV_SEQ_GAP                                                                                 \
+  0x040u /**< with EV_WINDOW: the sequence number skipped
                                             ev.seq_gap more windows than the rolling counter:
                                             windows the estimator dropped (overruns), not
                                             lost on the bus */
-#define IMEST_CAN_EV_RESTART    0x080u /**< with EV_WINDOW: its sequence number went back:
+#define IMEST_CAN_EV_RESTART                                                                                 \
+  0x080u /**< with EV_WINDOW: its sequence number went back:
                                             the sender restarted (no loss counted across) */
-#define IMEST_CAN_EV_LATE       0x100u /**< ours, a frame of the window already returned
+#define IMEST_CAN_EV_LATE                                                                                    \
+  0x100u /**< ours, a frame of the window already returned
                                             incomplete (sent out of order): dropped */
 
 /** Details of one imest_can_rx_feed() call. */
 typedef struct {
-  unsigned int events;     /**< IMEST_CAN_EV_* */
-  unsigned int index;      /**< frame index (when ours) */
-  unsigned int counter;    /**< its rolling counter (when decoded) */
+  unsigned int events;       /**< IMEST_CAN_EV_* */
+  unsigned int index;        /**< frame index (when ours) */
+  unsigned int counter;      /**< its rolling counter (when decoded) */
   unsigned int prev_counter; /**< counter of the window returned before (EV_LOST) */
-  uint32_t lost;           /**< EV_LOST: frames lost */
-  uint32_t seq_gap;        /**< EV_SEQ_GAP: windows dropped by the estimator */
-  int dec;                 /**< IMEST_CAN_DEC_* of the frame */
+  uint32_t lost;             /**< EV_LOST: frames lost */
+  uint32_t seq_gap;          /**< EV_SEQ_GAP: windows dropped by the estimator */
+  int dec;                   /**< IMEST_CAN_DEC_* of the frame */
 } imest_can_rx_event_t;
 
 /** Running totals of a reader. */
 typedef struct {
-  uint32_t frames;         /**< frames fed */
+  uint32_t frames; /**< frames fed */
   uint32_t foreign;
-  uint32_t corrupt;        /**< bad CRC or DLC (not also counted as lost) */
+  uint32_t corrupt; /**< bad CRC or DLC (not also counted as lost) */
   uint32_t repeated;
   uint32_t late;
-  uint32_t lost;           /**< frames that never arrived (rolling-counter accounting;
+  uint32_t lost;       /**< frames that never arrived (rolling-counter accounting;
                                 not across a sender restart) */
-  uint32_t windows;        /**< windows returned */
-  uint32_t incomplete;     /**< of which incomplete */
-  uint32_t seq_gaps;       /**< windows dropped by the estimator (sequence gaps
+  uint32_t windows;    /**< windows returned */
+  uint32_t incomplete; /**< of which incomplete */
+  uint32_t seq_gaps;   /**< windows dropped by the estimator (sequence gaps
                                 beyond what the counter explains) */
-  uint32_t restarts;       /**< sequence number went backwards */
+  uint32_t restarts;   /**< sequence number went backwards */
 } imest_can_rx_stats_t;
 
 /** Reader state (caller-owned; fields private except `st`). */
 typedef struct {
   uint32_t base_id;
-  unsigned int seen;                      /* bit i: a frame of id i was seen */
+  unsigned int seen; /* bit i: a frame of id i was seen */
   unsigned int last_ctr[IMEST_CAN_NFRAMES];
-  int open;                               /* a window is being assembled */
+  int open; /* a window is being assembled */
   imest_can_window_t cur;
-  int have_prev;                          /* a window was returned before */
-  unsigned int prev_ctr, prev_have;       /* its counter and frames */
-  uint32_t corrupt_cur;                   /* corrupt frames in place of the open window's */
-  uint32_t corrupt_next;                  /* ... and of the window that opens next */
+  int have_prev;                    /* a window was returned before */
+  unsigned int prev_ctr, prev_have; /* its counter and frames */
+  uint32_t corrupt_cur;             /* corrupt frames in place of the open window's */
+  uint32_t corrupt_next;            /* ... and of the window that opens next */
   int have_seq;
   uint32_t last_seq;
-  unsigned int last_seq_ctr;              /* counter of the window that carried last_seq */
-  imest_can_rx_stats_t st;                /**< running totals */
+  unsigned int last_seq_ctr; /* counter of the window that carried last_seq */
+  imest_can_rx_stats_t st;   /**< running totals */
 } imest_can_rx_t;
 
 /**
@@ -334,8 +338,8 @@ int imest_can_rx_init(imest_can_rx_t *rx, uint32_t base_id);
  * @return the event bits (>= 0)
  * @retval IMEST_ERR_NULL  rx or f is NULL
  */
-int imest_can_rx_feed(imest_can_rx_t *rx, const imest_can_frame_t *f,
-                      imest_can_window_t *out, imest_can_rx_event_t *ev);
+int imest_can_rx_feed(imest_can_rx_t *rx, const imest_can_frame_t *f, imest_can_window_t *out,
+                      imest_can_rx_event_t *ev);
 
 /**
  * End of input: return the window still being assembled (frames missing after

@@ -3,7 +3,8 @@
 
 #include <stddef.h>
 
-static int cb_send(void *ctx, const imest_can_frame_t *f) {
+static int cb_send(void *ctx, const imest_can_frame_t *f)
+{
   imest_can_callback_t *cb = (imest_can_callback_t *)ctx;
   int ext;
   uint32_t id;
@@ -20,7 +21,8 @@ static int cb_send(void *ctx, const imest_can_frame_t *f) {
   return 0;
 }
 
-int imest_can_callback_init(imest_can_callback_t *cb, imest_can_hal_tx_fn_t tx, void *hal) {
+int imest_can_callback_init(imest_can_callback_t *cb, imest_can_hal_tx_fn_t tx, void *hal)
+{
   if (cb == NULL || tx == NULL) {
     return -1;
   }

@@ -29,15 +29,15 @@ extern "C" {
 /** HAL transmit hook. id: 11-bit or 29-bit identifier (without flag);
  *  extended: 1 for a 29-bit identifier; data: dlc octets. Must not block.
  *  @return 0 when queued, nonzero when not. */
-typedef int (*imest_can_hal_tx_fn_t)(void *hal, uint32_t id, int extended,
-                                   const unsigned char *data, unsigned int dlc);
+typedef int (*imest_can_hal_tx_fn_t)(void *hal, uint32_t id, int extended, const unsigned char *data,
+                                     unsigned int dlc);
 
 typedef struct imest_can_callback {
-  imest_can_port_t port;   /**< pass &cb.port to imest_can_pub_init() */
+  imest_can_port_t port; /**< pass &cb.port to imest_can_pub_init() */
   imest_can_hal_tx_fn_t tx;
-  void *hal;                    /**< the HAL handle given to tx (e.g. &hcan1) */
-  uint32_t sent;                /**< frames the HAL accepted */
-  uint32_t failed;              /**< frames it refused */
+  void *hal;       /**< the HAL handle given to tx (e.g. &hcan1) */
+  uint32_t sent;   /**< frames the HAL accepted */
+  uint32_t failed; /**< frames it refused */
 } imest_can_callback_t;
 
 /** Fill cb. @return 0, or -1 if cb or tx is NULL. */

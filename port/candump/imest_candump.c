@@ -6,7 +6,8 @@
 
 static const char *const k_default_iface = "vcan0";
 
-static int iface_ok(const char *s) {
+static int iface_ok(const char *s)
+{
   size_t n = strlen(s);
   size_t i;
   if (n == 0u || n >= IMEST_CANDUMP_IFNAMSIZ) {
@@ -21,8 +22,8 @@ static int iface_ok(const char *s) {
   return 1;
 }
 
-int imest_candump_format(char *buf, size_t n, double t_s, const char *iface,
-                         const imest_can_frame_t *f) {
+int imest_candump_format(char *buf, size_t n, double t_s, const char *iface, const imest_can_frame_t *f)
+{
   static const char hex[] = "0123456789ABCDEF";
   unsigned long long sec;
   unsigned long usec;
@@ -58,8 +59,7 @@ int imest_candump_format(char *buf, size_t n, double t_s, const char *iface,
     if (f->id > IMEST_CAN_SFF_MASK) {
       return -1;
     }
-    len = snprintf(tmp, sizeof tmp, "(%010llu.%06lu) %s %03lX#", sec, usec, iface,
-                   (unsigned long)f->id);
+    len = snprintf(tmp, sizeof tmp, "(%010llu.%06lu) %s %03lX#", sec, usec, iface, (unsigned long)f->id);
   }
   if (len < 0 || (size_t)len + 2u * f->dlc >= sizeof tmp) {
     return -1;
@@ -78,23 +78,25 @@ int imest_candump_format(char *buf, size_t n, double t_s, const char *iface,
   return (int)pos;
 }
 
-static int hexval(char c) {
+static int hexval(char c)
+{
   if (c >= '0' && c <= '9') return c - '0';
   if (c >= 'a' && c <= 'f') return c - 'a' + 10;
   if (c >= 'A' && c <= 'F') return c - 'A' + 10;
   return -1;
 }
 
-#define FAIL(msg)           \
-  do {                      \
-    if (err != NULL) {      \
-      *err = (msg);         \
-    }                       \
-    return IMEST_CANDUMP_ERROR; \
+#define FAIL(msg)                                                                                            \
+  do {                                                                                                       \
+    if (err != NULL) {                                                                                       \
+      *err = (msg);                                                                                          \
+    }                                                                                                        \
+    return IMEST_CANDUMP_ERROR;                                                                              \
   } while (0)
 
 int imest_candump_parse(const char *line, double *t_s, char iface[IMEST_CANDUMP_IFNAMSIZ],
-                        imest_can_frame_t *f, const char **err) {
+                        imest_can_frame_t *f, const char **err)
+{
   const char *p = line;
   const char *q;
   double sec = 0.0;
@@ -193,11 +195,11 @@ int imest_candump_parse(const char *line, double *t_s, char iface[IMEST_CANDUMP_
   return IMEST_CANDUMP_OK;
 }
 
-static int candump_send(void *ctx, const imest_can_frame_t *f) {
+static int candump_send(void *ctx, const imest_can_frame_t *f)
+{
   imest_candump_port_t *p = (imest_candump_port_t *)ctx;
   char buf[IMEST_CANDUMP_LINE_MAX];
-  if (p == NULL || p->fp == NULL ||
-      imest_candump_format(buf, sizeof buf, p->t_s, p->iface, f) < 0 ||
+  if (p == NULL || p->fp == NULL || imest_candump_format(buf, sizeof buf, p->t_s, p->iface, f) < 0 ||
       fputs(buf, p->fp) == EOF || fputc('\n', p->fp) == EOF || ferror(p->fp)) {
     if (p != NULL) p->failed++;
     return -1;
@@ -206,7 +208,8 @@ static int candump_send(void *ctx, const imest_can_frame_t *f) {
   return 0;
 }
 
-int imest_candump_port_open(imest_candump_port_t *p, FILE *fp, const char *iface) {
+int imest_candump_port_open(imest_candump_port_t *p, FILE *fp, const char *iface)
+{
   if (p == NULL || fp == NULL) {
     return -1;
   }
@@ -225,7 +228,8 @@ int imest_candump_port_open(imest_candump_port_t *p, FILE *fp, const char *iface
   return 0;
 }
 
-void imest_candump_port_set_time(imest_candump_port_t *p, double t_s) {
+void imest_candump_port_set_time(imest_candump_port_t *p, double t_s)
+{
   if (p != NULL) {
     p->t_s = t_s;
   }

@@ -24,20 +24,19 @@
 extern "C" {
 #endif
 
-#define IMEST_CANDUMP_IFNAMSIZ 16        /**< as Linux IFNAMSIZ, including the NUL */
-#define IMEST_CANDUMP_LINE_MAX 64        /**< longest formatted line + NUL */
+#define IMEST_CANDUMP_IFNAMSIZ 16 /**< as Linux IFNAMSIZ, including the NUL */
+#define IMEST_CANDUMP_LINE_MAX 64 /**< longest formatted line + NUL */
 
 /** Format one line (no newline). t_s: timestamp in seconds (negative or
  *  non-finite -> 0), printed with microseconds. iface NULL -> "vcan0".
  *  @return characters written (excluding NUL), or -1 if buf is too small or
  *  the frame is invalid (dlc > 8, identifier out of range). */
-int imest_candump_format(char *buf, size_t n, double t_s, const char *iface,
-                         const imest_can_frame_t *f);
+int imest_candump_format(char *buf, size_t n, double t_s, const char *iface, const imest_can_frame_t *f);
 
 /** Results of imest_candump_parse(). */
-#define IMEST_CANDUMP_OK    0   /**< a frame */
-#define IMEST_CANDUMP_EMPTY 1   /**< blank line: nothing to do */
-#define IMEST_CANDUMP_ERROR (-1)/**< malformed: *err says why */
+#define IMEST_CANDUMP_OK    0    /**< a frame */
+#define IMEST_CANDUMP_EMPTY 1    /**< blank line: nothing to do */
+#define IMEST_CANDUMP_ERROR (-1) /**< malformed: *err says why */
 
 /**
  * Parse one line (a trailing newline / CR is accepted).
@@ -50,12 +49,12 @@ int imest_candump_parse(const char *line, double *t_s, char iface[IMEST_CANDUMP_
 
 /** A port that writes every frame as one line to a FILE*. */
 typedef struct imest_candump_port {
-  imest_can_port_t port;   /**< pass &p.port to imest_can_pub_init() */
+  imest_can_port_t port; /**< pass &p.port to imest_can_pub_init() */
   FILE *fp;
   char iface[IMEST_CANDUMP_IFNAMSIZ];
-  double t_s;                   /**< timestamp of the next lines */
-  unsigned long lines;          /**< lines written */
-  unsigned long failed;         /**< frames that could not be written */
+  double t_s;           /**< timestamp of the next lines */
+  unsigned long lines;  /**< lines written */
+  unsigned long failed; /**< frames that could not be written */
 } imest_candump_port_t;
 
 /** Set up p to write to fp (not closed by this library) with interface name

@@ -22,8 +22,8 @@ static int fail(char *err, size_t n, const char *msg, const char *text)
   return IMEST_ERR_ARG;
 }
 
-int imest_can_id_parse(const char *text, int force_ext, const char *ext_option, uint32_t *base_id,
-                       char *err, size_t n)
+int imest_can_id_parse(const char *text, int force_ext, const char *ext_option, uint32_t *base_id, char *err,
+                       size_t n)
 {
   const unsigned long last = (unsigned long)IMEST_CAN_NFRAMES - 1ul;
   char *end = NULL;

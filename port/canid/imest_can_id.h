@@ -36,8 +36,8 @@ extern "C" {
  * @retval IMEST_ERR_NULL  text, ext_option or base_id is NULL
  * @retval IMEST_ERR_ARG   not a number, negative, or out of range (*err says why)
  */
-int imest_can_id_parse(const char *text, int force_ext, const char *ext_option, uint32_t *base_id,
-                       char *err, size_t n);
+int imest_can_id_parse(const char *text, int force_ext, const char *ext_option, uint32_t *base_id, char *err,
+                       size_t n);
 
 /** Format an identifier as candump does: 3 hex digits for 11-bit, 8 for
  *  29-bit, with "0x" (e.g. "0x6A0", "0x18FF5000"). @return buf */

@@ -15,13 +15,15 @@
 #include <linux/can.h>
 #include <linux/can/raw.h>
 
-static int fail(imest_socketcan_t *sc, int e, const char *fmt, const char *a) {
+static int fail(imest_socketcan_t *sc, int e, const char *fmt, const char *a)
+{
   sc->last_errno = e;
   snprintf(sc->err, sizeof sc->err, fmt, a, strerror(e));
   return -e;
 }
 
-static int sc_send(void *ctx, const imest_can_frame_t *f) {
+static int sc_send(void *ctx, const imest_can_frame_t *f)
+{
   imest_socketcan_t *sc = (imest_socketcan_t *)ctx;
   struct can_frame cf;
   unsigned int i;
@@ -49,7 +51,8 @@ static int sc_send(void *ctx, const imest_can_frame_t *f) {
   return 0;
 }
 
-int imest_socketcan_open(imest_socketcan_t *sc, const char *ifname) {
+int imest_socketcan_open(imest_socketcan_t *sc, const char *ifname)
+{
   struct sockaddr_can addr;
   struct ifreq ifr;
   unsigned int idx;
@@ -110,8 +113,7 @@ int imest_socketcan_open(imest_socketcan_t *sc, const char *ifname) {
   if (ioctl(fd, SIOCGIFFLAGS, &ifr) == 0 && !(ifr.ifr_flags & IFF_UP)) {
     close(fd);
     fail(sc, ENETDOWN, "CAN interface '%s' is down (%s)", ifname);
-    snprintf(sc->err + strlen(sc->err), sizeof sc->err - strlen(sc->err),
-             ": ip link set up %s", ifname);
+    snprintf(sc->err + strlen(sc->err), sizeof sc->err - strlen(sc->err), ": ip link set up %s", ifname);
     return -ENETDOWN;
   }
   sc->fd = fd;
@@ -119,8 +121,8 @@ int imest_socketcan_open(imest_socketcan_t *sc, const char *ifname) {
   return 0;
 }
 
-int imest_socketcan_recv(imest_socketcan_t *sc, imest_can_frame_t *f, int timeout_ms,
-                         double *t_s) {
+int imest_socketcan_recv(imest_socketcan_t *sc, imest_can_frame_t *f, int timeout_ms, double *t_s)
+{
   struct pollfd pfd;
   struct can_frame cf;
   struct timespec ts;
@@ -145,8 +147,8 @@ int imest_socketcan_recv(imest_socketcan_t *sc, imest_can_frame_t *f, int timeou
       if (errno == EINTR || errno == EAGAIN) return 0;
       return fail(sc, errno, "receive on %s: %s", sc->ifname);
     }
-    if (n != (ssize_t)sizeof cf) continue;                       /* CAN FD or short */
-    if (cf.can_id & (CAN_RTR_FLAG | CAN_ERR_FLAG)) continue;    /* not a data frame */
+    if (n != (ssize_t)sizeof cf) continue;                   /* CAN FD or short */
+    if (cf.can_id & (CAN_RTR_FLAG | CAN_ERR_FLAG)) continue; /* not a data frame */
     if (cf.can_id & CAN_EFF_FLAG) {
       f->id = (uint32_t)(cf.can_id & CAN_EFF_MASK) | IMEST_CAN_ID_EXT;
     } else {
@@ -162,7 +164,8 @@ int imest_socketcan_recv(imest_socketcan_t *sc, imest_can_frame_t *f, int timeou
   }
 }
 
-void imest_socketcan_close(imest_socketcan_t *sc) {
+void imest_socketcan_close(imest_socketcan_t *sc)
+{
   if (sc != NULL && sc->fd >= 0) {
     close(sc->fd);
     sc->fd = -1;

@@ -23,12 +23,12 @@ extern "C" {
 #endif
 
 typedef struct imest_socketcan {
-  imest_can_port_t port;  /**< pass &sc.port to imest_can_pub_init() */
-  int fd;                      /**< CAN_RAW socket, -1 when closed */
+  imest_can_port_t port; /**< pass &sc.port to imest_can_pub_init() */
+  int fd;                /**< CAN_RAW socket, -1 when closed */
   int ifindex;
   char ifname[16];
-  int last_errno;              /**< errno of the last failure (open, send, recv) */
-  char err[256];               /**< human-readable message of the last failure */
+  int last_errno; /**< errno of the last failure (open, send, recv) */
+  char err[256];  /**< human-readable message of the last failure */
   unsigned long sent;
   unsigned long failed;
 } imest_socketcan_t;
@@ -46,8 +46,7 @@ int imest_socketcan_open(imest_socketcan_t *sc, const char *ifname);
  *  error and CAN FD frames are skipped. t_s (optional): receive time
  *  (CLOCK_REALTIME, seconds). @return 1 frame, 0 timeout / interrupted,
  *  -errno on error (sc->err set). */
-int imest_socketcan_recv(imest_socketcan_t *sc, imest_can_frame_t *f, int timeout_ms,
-                         double *t_s);
+int imest_socketcan_recv(imest_socketcan_t *sc, imest_can_frame_t *f, int timeout_ms, double *t_s);
 
 /** Close the socket (safe to call twice). */
 void imest_socketcan_close(imest_socketcan_t *sc);

@@ -9,13 +9,15 @@
 
 #include "imsim/imsim.h"
 
-static double now_s(void) {
+static double now_s(void)
+{
   struct timespec ts;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static double run(const char *label, const imsim_config_t *c, double motor_s) {
+static double run(const char *label, const imsim_config_t *c, double motor_s)
+{
   static imsim_t sim;
   imsim_sample_t s;
   if (imsim_init(&sim, c, &s) != 0) {
@@ -36,7 +38,8 @@ static double run(const char *label, const imsim_config_t *c, double motor_s) {
   return x;
 }
 
-int main(int argc, char **argv) {
+int main(int argc, char **argv)
+{
   const double motor_s = argc > 1 ? atof(argv[1]) : 60.0;
   imsim_config_t c;
   imsim_config_preset(&c, "exp2");

@@ -4,7 +4,8 @@
 
 #include "imsim_internal.h"
 
-void imsim_config_default(imsim_config_t *c) {
+void imsim_config_default(imsim_config_t *c)
+{
   memset(c, 0, sizeof *c);
   /* The paper's motor (Section VI) and docs/METHOD.md §9. */
   c->pole_pairs = 2;
@@ -73,7 +74,8 @@ void imsim_config_default(imsim_config_t *c) {
   c->duration_s = 2.0;
 }
 
-int imsim_config_preset(imsim_config_t *c, const char *name) {
+int imsim_config_preset(imsim_config_t *c, const char *name)
+{
   imsim_config_default(c);
   if (name != NULL && strcmp(name, "exp1") == 0) {
     return 0; /* 60 Hz, 230 V applied at standstill, no load, 2 s run-up */
@@ -98,4 +100,7 @@ int imsim_config_preset(imsim_config_t *c, const char *name) {
   return -1;
 }
 
-const char *imsim_preset_names(void) { return "exp1|exp2|" IMS_MOTOR_PRESET_NAMES; }
+const char *imsim_preset_names(void)
+{
+  return "exp1|exp2|" IMS_MOTOR_PRESET_NAMES;
+}

@@ -7,7 +7,8 @@
 
 /* Duties from an alpha-beta voltage command, as firmware computes them: the configured
    modulation with the measured bus, clipped to [0, 1]. Returns true if it clipped. */
-static bool duties_from(imsim_t *s, cpx v, double d[3]) {
+static bool duties_from(imsim_t *s, cpx v, double d[3])
+{
   double m[3];
   const double vdc = s->vdc_meas > 0.0 ? s->vdc_meas : s->c.vdc_v;
   const bool clipped = ims_pwm_modulate(s, v, vdc, m);
@@ -17,13 +18,15 @@ static bool duties_from(imsim_t *s, cpx v, double d[3]) {
 
 /* The reference a V/f drive computes at t for the sample period after the next one: taken at
    that period's centre, t + 1.5/fs, so that the applied fundamental is not delayed. */
-static cpx vf_command(const imsim_t *s, double t) {
+static cpx vf_command(const imsim_t *s, double t)
+{
   double amp, phs, f;
   ims_vf_ref(s, t + 1.5 * s->ts_s, &amp, &phs, &f);
   return cscale(cexpj(phs), amp);
 }
 
-void ims_drive_init(imsim_t *s) {
+void ims_drive_init(imsim_t *s)
+{
   for (int k = 0; k < 3; ++k) s->duty[k] = s->duty_next[k] = 0.5; /* zero voltage */
   if (!ims_firmware_timing(&s->c)) return;
   if (s->c.supply == IMSIM_SUPPLY_PWM) {
@@ -33,30 +36,30 @@ void ims_drive_init(imsim_t *s) {
   }
 }
 
-void ims_drive_update(imsim_t *s) {
+void ims_drive_update(imsim_t *s)
+{
   cpx v;
   switch (s->c.supply) {
-    case IMSIM_SUPPLY_PWM:
-      v = vf_command(s, s->t);
-      break;
-    case IMSIM_SUPPLY_IFOC:
-      /* the controller's synchronous-frame command rotated to the centre of its period */
-      v = ims_ifoc_vref(s, s->t + 1.5 * s->ts_s);
-      break;
-    case IMSIM_SUPPLY_EXT:
-    case IMSIM_SUPPLY_SINE:
-    case IMSIM_SUPPLY_VF:
-    default:
-      return; /* ext: set by the caller since the last step */
+  case IMSIM_SUPPLY_PWM: v = vf_command(s, s->t); break;
+  case IMSIM_SUPPLY_IFOC:
+    /* the controller's synchronous-frame command rotated to the centre of its period */
+    v = ims_ifoc_vref(s, s->t + 1.5 * s->ts_s);
+    break;
+  case IMSIM_SUPPLY_EXT:
+  case IMSIM_SUPPLY_SINE:
+  case IMSIM_SUPPLY_VF:
+  default: return; /* ext: set by the caller since the last step */
   }
   if (duties_from(s, v, s->duty_next)) s->pwm_clipped_half_periods += (uint64_t)s->k_steps;
 }
 
-void ims_drive_advance(imsim_t *s) {
+void ims_drive_advance(imsim_t *s)
+{
   for (int k = 0; k < 3; ++k) s->duty[k] = s->duty_next[k];
 }
 
-int imsim_set_duty(imsim_t *s, const double duty[3]) {
+int imsim_set_duty(imsim_t *s, const double duty[3])
+{
   if (s->c.supply != IMSIM_SUPPLY_EXT) return -1;
   if (!isfinite(duty[0]) || !isfinite(duty[1]) || !isfinite(duty[2])) return -1;
   bool clipped = false;
@@ -71,7 +74,8 @@ int imsim_set_duty(imsim_t *s, const double duty[3]) {
   return 0;
 }
 
-int imsim_set_voltage(imsim_t *s, const double u_abc[3]) {
+int imsim_set_voltage(imsim_t *s, const double u_abc[3])
+{
   if (s->c.supply != IMSIM_SUPPLY_EXT) return -1;
   if (!isfinite(u_abc[0]) || !isfinite(u_abc[1]) || !isfinite(u_abc[2])) return -1;
   double ab[2];

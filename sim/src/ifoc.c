@@ -2,7 +2,8 @@
  * encoder angle, slip from the controller's T_R (which the estimator may update). */
 #include "imsim_internal.h"
 
-void ims_ifoc_update(imsim_t *s) {
+void ims_ifoc_update(imsim_t *s)
+{
   const imsim_config_t *c = &s->c;
   const double ts = s->ts_s;
   const double np = (double)c->pole_pairs;
@@ -22,9 +23,12 @@ void ims_ifoc_update(imsim_t *s) {
     const double ki = kp * 2.0 * PI * c->speed_bw_hz / 4.0;
     const double e = wref - s->w_meas;
     te_ref = kp * e + s->integ_w;
-    if (te_ref > c->torque_limit_nm) te_ref = c->torque_limit_nm;
-    else if (te_ref < -c->torque_limit_nm) te_ref = -c->torque_limit_nm;
-    else s->integ_w += ki * e * ts;
+    if (te_ref > c->torque_limit_nm)
+      te_ref = c->torque_limit_nm;
+    else if (te_ref < -c->torque_limit_nm)
+      te_ref = -c->torque_limit_nm;
+    else
+      s->integ_w += ki * e * ts;
   } else {
     te_ref = c->torque_ref_nm;
     if (te_ref > c->torque_limit_nm) te_ref = c->torque_limit_nm;
@@ -65,16 +69,21 @@ void ims_ifoc_update(imsim_t *s) {
   s->slip_angle += w_sl * ts;
 }
 
-cpx ims_ifoc_vref(const imsim_t *s, double t) {
+cpx ims_ifoc_vref(const imsim_t *s, double t)
+{
   return cmul(cx(s->v_dq[0], s->v_dq[1]), cexpj(s->rho + s->we_ctrl * (t - s->t_ctrl)));
 }
 
-
-void imsim_set_ifoc_tr(imsim_t *s, double tr_s) {
+void imsim_set_ifoc_tr(imsim_t *s, double tr_s)
+{
   if (tr_s > 0.0) s->ifoc_tr = tr_s;
 }
-void imsim_set_speed_ref(imsim_t *s, double rpm) {
+void imsim_set_speed_ref(imsim_t *s, double rpm)
+{
   s->speed_ref = rpm * 2.0 * PI / 60.0;
   s->c.speed_ramp_s = 0.0;
 }
-void imsim_set_torque_ref(imsim_t *s, double nm) { s->c.torque_ref_nm = nm; }
+void imsim_set_torque_ref(imsim_t *s, double nm)
+{
+  s->c.torque_ref_nm = nm;
+}

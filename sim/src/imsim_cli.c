@@ -18,7 +18,10 @@ static const char HEADER[] =
     "ifoc_torque_ref_nm,ifoc_flux_ref_wb,ifoc_tr_s,ifoc_speed_ref_rad_s,"
     "d_a,d_b,d_c,v_dc";
 
-const char *imsim_cli_header(void) { return HEADER; }
+const char *imsim_cli_header(void)
+{
+  return HEADER;
+}
 
 static const char USAGE[] =
     "usage: imest-sim [options]\n"
@@ -99,12 +102,14 @@ static const char USAGE[] =
 
 /* ---- parse ------------------------------------------------------------------------------ */
 
-static int perr(char *err, size_t n, const char *a, const char *b) {
+static int perr(char *err, size_t n, const char *a, const char *b)
+{
   snprintf(err, n, "%s%s", a, b);
   return -1;
 }
 
-static int num(const char *s, double *v) {
+static int num(const char *s, double *v)
+{
   if (s == NULL || *s == '\0') return -1;
   char *end = NULL;
   errno = 0;
@@ -114,7 +119,8 @@ static int num(const char *s, double *v) {
   return 0;
 }
 
-static int inum(const char *s, long *v) {
+static int inum(const char *s, long *v)
+{
   if (s == NULL || *s == '\0') return -1;
   char *end = NULL;
   errno = 0;
@@ -125,8 +131,8 @@ static int inum(const char *s, long *v) {
 }
 
 #define CFG(field) offsetof(imsim_config_t, field)
-#define NONE_LO (-INFINITY)
-#define NONE_HI INFINITY
+#define NONE_LO    (-INFINITY)
+#define NONE_HI    INFINITY
 
 /* Real-valued flags: value in (lo, hi) or [lo, hi] as lo_open/hi_open say. */
 typedef struct {
@@ -205,18 +211,34 @@ typedef struct {
 } choice_flag;
 
 static const choice_flag CHOICE_FLAGS[] = {
-    {"--supply", CFG(supply), {"sine", "vf", "pwm", "ifoc", NULL},
+    {"--supply",
+     CFG(supply),
+     {"sine", "vf", "pwm", "ifoc", NULL},
      {IMSIM_SUPPLY_SINE, IMSIM_SUPPLY_VF, IMSIM_SUPPLY_PWM, IMSIM_SUPPLY_IFOC, 0}},
-    {"--vmeas", CFG(vmeas), {"auto", "avg", "aa", "inst", NULL},
+    {"--vmeas",
+     CFG(vmeas),
+     {"auto", "avg", "aa", "inst", NULL},
      {IMSIM_VMEAS_AUTO, IMSIM_VMEAS_AVG, IMSIM_VMEAS_AA, IMSIM_VMEAS_INST, 0}},
-    {"--start", CFG(start), {"rest", "steady", NULL, NULL, NULL}, {IMSIM_START_REST, IMSIM_START_STEADY, 0, 0, 0}},
-    {"--ifoc-mode", CFG(ifoc_mode), {"speed", "torque", NULL, NULL, NULL},
+    {"--start",
+     CFG(start),
+     {"rest", "steady", NULL, NULL, NULL},
+     {IMSIM_START_REST, IMSIM_START_STEADY, 0, 0, 0}},
+    {"--ifoc-mode",
+     CFG(ifoc_mode),
+     {"speed", "torque", NULL, NULL, NULL},
      {IMSIM_IFOC_SPEED, IMSIM_IFOC_TORQUE, 0, 0, 0}},
-    {"--integrator", CFG(integrator), {"fast", "rk4", NULL, NULL, NULL},
+    {"--integrator",
+     CFG(integrator),
+     {"fast", "rk4", NULL, NULL, NULL},
      {IMSIM_INTEGRATOR_FAST, IMSIM_INTEGRATOR_RK4, 0, 0, 0}},
-    {"--timing", CFG(timing), {"ideal", "firmware", NULL, NULL, NULL},
+    {"--timing",
+     CFG(timing),
+     {"ideal", "firmware", NULL, NULL, NULL},
      {IMSIM_TIMING_IDEAL, IMSIM_TIMING_FIRMWARE, 0, 0, 0}},
-    {"--modulation", CFG(modulation), {"spwm", "svpwm", NULL, NULL, NULL}, {IMSIM_MOD_SPWM, IMSIM_MOD_SVPWM, 0, 0, 0}},
+    {"--modulation",
+     CFG(modulation),
+     {"spwm", "svpwm", NULL, NULL, NULL},
+     {IMSIM_MOD_SPWM, IMSIM_MOD_SVPWM, 0, 0, 0}},
 };
 
 /* Per-phase flags: three comma-separated numbers for phases a, b, c. */
@@ -233,19 +255,24 @@ static const phase_flag PHASE_FLAGS[] = {
 
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 
-static void *field(imsim_config_t *c, size_t off) { return (char *)c + off; }
+static void *field(imsim_config_t *c, size_t off)
+{
+  return (char *)c + off;
+}
 
 /* Flags without a value, and the valued flags handled one by one in parse_valued. */
-static const char *const SWITCH_FLAGS[] = {"--help", "--ideal-sensors", "--no-thermal", "--ifoc-ideal-stage",
-                                           "--progress", "--no-progress", "--pwm-segments"};
+static const char *const SWITCH_FLAGS[] = {
+    "--help",     "--ideal-sensors", "--no-thermal",  "--ifoc-ideal-stage",
+    "--progress", "--no-progress",   "--pwm-segments"};
 static const char *const OTHER_FLAGS[] = {"--preset", "--out", "--decimate", "--seed"};
 
-size_t imsim_cli_flags(const char **names, size_t max) {
+size_t imsim_cli_flags(const char **names, size_t max)
+{
   size_t n = 0;
-#define ADD(x)                  \
-  do {                          \
-    if (n < max) names[n] = (x); \
-    ++n;                        \
+#define ADD(x)                                                                                               \
+  do {                                                                                                       \
+    if (n < max) names[n] = (x);                                                                             \
+    ++n;                                                                                                     \
   } while (0)
   for (size_t k = 0; k < COUNT(SWITCH_FLAGS); ++k) ADD(SWITCH_FLAGS[k]);
   for (size_t k = 0; k < COUNT(OTHER_FLAGS); ++k) ADD(OTHER_FLAGS[k]);
@@ -257,24 +284,37 @@ size_t imsim_cli_flags(const char **names, size_t max) {
   return n;
 }
 
-const char *imsim_cli_usage(void) { return USAGE; }
+const char *imsim_cli_usage(void)
+{
+  return USAGE;
+}
 
 /* Flags without a value. Returns 1 if name is one (and applies it), 0 otherwise. */
-static int parse_switch(const char *name, imsim_config_t *c, imsim_cli_opts_t *o) {
-  if (strcmp(name, "--help") == 0) o->help = 1;
-  else if (strcmp(name, "--ideal-sensors") == 0) c->ideal_sensors = true;
-  else if (strcmp(name, "--no-thermal") == 0) c->thermal = false;
-  else if (strcmp(name, "--ifoc-ideal-stage") == 0) c->ifoc_ideal_stage = true;
-  else if (strcmp(name, "--progress") == 0) o->progress = 1;
-  else if (strcmp(name, "--no-progress") == 0) o->progress = 0;
-  else if (strcmp(name, "--pwm-segments") == 0) c->pwm_moments = false;
-  else return 0;
+static int parse_switch(const char *name, imsim_config_t *c, imsim_cli_opts_t *o)
+{
+  if (strcmp(name, "--help") == 0)
+    o->help = 1;
+  else if (strcmp(name, "--ideal-sensors") == 0)
+    c->ideal_sensors = true;
+  else if (strcmp(name, "--no-thermal") == 0)
+    c->thermal = false;
+  else if (strcmp(name, "--ifoc-ideal-stage") == 0)
+    c->ifoc_ideal_stage = true;
+  else if (strcmp(name, "--progress") == 0)
+    o->progress = 1;
+  else if (strcmp(name, "--no-progress") == 0)
+    o->progress = 0;
+  else if (strcmp(name, "--pwm-segments") == 0)
+    c->pwm_moments = false;
+  else
+    return 0;
   return 1;
 }
 
 /* Flags with a value. Returns 0 (applied), -1 (bad value, message in err) or 1 (unknown). */
 static int parse_valued(const char *name, const char *val, imsim_config_t *c, imsim_cli_opts_t *o, char *err,
-                        size_t errlen) {
+                        size_t errlen)
+{
   if (strcmp(name, "--preset") == 0) return 0; /* applied in the first pass */
   if (strcmp(name, "--out") == 0) {
     if (val[0] == '\0') return perr(err, errlen, "empty value for ", name);
@@ -283,7 +323,8 @@ static int parse_valued(const char *name, const char *val, imsim_config_t *c, im
   }
   long l = 0;
   if (strcmp(name, "--decimate") == 0) {
-    if (inum(val, &l) != 0 || l < 1) return perr(err, errlen, "invalid value for --decimate (integer >= 1): ", val);
+    if (inum(val, &l) != 0 || l < 1)
+      return perr(err, errlen, "invalid value for --decimate (integer >= 1): ", val);
     o->decimate = l;
     return 0;
   }
@@ -329,7 +370,8 @@ static int parse_valued(const char *name, const char *val, imsim_config_t *c, im
     const real_flag *f = &REAL_FLAGS[k];
     if (strcmp(name, f->flag) != 0) continue;
     double d = 0.0;
-    const bool ok = num(val, &d) == 0 && (f->lo_open ? d > f->lo : d >= f->lo) && (f->hi_open ? d < f->hi : d <= f->hi);
+    const bool ok =
+        num(val, &d) == 0 && (f->lo_open ? d > f->lo : d >= f->lo) && (f->hi_open ? d < f->hi : d <= f->hi);
     if (!ok) {
       snprintf(err, errlen, "invalid value for %s: '%s' (%s)", name, val, f->what);
       return -1;
@@ -351,12 +393,14 @@ static int parse_valued(const char *name, const char *val, imsim_config_t *c, im
 }
 
 /* Pass 1: the preset, wherever it stands, so that every other flag overrides it. */
-static int parse_preset(int argc, char **argv, imsim_config_t *c, char *err, size_t errlen) {
+static int parse_preset(int argc, char **argv, imsim_config_t *c, char *err, size_t errlen)
+{
   imsim_config_default(c);
   for (int a = 1; a < argc; ++a) {
     const char *arg = argv[a];
     const char *val = NULL;
-    if (strncmp(arg, "--preset=", 9) == 0) val = arg + 9;
+    if (strncmp(arg, "--preset=", 9) == 0)
+      val = arg + 9;
     else if (strcmp(arg, "--preset") == 0) {
       if (a + 1 >= argc) return perr(err, errlen, "missing value for ", arg);
       val = argv[a + 1];
@@ -369,7 +413,8 @@ static int parse_preset(int argc, char **argv, imsim_config_t *c, char *err, siz
   return 0;
 }
 
-int imsim_cli_parse(int argc, char **argv, imsim_config_t *c, imsim_cli_opts_t *o, char *err, size_t errlen) {
+int imsim_cli_parse(int argc, char **argv, imsim_config_t *c, imsim_cli_opts_t *o, char *err, size_t errlen)
+{
   o->out = "-";
   o->decimate = 1;
   o->progress = -1;
@@ -405,7 +450,8 @@ int imsim_cli_parse(int argc, char **argv, imsim_config_t *c, imsim_cli_opts_t *
 /* ---- run -------------------------------------------------------------------------------- */
 
 /* %.9g is exact to ~1e-9 relative, which is what the spec asks for. */
-void imsim_cli_write_row(FILE *f, const imsim_sample_t *s) {
+void imsim_cli_write_row(FILE *f, const imsim_sample_t *s)
+{
   fprintf(f,
           "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
           "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
@@ -416,7 +462,8 @@ void imsim_cli_write_row(FILE *f, const imsim_sample_t *s) {
           s->ifoc_tr_s, s->ifoc_speed_ref_rad_s, s->duty[0], s->duty[1], s->duty[2], s->vdc_v);
 }
 
-static double now_s(void) {
+static double now_s(void)
+{
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
@@ -429,7 +476,8 @@ typedef struct {
   uint64_t total, next, step;
 } progress;
 
-static void progress_start(progress *p, int on, uint64_t total, double total_s) {
+static void progress_start(progress *p, int on, uint64_t total, double total_s)
+{
   p->on = on;
   p->t0_wall = now_s();
   p->total = total;
@@ -438,7 +486,8 @@ static void progress_start(progress *p, int on, uint64_t total, double total_s) 
   p->step = total / 200u + 1u;
 }
 
-static void progress_update(progress *p, uint64_t n, double t) {
+static void progress_update(progress *p, uint64_t n, double t)
+{
   if (!p->on || n < p->next) return;
   p->next = n + p->step;
   const double frac = (double)n / (double)p->total;
@@ -452,7 +501,8 @@ static void progress_update(progress *p, uint64_t n, double t) {
 }
 
 /* Opens the output ('-' = stdout) with a large buffer. NULL on failure (message printed). */
-static FILE *open_output(const char *path) {
+static FILE *open_output(const char *path)
+{
   static char buf[1 << 20];
   FILE *f = stdout;
   if (strcmp(path, "-") != 0) {
@@ -468,21 +518,24 @@ static FILE *open_output(const char *path) {
 
 /* A bus too low for the reference saturates the inverter, as in a real drive: the run is
    valid, but the voltage is not the commanded one, so say so with the numbers. */
-static void report_clipping(const imsim_t *sim, const imsim_config_t *c) {
+static void report_clipping(const imsim_t *sim, const imsim_config_t *c)
+{
   imsim_pwm_stats_t st;
   imsim_get_pwm_stats(sim, &st);
   if (st.clipped_half_periods == 0u) return;
-  fprintf(stderr,
-          "imest-sim: warning: the PWM reference exceeded the DC bus in %.3g %% of the half carrier periods "
-          "(%llu of %llu) and was clipped: it needs Vdc >= %.1f V, given --vdc %.1f V. The applied voltage is "
-          "not the commanded sine; raise --vdc or lower --vll.\n",
-          100.0 * (double)st.clipped_half_periods / (double)st.half_periods,
-          (unsigned long long)st.clipped_half_periods, (unsigned long long)st.half_periods, st.vdc_needed_v,
-          c->vdc_v);
+  fprintf(
+      stderr,
+      "imest-sim: warning: the PWM reference exceeded the DC bus in %.3g %% of the half carrier periods "
+      "(%llu of %llu) and was clipped: it needs Vdc >= %.1f V, given --vdc %.1f V. The applied voltage is "
+      "not the commanded sine; raise --vdc or lower --vll.\n",
+      100.0 * (double)st.clipped_half_periods / (double)st.half_periods,
+      (unsigned long long)st.clipped_half_periods, (unsigned long long)st.half_periods, st.vdc_needed_v,
+      c->vdc_v);
 }
 
 /* Simulates c and writes the CSV. Returns the exit status. */
-static int run(const imsim_config_t *c, const imsim_cli_opts_t *o) {
+static int run(const imsim_config_t *c, const imsim_cli_opts_t *o)
+{
   static imsim_t sim;
   imsim_sample_t smp;
   if (imsim_init(&sim, c, &smp) != 0) {
@@ -512,7 +565,8 @@ static int run(const imsim_config_t *c, const imsim_cli_opts_t *o) {
   return rc;
 }
 
-int imsim_cli_main(int argc, char **argv) {
+int imsim_cli_main(int argc, char **argv)
+{
   imsim_config_t c;
   imsim_cli_opts_t o;
   char err[256];

@@ -12,9 +12,9 @@ extern "C" {
 #endif
 
 typedef struct {
-  const char *out;   /* "-" = stdout */
-  long decimate;     /* write every n-th sample (1 = all) */
-  int progress;      /* -1 auto (isatty(stderr)), 0 off, 1 on */
+  const char *out; /* "-" = stdout */
+  long decimate;   /* write every n-th sample (1 = all) */
+  int progress;    /* -1 auto (isatty(stderr)), 0 off, 1 on */
   int help;
 } imsim_cli_opts_t;
 

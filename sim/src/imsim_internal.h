@@ -13,9 +13,9 @@
 
 #include "imsim/imsim.h"
 
-#define PI 3.14159265358979323846
-#define SQ23 0.81649658092772603273  /* sqrt(2/3) */
-#define SQ3H 0.86602540378443864676  /* sqrt(3)/2 */
+#define PI    3.14159265358979323846
+#define SQ23  0.81649658092772603273 /* sqrt(2/3) */
+#define SQ3H  0.86602540378443864676 /* sqrt(3)/2 */
 #define SQRT2 1.41421356237309504880
 #define NAN_D ((double)NAN)
 
@@ -23,17 +23,33 @@
 
 typedef imsim_cpx_t cpx;
 
-static inline cpx cx(double re, double im) {
+static inline cpx cx(double re, double im)
+{
   cpx r;
   r.re = re;
   r.im = im;
   return r;
 }
-static inline cpx cmul(cpx a, cpx b) { return cx(a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re); }
-static inline cpx cadd(cpx a, cpx b) { return cx(a.re + b.re, a.im + b.im); }
-static inline cpx cscale(cpx a, double k) { return cx(a.re * k, a.im * k); }
-static inline double cabs2(cpx a) { return a.re * a.re + a.im * a.im; }
-static inline cpx cexpj(double ph) { return cx(cos(ph), sin(ph)); }
+static inline cpx cmul(cpx a, cpx b)
+{
+  return cx(a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re);
+}
+static inline cpx cadd(cpx a, cpx b)
+{
+  return cx(a.re + b.re, a.im + b.im);
+}
+static inline cpx cscale(cpx a, double k)
+{
+  return cx(a.re * k, a.im * k);
+}
+static inline double cabs2(cpx a)
+{
+  return a.re * a.re + a.im * a.im;
+}
+static inline cpx cexpj(double ph)
+{
+  return cx(cos(ph), sin(ph));
+}
 
 /* a_k of u = sqrt(2/3) (x1 + a1 x2 + a2 x3): 1, e^{j2pi/3}, e^{-j2pi/3} (transform.c). */
 extern const double IMS_AK_RE[3];
@@ -46,12 +62,14 @@ extern const double IMS_INV_K[33];
 /* ---- motor model (eq. (1)) ---------------------------------------------------------------- */
 
 /* Electromagnetic torque at (i, psi). */
-static inline double ims_torque_of(const imsim_t *s, cpx i, cpx psi) {
+static inline double ims_torque_of(const imsim_t *s, cpx i, cpx psi)
+{
   return (double)s->c.pole_pairs * s->m_h / s->c.lr_h * (i.im * psi.re - i.re * psi.im);
 }
 
 /* dTe/dt along the model at state (i, psi, w) with input u. */
-static inline double ims_torque_rate(const imsim_t *s, cpx i, cpx psi, double w, cpx u) {
+static inline double ims_torque_rate(const imsim_t *s, cpx i, cpx psi, double w, cpx u)
+{
   const imsim_config_t *c = &s->c;
   const double nw = (double)c->pole_pairs * w;
   const cpx di = cadd(cadd(cscale(u, 1.0 / (c->sigma * c->ls_h)), cscale(i, -s->gamma)),
@@ -85,20 +103,20 @@ double ims_rng_gauss(imsim_rng_t *r);
 /* Input of one integration step. */
 typedef struct {
   bool aa, src, pwm;
-  bool piecewise;  /* PWM, fast path: integrate this half period piecewise (else by moments) */
-  int p;           /* Taylor order */
-  double we;       /* source rotation (rad/s), src only */
-  cpx mom[32];     /* PWM input moments m_k = int_0^h (h-s)^k/k! u(s) ds */
+  bool piecewise; /* PWM, fast path: integrate this half period piecewise (else by moments) */
+  int p;          /* Taylor order */
+  double we;      /* source rotation (rad/s), src only */
+  cpx mom[32];    /* PWM input moments m_k = int_0^h (h-s)^k/k! u(s) ds */
 } step_input_t;
 
 /* One PWM half carrier period (time from its start). */
 typedef struct {
-  bool rising;        /* carrier rising: each leg high before its edge, low after; falling: the reverse */
-  double e_cmd[3];    /* commanded edge of each leg */
-  bool has_edge[3];   /* 0 < e_cmd < h (else the leg does not switch) */
-  double td;          /* dead time */
-  double cmd_avg[2];  /* commanded average voltage (alpha-beta) */
-  double act_avg[2];  /* actual average voltage (alpha-beta, dead time and drops) */
+  bool rising;       /* carrier rising: each leg high before its edge, low after; falling: the reverse */
+  double e_cmd[3];   /* commanded edge of each leg */
+  bool has_edge[3];  /* 0 < e_cmd < h (else the leg does not switch) */
+  double td;         /* dead time */
+  double cmd_avg[2]; /* commanded average voltage (alpha-beta) */
+  double act_avg[2]; /* actual average voltage (alpha-beta, dead time and drops) */
 } pwm_half_t;
 
 /* taylor.c: Taylor order for ||A h|| = rho; norm bound of the augmented A (per second);
@@ -113,7 +131,8 @@ typedef struct {
   cpx x[7];
   double w, th;
 } ims_full_state_t;
-void ims_rk4_piece(const imsim_t *s, ims_full_state_t *X, double len, cpx u_pwm, const step_input_t *in, double tl);
+void ims_rk4_piece(const imsim_t *s, ims_full_state_t *X, double len, cpx u_pwm, const step_input_t *in,
+                   double tl);
 
 /* integrate.c: one integration step of length h_s with input in (fast or RK4). With PWM on the
    piecewise paths and a non-ideal inverter it sets ph->act_avg from the pieces. */

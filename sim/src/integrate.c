@@ -9,8 +9,9 @@
    NULL) holds the PWM current-ripple integrals r1 = int r ds and r2 = int (h-s) r ds of
    r(s) = (1/(sigma L_S)) (U(s) - s U(h)/h), U(s) = int_0^s u: the part of i(s) that the smooth
    (Hermite) quadratures below do not see; then u0 = u1 = the mean voltage of the step. */
-static void fast_piece(imsim_t *s, double h, const double *hkv, const step_input_t *in, double tl, cpx u0, cpx u1,
-                       const cpx *rip) {
+static void fast_piece(imsim_t *s, double h, const double *hkv, const step_input_t *in, double tl, cpx u0,
+                       cpx u1, const cpx *rip)
+{
   const imsim_config_t *c = &s->c;
   const double kj = 1.0 / c->j_kgm2;
   const double kt = (double)c->pole_pairs * s->m_h / c->lr_h;
@@ -53,7 +54,8 @@ static void fast_piece(imsim_t *s, double h, const double *hkv, const step_input
 }
 
 /* Phase currents at the start of a piece (only needed by a non-ideal inverter). */
-static void piece_currents(const imsim_config_t *c, cpx i, double i_abc[3]) {
+static void piece_currents(const imsim_config_t *c, cpx i, double i_abc[3])
+{
   if (ims_inverter_is_ideal(c)) {
     i_abc[0] = i_abc[1] = i_abc[2] = 0.0;
     return;
@@ -62,7 +64,8 @@ static void piece_currents(const imsim_config_t *c, cpx i, double i_abc[3]) {
   imsim_ab_to_abc(iab, i_abc);
 }
 
-void ims_advance(imsim_t *s, const step_input_t *in, pwm_half_t *ph, double tl) {
+void ims_advance(imsim_t *s, const step_input_t *in, pwm_half_t *ph, double tl)
+{
   const imsim_config_t *c = &s->c;
   const double h = s->h_s;
   if (c->integrator == IMSIM_INTEGRATOR_FAST) {

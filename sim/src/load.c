@@ -2,7 +2,8 @@
  * positive rotation); imsim_set_load() overrides it. */
 #include "imsim_internal.h"
 
-double ims_load_at(const imsim_t *s, double t) {
+double ims_load_at(const imsim_t *s, double t)
+{
   if (s->load_overridden) return s->load_override;
   const imsim_config_t *c = &s->c;
   if (t < c->load_on_s) return 0.0;
@@ -11,7 +12,8 @@ double ims_load_at(const imsim_t *s, double t) {
   return c->load_nm;
 }
 
-void imsim_set_load(imsim_t *s, double load_nm) {
+void imsim_set_load(imsim_t *s, double load_nm)
+{
   s->load_override = load_nm;
   s->load_overridden = true;
 }

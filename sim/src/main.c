@@ -1,4 +1,7 @@
 /* imest-sim entry point; everything is in imsim_cli.c. */
 #include "imsim_cli.h"
 
-int main(int argc, char **argv) { return imsim_cli_main(argc, argv); }
+int main(int argc, char **argv)
+{
+  return imsim_cli_main(argc, argv);
+}

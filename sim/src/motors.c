@@ -16,10 +16,10 @@
 
 typedef struct {
   const char *name;
-  double p_w;                 /* rated shaft power                         */
-  double rs, rr, lls, lm, j;  /* ohm, ohm, H (stator = rotor leakage), H, kg m^2 */
-  double t_nm, i_a;           /* rated torque, rated current (catalogue)   */
-  double i_range_a;           /* current ADC full scale, about 2.5 x rated peak */
+  double p_w;                /* rated shaft power                         */
+  double rs, rr, lls, lm, j; /* ohm, ohm, H (stator = rotor leakage), H, kg m^2 */
+  double t_nm, i_a;          /* rated torque, rated current (catalogue)   */
+  double i_range_a;          /* current ADC full scale, about 2.5 x rated peak */
 } motor_row;
 
 static const motor_row MOTORS[] = {
@@ -30,7 +30,8 @@ static const motor_row MOTORS[] = {
     {"75kw", 75000.0, 0.03552, 0.02092, 0.335e-3, 15.1e-3, 1.25, 485.0, 135.0, 500.0},
 };
 
-int ims_motor_preset(imsim_config_t *c, const char *name) {
+int ims_motor_preset(imsim_config_t *c, const char *name)
+{
   const motor_row *m = NULL;
   for (size_t k = 0; k < sizeof MOTORS / sizeof MOTORS[0]; ++k)
     if (strcmp(name, MOTORS[k].name) == 0) m = &MOTORS[k];

@@ -10,14 +10,19 @@
  *   i = 0: no drop, and the dead time does not delay the edge. */
 #include "imsim_internal.h"
 
-bool ims_inverter_has_drops(const imsim_config_t *c) {
+bool ims_inverter_has_drops(const imsim_config_t *c)
+{
   return c->v_switch_v != 0.0 || c->r_switch_ohm != 0.0 || c->v_diode_v != 0.0 || c->r_diode_ohm != 0.0;
 }
 
-bool ims_inverter_is_ideal(const imsim_config_t *c) { return c->dead_time_s == 0.0 && !ims_inverter_has_drops(c); }
+bool ims_inverter_is_ideal(const imsim_config_t *c)
+{
+  return c->dead_time_s == 0.0 && !ims_inverter_has_drops(c);
+}
 
 /* Leg voltage (against the negative bus rail) with the upper (high) or lower device pair on. */
-static double leg_level(const imsim_config_t *c, bool drops, bool high, double i) {
+static double leg_level(const imsim_config_t *c, bool drops, bool high, double i)
+{
   if (!drops) return high ? c->vdc_v : 0.0;
   if (high) {
     if (i > 0.0) return c->vdc_v - (c->v_switch_v + c->r_switch_ohm * i);
@@ -29,7 +34,8 @@ static double leg_level(const imsim_config_t *c, bool drops, bool high, double i
   return 0.0;
 }
 
-bool ims_pwm_modulate(imsim_t *s, cpx vref, double vdc, double m[3]) {
+bool ims_pwm_modulate(imsim_t *s, cpx vref, double vdc, double m[3])
+{
   const imsim_config_t *c = &s->c;
   double vabc[3];
   const double vab[2] = {vref.re, vref.im};
@@ -58,23 +64,28 @@ bool ims_pwm_modulate(imsim_t *s, cpx vref, double vdc, double m[3]) {
 
 /* Voltage applied on the piece of the half period around tm, with the phase currents i_abc at
    the piece's start deciding the dead time and the drops. */
-cpx ims_pwm_piece_voltage(const imsim_t *s, const pwm_half_t *ph, double tm, const double i_abc[3]) {
+cpx ims_pwm_piece_voltage(const imsim_t *s, const pwm_half_t *ph, double tm, const double i_abc[3])
+{
   const imsim_config_t *c = &s->c;
   const bool drops = ims_inverter_has_drops(c);
   cpx u = cx(0.0, 0.0);
   for (int k = 0; k < 3; ++k) {
     const double e = ph->e_cmd[k];
     bool high;
-    if (tm < e) high = ph->rising; /* before the edge: the state the half period began with */
-    else if (ph->has_edge[k] && tm < e + ph->td && i_abc[k] != 0.0) high = i_abc[k] < 0.0; /* a diode */
-    else high = !ph->rising;
+    if (tm < e)
+      high = ph->rising; /* before the edge: the state the half period began with */
+    else if (ph->has_edge[k] && tm < e + ph->td && i_abc[k] != 0.0)
+      high = i_abc[k] < 0.0; /* a diode */
+    else
+      high = !ph->rising;
     const double v = leg_level(c, drops, high, i_abc[k]);
     u = cadd(u, cx(IMS_AK_RE[k] * SQ23 * v, IMS_AK_IM[k] * SQ23 * v));
   }
   return u;
 }
 
-int ims_pwm_breaks(const pwm_half_t *ph, double h, double b[8]) {
+int ims_pwm_breaks(const pwm_half_t *ph, double h, double b[8])
+{
   int n = 0;
   b[n++] = 0.0;
   for (int k = 0; k < 3; ++k) {
@@ -92,7 +103,8 @@ int ims_pwm_breaks(const pwm_half_t *ph, double h, double b[8]) {
   return n;
 }
 
-void ims_pwm_build(imsim_t *s, uint64_t g, const double m[3], step_input_t *in, pwm_half_t *ph) {
+void ims_pwm_build(imsim_t *s, uint64_t g, const double m[3], step_input_t *in, pwm_half_t *ph)
+{
   const imsim_config_t *c = &s->c;
   const double h = s->h_s;
   const double vdc = c->vdc_v;
@@ -117,7 +129,7 @@ void ims_pwm_build(imsim_t *s, uint64_t g, const double m[3], step_input_t *in, 
       if (ea > h) ea = h;
     }
     tau_cmd[k] = h - e;
-    tau_act[k] = h - ea < 1e-14 ? 0.0 : h - ea; /* avoid denormal powers */
+    tau_act[k] = h - ea < 1e-14 ? 0.0 : h - ea;      /* avoid denormal powers */
     lev0[k] = leg_level(c, drops, rising, iabc[k]);  /* before the (actual) edge */
     lev1[k] = leg_level(c, drops, !rising, iabc[k]); /* after it */
   }
@@ -157,8 +169,10 @@ void ims_pwm_build(imsim_t *s, uint64_t g, const double m[3], step_input_t *in, 
   ph->act_avg[0] = in->mom[0].re / h;
   ph->act_avg[1] = in->mom[0].im / h;
   const double kc = (rising ? -1.0 : 1.0) * SQ23 * vdc;
-  ph->cmd_avg[0] = kc / h * (IMS_AK_RE[0] * tau_cmd[0] + IMS_AK_RE[1] * tau_cmd[1] + IMS_AK_RE[2] * tau_cmd[2]);
-  ph->cmd_avg[1] = kc / h * (IMS_AK_IM[0] * tau_cmd[0] + IMS_AK_IM[1] * tau_cmd[1] + IMS_AK_IM[2] * tau_cmd[2]);
+  ph->cmd_avg[0] =
+      kc / h * (IMS_AK_RE[0] * tau_cmd[0] + IMS_AK_RE[1] * tau_cmd[1] + IMS_AK_RE[2] * tau_cmd[2]);
+  ph->cmd_avg[1] =
+      kc / h * (IMS_AK_IM[0] * tau_cmd[0] + IMS_AK_IM[1] * tau_cmd[1] + IMS_AK_IM[2] * tau_cmd[2]);
 }
 
 /* Whether a phase current may cross zero inside the half period. The prediction: the phase
@@ -167,7 +181,8 @@ void ims_pwm_build(imsim_t *s, uint64_t g, const double m[3], step_input_t *in, 
    the change of f0). The moments path decides the dead time and the drops once per half
    period, which is exact only when no current changes sign; otherwise the half period is
    integrated piecewise. */
-bool ims_pwm_may_cross_zero(const imsim_t *s, const pwm_half_t *ph) {
+bool ims_pwm_may_cross_zero(const imsim_t *s, const pwm_half_t *ph)
+{
   const imsim_config_t *c = &s->c;
   if (ims_inverter_is_ideal(c)) return false;
   const double h = s->h_s, sl = c->sigma * c->ls_h;

@@ -2,8 +2,9 @@
  * states together), one constant-input piece at a time. Slow; used to measure the fast path. */
 #include "imsim_internal.h"
 
-static void full_deriv(const imsim_t *s, const ims_full_state_t *X, cpx u_pwm, const step_input_t *in, double tl,
-                       ims_full_state_t *d) {
+static void full_deriv(const imsim_t *s, const ims_full_state_t *X, cpx u_pwm, const step_input_t *in,
+                       double tl, ims_full_state_t *d)
+{
   const imsim_config_t *c = &s->c;
   const double bi = 1.0 / (c->sigma * c->ls_h);
   const double nw = (double)c->pole_pairs * X->w;
@@ -25,13 +26,16 @@ static void full_deriv(const imsim_t *s, const ims_full_state_t *X, cpx u_pwm, c
   d->th = X->w;
 }
 
-static void full_axpy(ims_full_state_t *out, const ims_full_state_t *a, double k, const ims_full_state_t *b) {
+static void full_axpy(ims_full_state_t *out, const ims_full_state_t *a, double k, const ims_full_state_t *b)
+{
   for (int q = 0; q < 7; ++q) out->x[q] = cx(a->x[q].re + k * b->x[q].re, a->x[q].im + k * b->x[q].im);
   out->w = a->w + k * b->w;
   out->th = a->th + k * b->th;
 }
 
-void ims_rk4_piece(const imsim_t *s, ims_full_state_t *X, double len, cpx u_pwm, const step_input_t *in, double tl) {
+void ims_rk4_piece(const imsim_t *s, ims_full_state_t *X, double len, cpx u_pwm, const step_input_t *in,
+                   double tl)
+{
   const int n = s->c.rk4_substeps;
   const double hh = len / (double)n;
   for (int it = 0; it < n; ++it) {

@@ -2,14 +2,19 @@
  * polar method. Reproducible for a given seed. */
 #include "imsim_internal.h"
 
-static uint64_t splitmix64(uint64_t *x) {
+static uint64_t splitmix64(uint64_t *x)
+{
   uint64_t z = (*x += 0x9E3779B97F4A7C15ull);
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   return z ^ (z >> 31);
 }
-static inline uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-static uint64_t rng_next(uint64_t s[4]) {
+static inline uint64_t rotl(uint64_t x, int k)
+{
+  return (x << k) | (x >> (64 - k));
+}
+static uint64_t rng_next(uint64_t s[4])
+{
   const uint64_t result = rotl(s[1] * 5, 7) * 9;
   const uint64_t t = s[1] << 17;
   s[2] ^= s[0];
@@ -20,19 +25,22 @@ static uint64_t rng_next(uint64_t s[4]) {
   s[3] = rotl(s[3], 45);
   return result;
 }
-static double rng_uniform(uint64_t s[4]) { /* (-1, 1) */
+static double rng_uniform(uint64_t s[4])
+{ /* (-1, 1) */
   return (double)(rng_next(s) >> 11) * (2.0 / 9007199254740992.0) - 1.0;
 }
 
 /* Seeds r from the splitmix64 sequence at *sm (which advances), so that successive calls
    give independent streams from one seed. */
-void ims_rng_seed(imsim_rng_t *r, uint64_t *sm) {
+void ims_rng_seed(imsim_rng_t *r, uint64_t *sm)
+{
   for (int k = 0; k < 4; ++k) r->s[k] = splitmix64(sm);
   r->has_spare = false;
   r->spare = 0.0;
 }
 
-double ims_rng_gauss(imsim_rng_t *r) {
+double ims_rng_gauss(imsim_rng_t *r)
+{
   if (r->has_spare) {
     r->has_spare = false;
     return r->spare;

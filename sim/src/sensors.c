@@ -3,7 +3,8 @@
  * record with its truth columns. */
 #include "imsim_internal.h"
 
-static double adc(imsim_t *s, double x, double range) {
+static double adc(imsim_t *s, double x, double range)
+{
   const imsim_config_t *c = &s->c;
   const double lsb = 2.0 * range / ldexp(1.0, c->adc_bits);
   if (c->noise_lsb > 0.0) x += c->noise_lsb * lsb * ims_rng_gauss(&s->rng);
@@ -14,18 +15,21 @@ static double adc(imsim_t *s, double x, double range) {
   return code * lsb;
 }
 
-bool ims_is_pwm_stage(const imsim_config_t *c) {
+bool ims_is_pwm_stage(const imsim_config_t *c)
+{
   return c->supply == IMSIM_SUPPLY_PWM || c->supply == IMSIM_SUPPLY_EXT ||
          (c->supply == IMSIM_SUPPLY_IFOC && !c->ifoc_ideal_stage);
 }
 
-bool ims_firmware_timing(const imsim_config_t *c) {
+bool ims_firmware_timing(const imsim_config_t *c)
+{
   return ims_is_pwm_stage(c) && (c->timing == IMSIM_TIMING_FIRMWARE || c->supply == IMSIM_SUPPLY_EXT);
 }
 
 /* The DC bus through a unipolar ADC (0 .. vdc_range_v, same bits and noise as the others, its
    own noise stream). The bus itself is stiff: V_dc is constant. */
-void ims_sample_vdc(imsim_t *s) {
+void ims_sample_vdc(imsim_t *s)
+{
   const imsim_config_t *c = &s->c;
   if (!ims_is_pwm_stage(c)) {
     s->vdc_meas = NAN_D;
@@ -45,12 +49,14 @@ void ims_sample_vdc(imsim_t *s) {
   s->vdc_meas = code * lsb;
 }
 
-imsim_vmeas_t ims_vmeas_of(const imsim_config_t *c) {
+imsim_vmeas_t ims_vmeas_of(const imsim_config_t *c)
+{
   if (c->vmeas != IMSIM_VMEAS_AUTO) return c->vmeas;
   return ims_is_pwm_stage(c) ? IMSIM_VMEAS_AVG : IMSIM_VMEAS_INST;
 }
 
-void ims_fill_sample(imsim_t *s, imsim_sample_t *o) {
+void ims_fill_sample(imsim_t *s, imsim_sample_t *o)
+{
   const imsim_config_t *c = &s->c;
   const bool aa = !c->ideal_sensors && c->aa_hz > 0.0;
   o->n = s->n;
@@ -106,25 +112,25 @@ void ims_fill_sample(imsim_t *s, imsim_sample_t *o) {
   /* measured voltage (alpha-beta, before the ADC) */
   double um[2];
   switch (ims_vmeas_of(c)) {
-    case IMSIM_VMEAS_AVG:
-      if (fw) {
-        um[0] = s->u_sp_cmd[0] / (double)s->k_steps;
-        um[1] = s->u_sp_cmd[1] / (double)s->k_steps;
-      } else {
-        um[0] = 0.5 * (s->u_hp_cmd[0][0] + s->u_hp_cmd[1][0]);
-        um[1] = 0.5 * (s->u_hp_cmd[0][1] + s->u_hp_cmd[1][1]);
-      }
-      break;
-    case IMSIM_VMEAS_AA:
-      um[0] = s->x[4].re;
-      um[1] = s->x[4].im;
-      break;
-    case IMSIM_VMEAS_INST:
-    case IMSIM_VMEAS_AUTO:
-    default:
-      um[0] = s->u_inst[0];
-      um[1] = s->u_inst[1];
-      break;
+  case IMSIM_VMEAS_AVG:
+    if (fw) {
+      um[0] = s->u_sp_cmd[0] / (double)s->k_steps;
+      um[1] = s->u_sp_cmd[1] / (double)s->k_steps;
+    } else {
+      um[0] = 0.5 * (s->u_hp_cmd[0][0] + s->u_hp_cmd[1][0]);
+      um[1] = 0.5 * (s->u_hp_cmd[0][1] + s->u_hp_cmd[1][1]);
+    }
+    break;
+  case IMSIM_VMEAS_AA:
+    um[0] = s->x[4].re;
+    um[1] = s->x[4].im;
+    break;
+  case IMSIM_VMEAS_INST:
+  case IMSIM_VMEAS_AUTO:
+  default:
+    um[0] = s->u_inst[0];
+    um[1] = s->u_inst[1];
+    break;
   }
   double uabc[3], imab[2], iabc[3];
   imsim_ab_to_abc(um, uabc);

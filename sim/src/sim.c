@@ -4,24 +4,31 @@
 
 #include "imsim_internal.h"
 
-static int fail(imsim_t *s, const char *msg) {
+static int fail(imsim_t *s, const char *msg)
+{
   snprintf(s->err, sizeof s->err, "%s", msg);
   return -1;
 }
 
-const char *imsim_error(const imsim_t *sim) { return sim->err; }
+const char *imsim_error(const imsim_t *sim)
+{
+  return sim->err;
+}
 
-void imsim_get_pwm_stats(const imsim_t *s, imsim_pwm_stats_t *out) {
+void imsim_get_pwm_stats(const imsim_t *s, imsim_pwm_stats_t *out)
+{
   out->half_periods = s->pwm_half_periods;
   out->clipped_half_periods = s->pwm_clipped_half_periods;
   out->vdc_needed_v = s->pwm_vdc_needed;
 }
 
-int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first) {
+int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first)
+{
   memset(s, 0, sizeof *s);
   s->c = *cfg;
   imsim_config_t *c = &s->c;
-  if ((unsigned)c->supply > (unsigned)IMSIM_SUPPLY_EXT || (unsigned)c->timing > (unsigned)IMSIM_TIMING_FIRMWARE ||
+  if ((unsigned)c->supply > (unsigned)IMSIM_SUPPLY_EXT ||
+      (unsigned)c->timing > (unsigned)IMSIM_TIMING_FIRMWARE ||
       (unsigned)c->modulation > (unsigned)IMSIM_MOD_SVPWM)
     return fail(s, "unknown supply, timing or modulation");
   if (c->pole_pairs < 1) return fail(s, "pole_pairs must be >= 1");
@@ -46,30 +53,38 @@ int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first) {
   }
   if (c->rk4_substeps < 1) return fail(s, "rk4 substeps must be >= 1");
   const imsim_vmeas_t vm = ims_vmeas_of(c);
-  if (vm == IMSIM_VMEAS_AVG && !ims_is_pwm_stage(c)) return fail(s, "voltage measurement 'avg' needs a PWM stage");
+  if (vm == IMSIM_VMEAS_AVG && !ims_is_pwm_stage(c))
+    return fail(s, "voltage measurement 'avg' needs a PWM stage");
   if (vm == IMSIM_VMEAS_INST && ims_is_pwm_stage(c))
-    return fail(s, "voltage measurement 'inst' with a PWM stage would record 0 V: every sample instant is a "
-                   "carrier extreme, where all legs sit in a zero vector. Use 'avg' (phase voltage from the "
-                   "commanded duties and Vdc, what a drive knows) or 'aa' with an AA filter (measured voltage)");
+    return fail(s,
+                "voltage measurement 'inst' with a PWM stage would record 0 V: every sample instant is a "
+                "carrier extreme, where all legs sit in a zero vector. Use 'avg' (phase voltage from the "
+                "commanded duties and Vdc, what a drive knows) or 'aa' with an AA filter (measured voltage)");
   if (vm == IMSIM_VMEAS_AA && (c->ideal_sensors || !(c->aa_hz > 0.0)))
     return fail(s, "voltage measurement 'aa' needs an AA filter (aa_hz > 0, sensors not ideal)");
   s->ts_s = 1.0 / c->fs_hz;
   if (c->timing == IMSIM_TIMING_FIRMWARE && !ims_is_pwm_stage(c))
-    return fail(s, "firmware timing needs the PWM inverter (supply pwm, ifoc without the ideal stage, or ext)");
+    return fail(s,
+                "firmware timing needs the PWM inverter (supply pwm, ifoc without the ideal stage, or ext)");
   if (c->supply == IMSIM_SUPPLY_EXT && c->start == IMSIM_START_STEADY)
-    return fail(s, "start 'steady' is not available with external commands: the motor starts at rest (--start rest)");
+    return fail(
+        s, "start 'steady' is not available with external commands: the motor starts at rest (--start rest)");
   if (ims_is_pwm_stage(c)) {
     if (!(c->carrier_hz > 0.0) || !(c->vdc_v > 0.0)) return fail(s, "carrier and vdc must be > 0");
     const double ratio = 2.0 * c->carrier_hz / c->fs_hz;
     const double k = floor(ratio + 0.5);
-    if (k < 1.0 || fabs(ratio - k) > 1e-9 * ratio) return fail(s, "2 * carrier_hz must be an integer multiple of fs_hz (PWM-synchronous sampling)");
+    if (k < 1.0 || fabs(ratio - k) > 1e-9 * ratio)
+      return fail(s, "2 * carrier_hz must be an integer multiple of fs_hz (PWM-synchronous sampling)");
     if (ims_firmware_timing(c) && fmod(k, 2.0) != 0.0)
       return fail(s, "firmware timing samples at a carrier valley once every N carrier periods: carrier_hz "
                      "must be an integer multiple of fs_hz (fs = f_c / N)");
-    if (c->steps_per_sample != 0 && c->steps_per_sample != (int)k) return fail(s, "with PWM, steps per sample is fixed to 2 f_c / fs");
+    if (c->steps_per_sample != 0 && c->steps_per_sample != (int)k)
+      return fail(s, "with PWM, steps per sample is fixed to 2 f_c / fs");
     s->k_steps = (int)k;
-    if (!(c->dead_time_s >= 0.0) || c->dead_time_s >= 0.5 / c->carrier_hz) return fail(s, "dead time must be in [0, 1/(2 f_c))");
-    if (!(c->v_switch_v >= 0.0) || !(c->r_switch_ohm >= 0.0) || !(c->v_diode_v >= 0.0) || !(c->r_diode_ohm >= 0.0) ||
+    if (!(c->dead_time_s >= 0.0) || c->dead_time_s >= 0.5 / c->carrier_hz)
+      return fail(s, "dead time must be in [0, 1/(2 f_c))");
+    if (!(c->v_switch_v >= 0.0) || !(c->r_switch_ohm >= 0.0) || !(c->v_diode_v >= 0.0) ||
+        !(c->r_diode_ohm >= 0.0) ||
         !isfinite(c->v_switch_v + c->r_switch_ohm + c->v_diode_v + c->r_diode_ohm))
       return fail(s, "switch and diode drops must be finite and >= 0");
     if (!c->ideal_sensors && !(c->vdc_range_v > 0.0)) return fail(s, "the DC-bus ADC range must be > 0");
@@ -146,7 +161,8 @@ int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first) {
   return 0;
 }
 
-void imsim_step(imsim_t *s, imsim_sample_t *out) {
+void imsim_step(imsim_t *s, imsim_sample_t *out)
+{
   const imsim_config_t *c = &s->c;
   const double ts = s->ts_s, h = s->h_s;
   /* 1. thermal: copper losses at t_n drive both first-order models (exact exponential step) */

@@ -2,8 +2,9 @@
  * --start steady, the IFOC rated flux, and the presets' checks. */
 #include "imsim_internal.h"
 
-static void steady_at(const imsim_config_t *c, double m, double tr, double w, double vll, double we,
-                      cpx *i, cpx *psi, double *te) {
+static void steady_at(const imsim_config_t *c, double m, double tr, double w, double vll, double we, cpx *i,
+                      cpx *psi, double *te)
+{
   const double sl = c->sigma * c->ls_h;
   const double gamma = c->rs_ohm / sl + (1.0 - c->sigma) / (c->sigma * tr);
   const double beta = m / (c->sigma * c->ls_h * c->lr_h);
@@ -22,7 +23,9 @@ static void steady_at(const imsim_config_t *c, double m, double tr, double w, do
   *te = (double)c->pole_pairs * m / c->lr_h * (i->im * psi->re - i->re * psi->im);
 }
 
-int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, double load_nm, imsim_steady_t *out) {
+int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, double load_nm,
+                       imsim_steady_t *out)
+{
   const double m = sqrt((1.0 - c->sigma) * c->ls_h * c->lr_h);
   const double we = 2.0 * PI * freq_hz;
   const double wsync = we / (double)c->pole_pairs;
@@ -44,8 +47,10 @@ int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, do
     if (k > 4000) return -1;
     for (int it = 0; it < 200; ++it) {
       const double mid = 0.5 * (lo + hi);
-      if (F_OF(mid) > 0.0) lo = mid;
-      else hi = mid;
+      if (F_OF(mid) > 0.0)
+        lo = mid;
+      else
+        hi = mid;
     }
   }
 #undef F_OF

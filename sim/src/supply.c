@@ -3,7 +3,8 @@
 
 /* alpha-beta amplitude (= V_ll rms), phase and frequency at t. The phase is exact for a
    linear frequency ramp. */
-void ims_vf_ref(const imsim_t *s, double t, double *amp, double *phase, double *f_hz) {
+void ims_vf_ref(const imsim_t *s, double t, double *amp, double *phase, double *f_hz)
+{
   const imsim_config_t *c = &s->c;
   const double ramp = (c->supply == IMSIM_SUPPLY_SINE || c->start == IMSIM_START_STEADY) ? 0.0 : c->vf_ramp_s;
   if (ramp <= 0.0) {

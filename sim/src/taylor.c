@@ -2,27 +2,51 @@
  * the exact (to a Taylor tolerance) solution of the linear electrical part of eq. (1). */
 #include "imsim_internal.h"
 
-const double IMS_INV_FACT[34] = {
-    1.0, 1.0, 0.5, 1.0 / 6, 1.0 / 24, 1.0 / 120, 1.0 / 720, 1.0 / 5040, 1.0 / 40320,
-    1.0 / 362880, 1.0 / 3628800, 1.0 / 39916800, 1.0 / 479001600, 1.0 / 6227020800.0,
-    1.0 / 87178291200.0, 1.0 / 1307674368000.0, 1.0 / 20922789888000.0,
-    1.0 / 355687428096000.0, 1.0 / 6402373705728000.0, 1.0 / 121645100408832000.0,
-    1.0 / 2432902008176640000.0, 1.0 / 51090942171709440000.0,
-    1.0 / 1124000727777607680000.0, 1.0 / 25852016738884976640000.0,
-    1.0 / 620448401733239439360000.0, 1.0 / 15511210043330985984000000.0,
-    1.0 / 403291461126605635584000000.0, 1.0 / 10888869450418352160768000000.0,
-    1.0 / 304888344611713860501504000000.0, 1.0 / 8841761993739701954543616000000.0,
-    1.0 / 265252859812191058636308480000000.0, 1.0 / 8222838654177922817725562880000000.0,
-    1.0 / 263130836933693530167218012160000000.0, 1.0 / 8683317618811886495518194401280000000.0};
+const double IMS_INV_FACT[34] = {1.0,
+                                 1.0,
+                                 0.5,
+                                 1.0 / 6,
+                                 1.0 / 24,
+                                 1.0 / 120,
+                                 1.0 / 720,
+                                 1.0 / 5040,
+                                 1.0 / 40320,
+                                 1.0 / 362880,
+                                 1.0 / 3628800,
+                                 1.0 / 39916800,
+                                 1.0 / 479001600,
+                                 1.0 / 6227020800.0,
+                                 1.0 / 87178291200.0,
+                                 1.0 / 1307674368000.0,
+                                 1.0 / 20922789888000.0,
+                                 1.0 / 355687428096000.0,
+                                 1.0 / 6402373705728000.0,
+                                 1.0 / 121645100408832000.0,
+                                 1.0 / 2432902008176640000.0,
+                                 1.0 / 51090942171709440000.0,
+                                 1.0 / 1124000727777607680000.0,
+                                 1.0 / 25852016738884976640000.0,
+                                 1.0 / 620448401733239439360000.0,
+                                 1.0 / 15511210043330985984000000.0,
+                                 1.0 / 403291461126605635584000000.0,
+                                 1.0 / 10888869450418352160768000000.0,
+                                 1.0 / 304888344611713860501504000000.0,
+                                 1.0 / 8841761993739701954543616000000.0,
+                                 1.0 / 265252859812191058636308480000000.0,
+                                 1.0 / 8222838654177922817725562880000000.0,
+                                 1.0 / 263130836933693530167218012160000000.0,
+                                 1.0 / 8683317618811886495518194401280000000.0};
 
-const double IMS_INV_K[33] = {0.0, 1.0, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6, 1.0 / 7, 1.0 / 8,
-    1.0 / 9, 1.0 / 10, 1.0 / 11, 1.0 / 12, 1.0 / 13, 1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17, 1.0 / 18,
-    1.0 / 19, 1.0 / 20, 1.0 / 21, 1.0 / 22, 1.0 / 23, 1.0 / 24, 1.0 / 25, 1.0 / 26, 1.0 / 27, 1.0 / 28,
-    1.0 / 29, 1.0 / 30, 1.0 / 31, 1.0 / 32};
+const double IMS_INV_K[33] = {0.0,      1.0,      1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,  1.0 / 6,
+                              1.0 / 7,  1.0 / 8,  1.0 / 9,  1.0 / 10, 1.0 / 11, 1.0 / 12, 1.0 / 13,
+                              1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17, 1.0 / 18, 1.0 / 19, 1.0 / 20,
+                              1.0 / 21, 1.0 / 22, 1.0 / 23, 1.0 / 24, 1.0 / 25, 1.0 / 26, 1.0 / 27,
+                              1.0 / 28, 1.0 / 29, 1.0 / 30, 1.0 / 31, 1.0 / 32};
 
 /* Smallest Taylor order p with ||A h||^(p+1)/(p+1)! e^||A h|| < 1e-14 (balanced norm bound);
    the system is stable, so this local truncation error stays bounded (order 1e-11 globally). */
-int ims_taylor_order_rho(double rho) {
+int ims_taylor_order_rho(double rho)
+{
   double term = 1.0;
   const double er = rho < 1.0 ? 2.72 : exp(rho);
   int p = 0;
@@ -35,7 +59,8 @@ int ims_taylor_order_rho(double rho) {
 }
 
 /* Norm bound of the augmented A (per second). */
-double ims_a_norm(const imsim_t *s, double w, const step_input_t *in) {
+double ims_a_norm(const imsim_t *s, double w, const step_input_t *in)
+{
   const imsim_config_t *c = &s->c;
   const double nw = fabs((double)c->pole_pairs * w);
   double norm = s->gamma + s->beta * s->m_h / s->tr + 2.0 * (1.0 / s->tr + nw);
@@ -44,7 +69,8 @@ double ims_a_norm(const imsim_t *s, double w, const step_input_t *in) {
   return norm;
 }
 
-int ims_taylor_order(const imsim_t *s, double w, const step_input_t *in) {
+int ims_taylor_order(const imsim_t *s, double w, const step_input_t *in)
+{
   return ims_taylor_order_rho(ims_a_norm(s, w, in) * s->h_s);
 }
 
@@ -55,7 +81,8 @@ typedef struct {
 } amat;
 
 /* z = A y (augmented, frozen omega). */
-static inline void apply_a(const amat *m, const cpx *y, cpx *z) {
+static inline void apply_a(const amat *m, const cpx *y, cpx *z)
+{
   z[0] = cadd(cscale(y[0], m->a11), cmul(m->a12, y[1]));
   if (m->src) z[0] = cadd(z[0], cscale(y[6], m->bi));
   z[1] = cadd(cscale(y[0], m->a21), cmul(m->a22, y[1]));
@@ -76,7 +103,8 @@ static inline void apply_a(const amat *m, const cpx *y, cpx *z) {
    omega frozen at w_mid, plus the leading Magnus correction for omega varying linearly over
    the step: dx = n omega' h^3/12 [A1, A] x_mid, A1 = dA/d(n omega) = [[0, -j beta], [0, j]].
    The input does not enter the correction because A1 B = 0, so it holds for PWM too. */
-void ims_fast_step(imsim_t *s, const double *hkv, double w_mid, double nwdot, const step_input_t *in) {
+void ims_fast_step(imsim_t *s, const double *hkv, double w_mid, double nwdot, const step_input_t *in)
+{
   const imsim_config_t *c = &s->c;
   const double nw = (double)c->pole_pairs * w_mid;
   amat m;

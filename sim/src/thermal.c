@@ -2,7 +2,8 @@
  * model driven by its own copper loss (see sim/README.md, Thermal drift). */
 #include "imsim_internal.h"
 
-void ims_update_params(imsim_t *s) {
+void ims_update_params(imsim_t *s)
+{
   const imsim_config_t *c = &s->c;
   s->rs = c->rs_ohm * (1.0 + c->alpha_per_k * (s->temp_s - c->t_amb_c));
   s->rr = s->rr0_ohm * (1.0 + c->alpha_per_k * (s->temp_r - c->t_amb_c));
@@ -12,7 +13,8 @@ void ims_update_params(imsim_t *s) {
 }
 
 /* Copper losses at t_n drive both first-order models (exact exponential step over 1/fs). */
-void ims_thermal_step(imsim_t *s) {
+void ims_thermal_step(imsim_t *s)
+{
   const imsim_config_t *c = &s->c;
   const double ts = s->ts_s;
   const cpx ir = cscale(cadd(s->x[1], cscale(s->x[0], -s->m_h)), 1.0 / c->lr_h);

@@ -23,13 +23,14 @@
 #endif
 
 /* Window k's result (also used by the tests' expectations). */
-static void synth(unsigned int k, imest_result_t *r) {
+static void synth(unsigned int k, imest_result_t *r)
+{
   memset(r, 0, sizeof *r);
   r->seq = k + (k >= 6u ? 2u : 0u); /* seq jumps by 3 at k = 6: two windows dropped by the estimator */
   r->samples = 4000u;
   r->used_samples = 4000u;
   r->t_end_s = 1.0 + (double)r->seq;
-  r->tr_s = 0.001 * pow(10.0, 4.0 * (double)(k % 9u) / 8.0); /* 1 ms .. 10 s */
+  r->tr_s = 0.001 * pow(10.0, 4.0 * (double)(k % 9u) / 8.0);   /* 1 ms .. 10 s */
   r->rs_ohm = 0.001 * pow(10.0, 5.0 * (double)(k % 7u) / 6.0); /* 1 mohm .. 100 ohm */
   r->e_i = 0.0123 * (double)(k % 13u);
   r->pe_k1_rel = 0.0011 * (double)(k % 11u);
@@ -48,54 +49,53 @@ static void synth(unsigned int k, imest_result_t *r) {
   r->windows = 1u + k % 3u;
   r->span_s = 1.0 * (double)r->windows;
   switch (k % 10u) {
-    case 3u: /* no candidate */
-      r->tr_s = NAN;
-      r->rs_ohm = NAN;
-      r->e_i = NAN;
-      r->pe_k1_rel = NAN;
-      r->pe_k2_rel = NAN;
-      r->valid = 0;
-      r->status = IMEST_REASON_NO_ROOT;
-      r->tr_valid = r->rs_valid = 0;
-      r->tr_reason = r->rs_reason = IMEST_REASON_NO_ROOT;
-      r->tr_bound_rel = r->rs_bound_rel = NAN;
-      r->flags = IMEST_FLAG_WARMUP | IMEST_FLAG_ENCODER_FAULT;
-      r->n_admissible = 0u;
-      break;
-    case 5u: /* saturation of every field */
-      r->tr_s = 1e300;
-      r->rs_ohm = -INFINITY;
-      r->e_i = 9.5;
-      r->pe_k1_rel = INFINITY;
-      r->pe_k2_rel = 2.0;
-      r->valid = 0;
-      r->status = IMEST_REASON_HIGH_RESIDUAL;
-      r->tr_valid = r->rs_valid = 0;
-      r->tr_reason = IMEST_REASON_HIGH_RESIDUAL;
-      r->rs_reason = 300; /* not a reason: sent as 255, out of range */
-      r->tr_bound_rel = 5.0;
-      r->rs_bound_rel = -1.0;
-      r->span_s = 100.0;
-      r->windows = 300u; /* saturates at 255 */
-      r->flags = IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ADC_SAT | IMEST_FLAG_OVERRUN;
-      r->n_roots = 20u;
-      r->n_admissible = 17u;
-      break;
-    case 7u: /* T_R trusted, R_S not */
-      r->valid = 0;
-      r->status = IMEST_REASON_RS_OUT_OF_RANGE;
-      r->rs_valid = 0;
-      r->rs_reason = IMEST_REASON_RS_OUT_OF_RANGE;
-      break;
-    case 8u:
-      r->valid = 0;
-      r->status = IMEST_REASON_POORLY_DETERMINED;
-      r->tr_valid = r->rs_valid = 0;
-      r->tr_reason = r->rs_reason = IMEST_REASON_POORLY_DETERMINED;
-      r->pe_k2_rel = 0.25;
-      break;
-    default:
-      break;
+  case 3u: /* no candidate */
+    r->tr_s = NAN;
+    r->rs_ohm = NAN;
+    r->e_i = NAN;
+    r->pe_k1_rel = NAN;
+    r->pe_k2_rel = NAN;
+    r->valid = 0;
+    r->status = IMEST_REASON_NO_ROOT;
+    r->tr_valid = r->rs_valid = 0;
+    r->tr_reason = r->rs_reason = IMEST_REASON_NO_ROOT;
+    r->tr_bound_rel = r->rs_bound_rel = NAN;
+    r->flags = IMEST_FLAG_WARMUP | IMEST_FLAG_ENCODER_FAULT;
+    r->n_admissible = 0u;
+    break;
+  case 5u: /* saturation of every field */
+    r->tr_s = 1e300;
+    r->rs_ohm = -INFINITY;
+    r->e_i = 9.5;
+    r->pe_k1_rel = INFINITY;
+    r->pe_k2_rel = 2.0;
+    r->valid = 0;
+    r->status = IMEST_REASON_HIGH_RESIDUAL;
+    r->tr_valid = r->rs_valid = 0;
+    r->tr_reason = IMEST_REASON_HIGH_RESIDUAL;
+    r->rs_reason = 300; /* not a reason: sent as 255, out of range */
+    r->tr_bound_rel = 5.0;
+    r->rs_bound_rel = -1.0;
+    r->span_s = 100.0;
+    r->windows = 300u; /* saturates at 255 */
+    r->flags = IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ADC_SAT | IMEST_FLAG_OVERRUN;
+    r->n_roots = 20u;
+    r->n_admissible = 17u;
+    break;
+  case 7u: /* T_R trusted, R_S not */
+    r->valid = 0;
+    r->status = IMEST_REASON_RS_OUT_OF_RANGE;
+    r->rs_valid = 0;
+    r->rs_reason = IMEST_REASON_RS_OUT_OF_RANGE;
+    break;
+  case 8u:
+    r->valid = 0;
+    r->status = IMEST_REASON_POORLY_DETERMINED;
+    r->tr_valid = r->rs_valid = 0;
+    r->tr_reason = r->rs_reason = IMEST_REASON_POORLY_DETERMINED;
+    r->pe_k2_rel = 0.25;
+    break;
+  default: break;
   }
 }
 
@@ -110,7 +110,8 @@ static void usage(void)
 /* The signal table and the reason names, one line each (test_dbc.py). */
 static void print_table(void)
 {
-  static const char *const kind[] = {"f32", "scaled", "count", "u32", "enum", "bool", "flag", "sat", "txfail"};
+  static const char *const kind[] = {"f32",  "scaled", "count", "u32",   "enum",
+                                     "bool", "flag",   "sat",   "txfail"};
   unsigned int n = 0u;
   const imest_can_signal_t *t = imest_can_signal_table(&n);
   printf("frames %d counter %u crc %u\n", IMEST_CAN_NFRAMES, IMEST_CAN_COUNTER_START, IMEST_CAN_CRC_START);
@@ -153,12 +154,18 @@ int main(int argc, char **argv)
       usage();
       return 2;
     }
-    if (strcmp(argv[i], "--iface") == 0) iface = v;
-    else if (strcmp(argv[i], "--log") == 0) log = v;
-    else if (strcmp(argv[i], "--count") == 0) count = strtoul(v, NULL, 0);
-    else if (strcmp(argv[i], "--period-ms") == 0) period_ms = strtoul(v, NULL, 0);
-    else if (strcmp(argv[i], "--base-id") == 0) base_text = v;
-    else if (strcmp(argv[i], "--epoch") == 0) epoch = strtod(v, NULL);
+    if (strcmp(argv[i], "--iface") == 0)
+      iface = v;
+    else if (strcmp(argv[i], "--log") == 0)
+      log = v;
+    else if (strcmp(argv[i], "--count") == 0)
+      count = strtoul(v, NULL, 0);
+    else if (strcmp(argv[i], "--period-ms") == 0)
+      period_ms = strtoul(v, NULL, 0);
+    else if (strcmp(argv[i], "--base-id") == 0)
+      base_text = v;
+    else if (strcmp(argv[i], "--epoch") == 0)
+      epoch = strtod(v, NULL);
     else {
       usage();
       return 2;
@@ -211,8 +218,8 @@ int main(int argc, char **argv)
       nanosleep(&ts, NULL);
     }
   }
-  fprintf(stderr, "imest-can-selftest: published %lu window(s), %lu failed send(s), tx_failed %lu\n",
-          count, failed, (unsigned long)pub.tx_failed);
+  fprintf(stderr, "imest-can-selftest: published %lu window(s), %lu failed send(s), tx_failed %lu\n", count,
+          failed, (unsigned long)pub.tx_failed);
 #ifdef IMEST_SELFTEST_SOCKETCAN
   if (iface != NULL) imest_socketcan_close(&sc);
 #endif

@@ -22,7 +22,8 @@ extern "C" {
 
 namespace {
 
-imest_result_t golden_result() {
+imest_result_t golden_result()
+{
   imest_result_t r;
   std::memset(&r, 0, sizeof r);
   r.seq = 0x12345678u;
@@ -47,7 +48,8 @@ imest_result_t golden_result() {
   return r;
 }
 
-std::string hex(const imest_can_frame &f) {
+std::string hex(const imest_can_frame &f)
+{
   char b[32];
   std::string s;
   for (unsigned i = 0; i < f.dlc; i++) {
@@ -59,7 +61,8 @@ std::string hex(const imest_can_frame &f) {
 
 constexpr unsigned kAll = (1u << IMEST_CAN_NFRAMES) - 1u;
 
-imest_can_window_t roundtrip(const imest_result_t &r, uint32_t base = IMEST_CAN_DEFAULT_BASE_ID) {
+imest_can_window_t roundtrip(const imest_result_t &r, uint32_t base = IMEST_CAN_DEFAULT_BASE_ID)
+{
   imest_can_window_t w;
   imest_can_window_clear(&w);
   for (unsigned i = 0; i < IMEST_CAN_NFRAMES; i++) {
@@ -71,7 +74,8 @@ imest_can_window_t roundtrip(const imest_result_t &r, uint32_t base = IMEST_CAN_
   return w;
 }
 
-imest_can_pub_t make_pub(const imest_can_port *port, uint32_t base = IMEST_CAN_DEFAULT_BASE_ID) {
+imest_can_pub_t make_pub(const imest_can_port *port, uint32_t base = IMEST_CAN_DEFAULT_BASE_ID)
+{
   imest_can_pub_t pub;
   EXPECT_EQ(imest_can_pub_init(&pub, port, base), IMEST_OK);
   return pub;
@@ -81,9 +85,10 @@ imest_can_pub_t make_pub(const imest_can_port *port, uint32_t base = IMEST_CAN_D
 struct FakePort {
   std::vector<imest_can_frame> frames;
   unsigned calls = 0;
-  unsigned fail_index_mask = 0;  // fail frames whose offset bit is set
+  unsigned fail_index_mask = 0; // fail frames whose offset bit is set
   bool fail_all = false;
-  static int send(void *ctx, const imest_can_frame *f) {
+  static int send(void *ctx, const imest_can_frame *f)
+  {
     FakePort *p = static_cast<FakePort *>(ctx);
     p->calls++;
     unsigned off = (f->id - IMEST_CAN_DEFAULT_BASE_ID) & 0x7FFu;
@@ -94,11 +99,12 @@ struct FakePort {
   imest_can_port port() { return imest_can_port{&FakePort::send, this}; }
 };
 
-}  // namespace
+} // namespace
 
 // ---------------------------------------------------------------- codec
 
-TEST(CanCodec, Crc8SaeJ1850CheckValue) {
+TEST(CanCodec, Crc8SaeJ1850CheckValue)
+{
   const unsigned char s[] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
   EXPECT_EQ(imest_can_crc8(s, 9u), 0x4Bu);
   EXPECT_EQ(imest_can_crc8(s, 0u), 0x00u);
@@ -107,7 +113,8 @@ TEST(CanCodec, Crc8SaeJ1850CheckValue) {
 // The exact bytes on the bus (computed independently with Python struct /
 // int.to_bytes): pins the layout, byte order and CRC on every host. Frames
 // 0..3 are byte for byte those of layout 1 (before VERDICT and BOUNDS).
-TEST(CanCodec, GoldenFrames) {
+TEST(CanCodec, GoldenFrames)
+{
   const imest_result_t r = golden_result();
   const char *expect[IMEST_CAN_NFRAMES] = {"0000003EC8005AD3", "0000C03FFA005A86", "F401000360045A1A",
                                            "7856341202015AC4", "000003E803015A8D", "F401C40900005A55"};
@@ -120,7 +127,8 @@ TEST(CanCodec, GoldenFrames) {
   }
 }
 
-TEST(CanCodec, ErrorsFollowTheApiContract) {
+TEST(CanCodec, ErrorsFollowTheApiContract)
+{
   const imest_result_t r = golden_result();
   imest_can_frame f;
   imest_can_window_t w;
@@ -141,20 +149,23 @@ TEST(CanCodec, ErrorsFollowTheApiContract) {
   EXPECT_EQ(imest_can_rx_flush(nullptr, &w, nullptr), IMEST_ERR_NULL);
 }
 
-TEST(CanCodec, BaseIdentifierRange) {
+TEST(CanCodec, BaseIdentifierRange)
+{
   EXPECT_EQ(imest_can_base_id_check(0u), IMEST_OK);
   EXPECT_EQ(imest_can_base_id_check(0x7FFu - (IMEST_CAN_NFRAMES - 1u)), IMEST_OK);
   EXPECT_EQ(imest_can_base_id_check(0x7FFu - (IMEST_CAN_NFRAMES - 2u)), IMEST_ERR_ARG);
   EXPECT_EQ(imest_can_base_id_check(0x800u), IMEST_ERR_ARG) << "needs IMEST_CAN_ID_EXT";
   EXPECT_EQ(imest_can_base_id_check(0x800u | IMEST_CAN_ID_EXT), IMEST_OK);
   EXPECT_EQ(imest_can_base_id_check((0x1FFFFFFFu - (IMEST_CAN_NFRAMES - 1u)) | IMEST_CAN_ID_EXT), IMEST_OK);
-  EXPECT_EQ(imest_can_base_id_check((0x1FFFFFFFu - (IMEST_CAN_NFRAMES - 2u)) | IMEST_CAN_ID_EXT), IMEST_ERR_ARG);
+  EXPECT_EQ(imest_can_base_id_check((0x1FFFFFFFu - (IMEST_CAN_NFRAMES - 2u)) | IMEST_CAN_ID_EXT),
+            IMEST_ERR_ARG);
   EXPECT_EQ(imest_can_base_id_check(0x20000000u | IMEST_CAN_ID_EXT), IMEST_ERR_ARG);
 }
 
 // The table itself: every signal inside its frame's 48 data bits, no overlap,
 // each clamped field guarded by exactly one transmitted saturation bit.
-TEST(CanCodec, SignalTableIsConsistent) {
+TEST(CanCodec, SignalTableIsConsistent)
+{
   unsigned n = 0;
   const imest_can_signal_t *t = imest_can_signal_table(&n);
   ASSERT_GT(n, 0u);
@@ -167,29 +178,21 @@ TEST(CanCodec, SignalTableIsConsistent) {
     EXPECT_EQ(used[t[k].frame] & bits, 0u) << "signal " << k << " overlaps another";
     used[t[k].frame] |= bits;
     if (k > 0) {
-      EXPECT_TRUE(t[k].frame > t[k - 1].frame || (t[k].frame == t[k - 1].frame && t[k].start > t[k - 1].start))
+      EXPECT_TRUE(t[k].frame > t[k - 1].frame ||
+                  (t[k].frame == t[k - 1].frame && t[k].start > t[k - 1].start))
           << "table not ordered by frame and start bit at " << k;
     }
     switch (t[k].kind) {
-      case IMEST_CAN_F32:
-        EXPECT_EQ(t[k].len, 32u) << k;
-        break;
-      case IMEST_CAN_SCALED:
-        EXPECT_GT(t[k].scale, 1u) << k;
-        break;
-      case IMEST_CAN_COUNT:
-        EXPECT_LE(t[k].len, 16u) << k << ": unsigned int has 16 bits on C2000";
-        break;
-      case IMEST_CAN_ENUM:
-        EXPECT_GE(1u << t[k].len, IMEST_REASON_RS_OUT_OF_RANGE + 2u) << k << ": every reason must fit";
-        break;
-      case IMEST_CAN_BOOL:
-      case IMEST_CAN_FLAG:
-      case IMEST_CAN_SAT:
-        EXPECT_EQ(t[k].len, 1u) << k;
-        break;
-      default:
-        break;
+    case IMEST_CAN_F32: EXPECT_EQ(t[k].len, 32u) << k; break;
+    case IMEST_CAN_SCALED: EXPECT_GT(t[k].scale, 1u) << k; break;
+    case IMEST_CAN_COUNT: EXPECT_LE(t[k].len, 16u) << k << ": unsigned int has 16 bits on C2000"; break;
+    case IMEST_CAN_ENUM:
+      EXPECT_GE(1u << t[k].len, IMEST_REASON_RS_OUT_OF_RANGE + 2u) << k << ": every reason must fit";
+      break;
+    case IMEST_CAN_BOOL:
+    case IMEST_CAN_FLAG:
+    case IMEST_CAN_SAT: EXPECT_EQ(t[k].len, 1u) << k; break;
+    default: break;
     }
     if (t[k].kind == IMEST_CAN_F32 || t[k].kind == IMEST_CAN_SCALED) {
       unsigned carried = 0;
@@ -200,7 +203,8 @@ TEST(CanCodec, SignalTableIsConsistent) {
   for (unsigned i = 0; i < IMEST_CAN_NFRAMES; i++) EXPECT_NE(used[i], 0u) << "frame " << i << " is empty";
 }
 
-TEST(CanCodec, RoundTripAllFields) {
+TEST(CanCodec, RoundTripAllFields)
+{
   const imest_result_t r = golden_result();
   imest_can_window_t w = roundtrip(r);
   EXPECT_EQ(w.result.seq, r.seq);
@@ -226,7 +230,8 @@ TEST(CanCodec, RoundTripAllFields) {
   EXPECT_EQ(w.counter, 7u);
 }
 
-TEST(CanCodec, ClearedWindowSaysNotReceived) {
+TEST(CanCodec, ClearedWindowSaysNotReceived)
+{
   imest_can_window_t w;
   imest_can_window_clear(&w);
   EXPECT_EQ(w.have, 0u);
@@ -236,12 +241,13 @@ TEST(CanCodec, ClearedWindowSaysNotReceived) {
   EXPECT_EQ(w.result.status, -1);
   EXPECT_EQ(w.result.tr_reason, -1);
   EXPECT_EQ(w.result.tr_valid, 0);
-  imest_can_window_clear(nullptr);  // no effect, no crash
+  imest_can_window_clear(nullptr); // no effect, no crash
 }
 
 // T_R from 1 ms to 10 s and R_S from 1 mohm to 100 ohm (and well beyond):
 // float32 on the bus, so the decoded value is exactly (float)x.
-TEST(CanCodec, Float32RangeAndResolution) {
+TEST(CanCodec, Float32RangeAndResolution)
+{
   for (int e = -60; e <= 30; e++) {
     for (double m : {1.0, 1.2345678901, 3.3333333333, 9.87654321}) {
       imest_result_t r = golden_result();
@@ -256,7 +262,8 @@ TEST(CanCodec, Float32RangeAndResolution) {
   }
 }
 
-TEST(CanCodec, NonFiniteAndOutOfRangeFloats) {
+TEST(CanCodec, NonFiniteAndOutOfRangeFloats)
+{
   imest_result_t r = golden_result();
   r.tr_s = NAN;
   r.rs_ohm = INFINITY;
@@ -265,7 +272,7 @@ TEST(CanCodec, NonFiniteAndOutOfRangeFloats) {
   EXPECT_TRUE(std::isinf(w.result.rs_ohm) && w.result.rs_ohm > 0);
   EXPECT_EQ(w.sat, 0u) << "NaN / inf are carried, not saturated";
 
-  r.tr_s = 1e300;  // finite but beyond float32: clamped with a flag
+  r.tr_s = 1e300; // finite but beyond float32: clamped with a flag
   r.rs_ohm = -1e39;
   w = roundtrip(r);
   EXPECT_EQ(w.result.tr_s, static_cast<double>(FLT_MAX));
@@ -273,19 +280,20 @@ TEST(CanCodec, NonFiniteAndOutOfRangeFloats) {
   EXPECT_EQ(w.sat, IMEST_CAN_SAT_TR | IMEST_CAN_SAT_RS);
 
   r.tr_s = -INFINITY;
-  r.rs_ohm = static_cast<double>(FLT_MAX);  // the largest in-range value is not saturated
+  r.rs_ohm = static_cast<double>(FLT_MAX); // the largest in-range value is not saturated
   w = roundtrip(r);
   EXPECT_TRUE(std::isinf(w.result.tr_s) && w.result.tr_s < 0);
   EXPECT_EQ(w.result.rs_ohm, static_cast<double>(FLT_MAX));
   EXPECT_EQ(w.sat, 0u);
 }
 
-TEST(CanCodec, ScaledFieldsResolutionSaturationAndNaN) {
+TEST(CanCodec, ScaledFieldsResolutionSaturationAndNaN)
+{
   imest_result_t r = golden_result();
   // resolution and rounding
   r.e_i = 1.23456;
   r.pe_k1_rel = 0.123456;
-  r.pe_k2_rel = 0.00001;  // half a step: rounds up to one step
+  r.pe_k2_rel = 0.00001; // half a step: rounds up to one step
   r.tr_bound_rel = 0.0123456;
   r.span_s = 0.2504;
   imest_can_window_t w = roundtrip(r);
@@ -348,7 +356,8 @@ TEST(CanCodec, ScaledFieldsResolutionSaturationAndNaN) {
   EXPECT_EQ(w.sat, 0u);
 }
 
-TEST(CanCodec, VerdictsReasonsFlagsAndCounts) {
+TEST(CanCodec, VerdictsReasonsFlagsAndCounts)
+{
   imest_result_t r = golden_result();
   r.valid = 0;
   r.status = IMEST_REASON_RS_OUT_OF_RANGE;
@@ -358,7 +367,7 @@ TEST(CanCodec, VerdictsReasonsFlagsAndCounts) {
   r.flags = IMEST_FLAG_WARMUP | IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ADC_SAT | IMEST_FLAG_ENCODER_FAULT |
             IMEST_FLAG_OVERRUN;
   r.n_roots = 20;
-  r.n_admissible = 40;  // saturates at 31
+  r.n_admissible = 40; // saturates at 31
   r.windows = 60;
   imest_can_window_t w = roundtrip(r);
   EXPECT_EQ(w.result.valid, 0);
@@ -371,7 +380,7 @@ TEST(CanCodec, VerdictsReasonsFlagsAndCounts) {
   EXPECT_EQ(w.result.n_roots, 20u);
   EXPECT_EQ(w.result.n_admissible, 31u);
   EXPECT_EQ(w.result.windows, 60u);
-  r.windows = 1000;  // saturates at 255
+  r.windows = 1000; // saturates at 255
   EXPECT_EQ(roundtrip(r).result.windows, 255u);
   // every reason travels as its stable number
   for (int reason = IMEST_REASON_WARMUP; reason <= IMEST_REASON_RS_OUT_OF_RANGE; reason++) {
@@ -381,17 +390,18 @@ TEST(CanCodec, VerdictsReasonsFlagsAndCounts) {
     EXPECT_EQ(w.result.tr_reason, reason);
     EXPECT_EQ(w.result.rs_reason, reason);
   }
-  r.status = 300;  // not a reason: out of range (255)
+  r.status = 300; // not a reason: out of range (255)
   r.tr_reason = -3;
   EXPECT_EQ(roundtrip(r).result.status, 255);
   EXPECT_EQ(roundtrip(r).result.tr_reason, 255);
-  r.valid = 5;  // any nonzero is "valid"
+  r.valid = 5; // any nonzero is "valid"
   r.rs_valid = -1;
   EXPECT_EQ(roundtrip(r).result.valid, 1);
   EXPECT_EQ(roundtrip(r).result.rs_valid, 1);
 }
 
-TEST(CanCodec, ExtendedIdentifiers) {
+TEST(CanCodec, ExtendedIdentifiers)
+{
   const uint32_t base = 0x18FF5000u | IMEST_CAN_ID_EXT;
   imest_result_t r = golden_result();
   imest_can_frame f;
@@ -410,7 +420,8 @@ TEST(CanCodec, ExtendedIdentifiers) {
   EXPECT_EQ(imest_can_decode_frame(&f, 0x6A0u, &w2, nullptr), IMEST_CAN_DEC_FOREIGN);
 }
 
-TEST(CanCodec, EverySingleBitErrorIsDetected) {
+TEST(CanCodec, EverySingleBitErrorIsDetected)
+{
   const imest_result_t r = golden_result();
   for (unsigned i = 0; i < IMEST_CAN_NFRAMES; i++) {
     imest_can_frame f;
@@ -438,7 +449,8 @@ TEST(CanCodec, EverySingleBitErrorIsDetected) {
 
 // ---------------------------------------------------------------- publisher
 
-TEST(CanPublish, InitValidatesArguments) {
+TEST(CanPublish, InitValidatesArguments)
+{
   imest_can_pub_t pub;
   FakePort p;
   imest_can_port port = p.port();
@@ -447,7 +459,7 @@ TEST(CanPublish, InitValidatesArguments) {
   imest_can_port bad = {nullptr, nullptr};
   EXPECT_EQ(imest_can_pub_init(&pub, &bad, 0x6A0u), IMEST_ERR_NULL);
   EXPECT_EQ(imest_can_pub_init(&pub, &port, 0x7FAu), IMEST_OK);
-  EXPECT_EQ(imest_can_pub_init(&pub, &port, 0x7FBu), IMEST_ERR_ARG);  // 0x7FB+5 > 0x7FF
+  EXPECT_EQ(imest_can_pub_init(&pub, &port, 0x7FBu), IMEST_ERR_ARG); // 0x7FB+5 > 0x7FF
   EXPECT_EQ(imest_can_pub_init(&pub, &port, 0x800u), IMEST_ERR_ARG);
   EXPECT_EQ(imest_can_pub_init(&pub, &port, 0x1FFFFFFAu | IMEST_CAN_ID_EXT), IMEST_OK);
   EXPECT_EQ(imest_can_pub_init(&pub, &port, 0x1FFFFFFBu | IMEST_CAN_ID_EXT), IMEST_ERR_ARG);
@@ -459,12 +471,13 @@ TEST(CanPublish, InitValidatesArguments) {
   EXPECT_EQ(p.calls, 0u);
 }
 
-TEST(CanPublish, SixFramesPerWindowAndRollingCounter) {
+TEST(CanPublish, SixFramesPerWindowAndRollingCounter)
+{
   FakePort p;
   imest_can_port port = p.port();
   imest_can_pub_t pub = make_pub(&port);
   imest_result_t r = golden_result();
-  pub.counter = 254u;  // exercise the wrap of the 8-bit counter
+  pub.counter = 254u; // exercise the wrap of the 8-bit counter
   for (unsigned k = 0; k < 3; k++) {
     r.seq = k;
     EXPECT_EQ(imest_can_publish(&pub, &r), 0);
@@ -481,17 +494,18 @@ TEST(CanPublish, SixFramesPerWindowAndRollingCounter) {
   EXPECT_EQ(imest_can_publish(&pub, nullptr), IMEST_ERR_NULL);
 }
 
-TEST(CanPublish, FailedSendsAreCountedReportedAndNotRetried) {
+TEST(CanPublish, FailedSendsAreCountedReportedAndNotRetried)
+{
   FakePort p;
   imest_can_port port = p.port();
   imest_can_pub_t pub = make_pub(&port);
   imest_result_t r = golden_result();
   const unsigned N = IMEST_CAN_NFRAMES;
-  p.fail_index_mask = 1u << IMEST_CAN_FRAME_RS;  // queue refuses the second frame
+  p.fail_index_mask = 1u << IMEST_CAN_FRAME_RS; // queue refuses the second frame
   EXPECT_EQ(imest_can_publish(&pub, &r), 1);
   EXPECT_EQ(p.calls, N) << "one call per frame, no retry";
   EXPECT_EQ(pub.tx_failed, 1u);
-  p.fail_all = true;  // bus-off
+  p.fail_all = true; // bus-off
   EXPECT_EQ(imest_can_publish(&pub, &r), static_cast<int>(N));
   EXPECT_EQ(p.calls, 2u * N);
   EXPECT_EQ(pub.tx_failed, 1u + N);
@@ -509,8 +523,9 @@ TEST(CanPublish, FailedSendsAreCountedReportedAndNotRetried) {
   EXPECT_EQ(w.tx_failed, 1u + N);
   // the first window's status frame already counted its own failed frame
   imest_can_window_clear(&w);
-  ASSERT_EQ(imest_can_decode_frame(&p.frames[IMEST_CAN_FRAME_STAT - 1u], IMEST_CAN_DEFAULT_BASE_ID, &w, nullptr),
-            IMEST_CAN_DEC_OK);
+  ASSERT_EQ(
+      imest_can_decode_frame(&p.frames[IMEST_CAN_FRAME_STAT - 1u], IMEST_CAN_DEFAULT_BASE_ID, &w, nullptr),
+      IMEST_CAN_DEC_OK);
   EXPECT_EQ(w.tx_failed, 1u);
   // saturation of the 16-bit field
   pub.tx_failed = 70000u;
@@ -525,7 +540,8 @@ TEST(CanPublish, FailedSendsAreCountedReportedAndNotRetried) {
 // ---------------------------------------------------------------- reader
 
 namespace {
-std::vector<imest_can_frame> stream(unsigned n, unsigned seq0 = 0, unsigned ctr0 = 0) {
+std::vector<imest_can_frame> stream(unsigned n, unsigned seq0 = 0, unsigned ctr0 = 0)
+{
   std::vector<imest_can_frame> v;
   imest_result_t r = golden_result();
   for (unsigned k = 0; k < n; k++) {
@@ -546,7 +562,8 @@ struct Fed {
   imest_can_rx_t rx;
 };
 
-Fed feed(const std::vector<imest_can_frame> &v) {
+Fed feed(const std::vector<imest_can_frame> &v)
+{
   Fed o;
   imest_can_rx_init(&o.rx, 0x6A0u);
   for (const auto &f : v) {
@@ -568,9 +585,10 @@ Fed feed(const std::vector<imest_can_frame> &v) {
 }
 
 constexpr unsigned N = IMEST_CAN_NFRAMES;
-}  // namespace
+} // namespace
 
-TEST(CanReader, CleanStreamAcrossCounterWrap) {
+TEST(CanReader, CleanStreamAcrossCounterWrap)
+{
   Fed o = feed(stream(10, 100, 250));
   ASSERT_EQ(o.windows.size(), 10u);
   EXPECT_TRUE(o.events.empty());
@@ -583,9 +601,10 @@ TEST(CanReader, CleanStreamAcrossCounterWrap) {
   EXPECT_EQ(o.rx.st.lost + o.rx.st.repeated + o.rx.st.corrupt + o.rx.st.incomplete + o.rx.st.late, 0u);
 }
 
-TEST(CanReader, LostFrameGivesLossEventAndIncompleteWindow) {
+TEST(CanReader, LostFrameGivesLossEventAndIncompleteWindow)
+{
   auto v = stream(6);
-  v.erase(v.begin() + 3 * N + IMEST_CAN_FRAME_RS);  // window 3 loses IMEST_RS
+  v.erase(v.begin() + 3 * N + IMEST_CAN_FRAME_RS); // window 3 loses IMEST_RS
   Fed o = feed(v);
   ASSERT_EQ(o.windows.size(), 6u);
   EXPECT_EQ(o.windows[3].have, kAll & ~(1u << IMEST_CAN_FRAME_RS));
@@ -601,9 +620,10 @@ TEST(CanReader, LostFrameGivesLossEventAndIncompleteWindow) {
   EXPECT_EQ(o.events[0].prev_counter, 2u);
 }
 
-TEST(CanReader, LostWholeWindowIsBusLossNotEstimatorGap) {
+TEST(CanReader, LostWholeWindowIsBusLossNotEstimatorGap)
+{
   auto v = stream(6);
-  v.erase(v.begin() + 2 * N, v.begin() + 3 * N);  // window 2 entirely
+  v.erase(v.begin() + 2 * N, v.begin() + 3 * N); // window 2 entirely
   Fed o = feed(v);
   EXPECT_EQ(o.windows.size(), 5u);
   EXPECT_EQ(o.rx.st.lost, N);
@@ -611,9 +631,10 @@ TEST(CanReader, LostWholeWindowIsBusLossNotEstimatorGap) {
   EXPECT_EQ(o.rx.st.seq_gaps, 0u);
 }
 
-TEST(CanReader, EstimatorOverrunShowsAsSequenceGap) {
+TEST(CanReader, EstimatorOverrunShowsAsSequenceGap)
+{
   auto v = stream(3, 0, 0);
-  auto w = stream(3, 10, 3);  // counter continues, seq jumps 2 -> 10
+  auto w = stream(3, 10, 3); // counter continues, seq jumps 2 -> 10
   v.insert(v.end(), w.begin(), w.end());
   Fed o = feed(v);
   EXPECT_EQ(o.windows.size(), 6u);
@@ -621,7 +642,8 @@ TEST(CanReader, EstimatorOverrunShowsAsSequenceGap) {
   EXPECT_EQ(o.rx.st.seq_gaps, 7u);
 }
 
-TEST(CanReader, RepeatedAndCorruptedCopiesAreDropped) {
+TEST(CanReader, RepeatedAndCorruptedCopiesAreDropped)
+{
   auto v = stream(4);
   imest_can_frame bad = v[5];
   bad.data[2] ^= 0x10u;
@@ -630,7 +652,7 @@ TEST(CanReader, RepeatedAndCorruptedCopiesAreDropped) {
   imest_can_frame foreign = v[0];
   foreign.id = 0x123u;
   v.insert(v.begin() + 5, bad);  // corrupted copy before the good one
-  v.insert(v.begin() + 3, v[2]);  // repeat
+  v.insert(v.begin() + 3, v[2]); // repeat
   v.insert(v.begin() + 11, shortf);
   v.insert(v.begin() + 1, foreign);
   Fed o = feed(v);
@@ -643,11 +665,12 @@ TEST(CanReader, RepeatedAndCorruptedCopiesAreDropped) {
 }
 
 // A frame that arrives corrupted is counted once, as corrupted, not also as lost.
-TEST(CanReader, CorruptedFrameIsNotAlsoCountedLost) {
+TEST(CanReader, CorruptedFrameIsNotAlsoCountedLost)
+{
   auto v = stream(5);
-  v[2 * N + 1].data[0] ^= 0x01u;                // window 2, IMEST_RS: bad CRC
-  v[3 * N + N - 1].dlc = 3u;                     // window 3, last frame: bad length
-  v[4 * N].data[7] ^= 0xFFu;                     // window 4, first frame: bad CRC
+  v[2 * N + 1].data[0] ^= 0x01u; // window 2, IMEST_RS: bad CRC
+  v[3 * N + N - 1].dlc = 3u;     // window 3, last frame: bad length
+  v[4 * N].data[7] ^= 0xFFu;     // window 4, first frame: bad CRC
   Fed o = feed(v);
   ASSERT_EQ(o.windows.size(), 5u);
   EXPECT_EQ(o.rx.st.corrupt, 3u);
@@ -656,7 +679,8 @@ TEST(CanReader, CorruptedFrameIsNotAlsoCountedLost) {
 }
 
 // The sender restarts: sequence number and counter start again. No loss.
-TEST(CanReader, SenderRestartIsNotCountedAsLoss) {
+TEST(CanReader, SenderRestartIsNotCountedAsLoss)
+{
   auto v = stream(10, 50, 77);
   auto w = stream(5, 0, 0);
   v.insert(v.end(), w.begin(), w.end());
@@ -676,9 +700,10 @@ TEST(CanReader, SenderRestartIsNotCountedAsLoss) {
   EXPECT_EQ(o.rx.st.lost, 1u);
 }
 
-TEST(CanReader, FlushReturnsTheLastWindowWithoutCountingTheUnrecordedTail) {
+TEST(CanReader, FlushReturnsTheLastWindowWithoutCountingTheUnrecordedTail)
+{
   auto v = stream(3, 0, 0);
-  v.erase(v.end() - 2, v.end());  // capture ended two frames early
+  v.erase(v.end() - 2, v.end()); // capture ended two frames early
   Fed o = feed(v);
   ASSERT_EQ(o.windows.size(), 3u);
   EXPECT_EQ(o.windows.back().have, kAll >> 2) << "flush returns the last, incomplete window";
@@ -688,9 +713,10 @@ TEST(CanReader, FlushReturnsTheLastWindowWithoutCountingTheUnrecordedTail) {
   EXPECT_EQ(imest_can_rx_flush(&o.rx, &x, nullptr), 0);
 }
 
-TEST(CanReader, JoiningMidWindowIsNotLoss) {
+TEST(CanReader, JoiningMidWindowIsNotLoss)
+{
   auto v = stream(3, 0, 0);
-  v.erase(v.begin(), v.begin() + 4);  // the monitor started during window 0
+  v.erase(v.begin(), v.begin() + 4); // the monitor started during window 0
   Fed o = feed(v);
   ASSERT_EQ(o.windows.size(), 3u);
   EXPECT_EQ(o.rx.st.lost, 0u);
@@ -699,9 +725,10 @@ TEST(CanReader, JoiningMidWindowIsNotLoss) {
 
 // A controller sending by identifier priority from several mailboxes can put
 // the next window's first frame before this window's last one.
-TEST(CanReader, LateFrameIsNotLost) {
+TEST(CanReader, LateFrameIsNotLost)
+{
   auto v = stream(4, 0, 0);
-  std::swap(v[2 * N - 1], v[2 * N]);  // window 1's last frame after window 2's first
+  std::swap(v[2 * N - 1], v[2 * N]); // window 1's last frame after window 2's first
   Fed o = feed(v);
   ASSERT_EQ(o.windows.size(), 4u);
   EXPECT_EQ(o.rx.st.late, 1u);
@@ -714,12 +741,13 @@ TEST(CanReader, LateFrameIsNotLost) {
 // totals are exact, every corrupted frame is counted once as corrupted and
 // never also as lost. The first and last windows stay intact (what is missing
 // before the first or after the last frame received is not loss by design).
-TEST(CanReader, RandomLossAndCorruptionAreCountedExactly) {
+TEST(CanReader, RandomLossAndCorruptionAreCountedExactly)
+{
   std::mt19937 rng(12345u);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int run = 0; run < 300; run++) {
     const unsigned windows = 30;
-    const unsigned restart_at = (run % 3 == 0) ? 15u : 0u;  // the node reboots before window 15
+    const unsigned restart_at = (run % 3 == 0) ? 15u : 0u; // the node reboots before window 15
     std::vector<imest_can_frame> sent;
     for (unsigned k = 0; k < windows; k++) {
       const bool after = restart_at != 0 && k >= restart_at;
@@ -731,7 +759,7 @@ TEST(CanReader, RandomLossAndCorruptionAreCountedExactly) {
     for (size_t i = 0; i < sent.size(); i++) {
       const unsigned k = static_cast<unsigned>(i / N);
       const bool keep = k == 0 || k == windows - 1 ||
-                        (k == restart_at && i % N == IMEST_CAN_FRAME_STAT);  // the restart is seen
+                        (k == restart_at && i % N == IMEST_CAN_FRAME_STAT); // the restart is seen
       const double x = u(rng);
       if (!keep && x < 0.12) {
         dropped++;
@@ -759,7 +787,8 @@ TEST(CanReader, RandomLossAndCorruptionAreCountedExactly) {
 
 // ---------------------------------------------------------------- identifiers (tools)
 
-TEST(CanIdParse, OneParserForEveryTool) {
+TEST(CanIdParse, OneParserForEveryTool)
+{
   uint32_t id = 0;
   char err[256];
   EXPECT_EQ(imest_can_id_parse("0x6A0", 0, "--ext", &id, err, sizeof err), IMEST_OK);
@@ -801,7 +830,8 @@ TEST(CanIdParse, OneParserForEveryTool) {
 
 // ---------------------------------------------------------------- candump
 
-TEST(Candump, FormatLines) {
+TEST(Candump, FormatLines)
+{
   imest_can_frame f = {0x6A0u, 8u, {0xDE, 0xAD, 0xBE, 0xEF, 0x00, 0x01, 0x7F, 0x80}};
   char buf[IMEST_CANDUMP_LINE_MAX];
   ASSERT_GT(imest_candump_format(buf, sizeof buf, 1700000000.25, nullptr, &f), 0);
@@ -824,7 +854,8 @@ TEST(Candump, FormatLines) {
   EXPECT_EQ(imest_candump_format(buf, sizeof buf, 0.0, "bad name", &f), -1);
 }
 
-TEST(Candump, ParseGoodLines) {
+TEST(Candump, ParseGoodLines)
+{
   imest_can_frame f;
   double t = 0;
   char ifn[IMEST_CANDUMP_IFNAMSIZ];
@@ -848,7 +879,8 @@ TEST(Candump, ParseGoodLines) {
   EXPECT_EQ(imest_candump_parse("", &t, nullptr, &f, &err), IMEST_CANDUMP_EMPTY);
 }
 
-TEST(Candump, ParseMalformedAndTruncatedLines) {
+TEST(Candump, ParseMalformedAndTruncatedLines)
+{
   struct Case {
     const char *line;
     const char *why;
@@ -885,7 +917,8 @@ TEST(Candump, ParseMalformedAndTruncatedLines) {
   }
 }
 
-TEST(Candump, PortWritesParseableLines) {
+TEST(Candump, PortWritesParseableLines)
+{
   FILE *fp = std::tmpfile();
   ASSERT_NE(fp, nullptr);
   imest_candump_port cd;
@@ -920,7 +953,8 @@ TEST(Candump, PortWritesParseableLines) {
   std::fclose(fp);
 }
 
-TEST(Candump, WriteErrorIsAFailedSend) {
+TEST(Candump, WriteErrorIsAFailedSend)
+{
   FILE *fp = std::fopen("/dev/full", "w");
   if (fp == nullptr) GTEST_SKIP() << "/dev/full not available";
   std::setvbuf(fp, nullptr, _IONBF, 0);
@@ -942,7 +976,8 @@ struct HalLog {
   std::vector<int> ext;
   int refuse = 0;
 };
-int hal_tx(void *hal, uint32_t id, int extended, const unsigned char *data, unsigned dlc) {
+int hal_tx(void *hal, uint32_t id, int extended, const unsigned char *data, unsigned dlc)
+{
   HalLog *h = static_cast<HalLog *>(hal);
   if (h->refuse) return 1;
   imest_can_frame f;
@@ -953,9 +988,10 @@ int hal_tx(void *hal, uint32_t id, int extended, const unsigned char *data, unsi
   h->ext.push_back(extended);
   return 0;
 }
-}  // namespace
+} // namespace
 
-TEST(CanCallbackPort, ForwardsFramesAndCountsRefusals) {
+TEST(CanCallbackPort, ForwardsFramesAndCountsRefusals)
+{
   HalLog hal;
   imest_can_callback cb;
   EXPECT_EQ(imest_can_callback_init(nullptr, hal_tx, &hal), -1);
@@ -980,7 +1016,8 @@ TEST(CanCallbackPort, ForwardsFramesAndCountsRefusals) {
 }
 
 // The STM32-HAL-style example (software queue of 8 in front of 3 mailboxes) on the fake HAL.
-TEST(CanCallbackPort, Stm32ExampleQueuesDrainsAndRefusesWhenBusOff) {
+TEST(CanCallbackPort, Stm32ExampleQueuesDrainsAndRefusesWhenBusOff)
+{
   static CAN_HandleTypeDef hcan;
   static example_can_tx_t tx;
   std::memset(&hcan, 0, sizeof hcan);
@@ -992,15 +1029,15 @@ TEST(CanCallbackPort, Stm32ExampleQueuesDrainsAndRefusesWhenBusOff) {
   // 6 frames, 3 mailboxes: all accepted, 3 wait in the queue
   ASSERT_EQ(imest_can_publish(&pub, &r), 0);
   EXPECT_EQ(HAL_CAN_GetTxMailboxesFreeLevel(&hcan), 0u);
-  fake_can_complete(&hcan);  // the interrupt moves the queued three into mailboxes
+  fake_can_complete(&hcan); // the interrupt moves the queued three into mailboxes
   fake_can_complete(&hcan);
   ASSERT_EQ(hcan.n_log, N);
   for (unsigned i = 0; i < N; i++) EXPECT_EQ(hcan.log[i].id, 0x6A0u + i);
   // bus-off: 8 frames fit the queue, then refusals are counted, not retried
   hcan.bus_off = 1;
   EXPECT_EQ(imest_can_publish(&pub, &r), 0);                        // window 1: queued
-  EXPECT_EQ(imest_can_publish(&pub, &r), static_cast<int>(N - 2u));  // window 2: 2 queued
-  EXPECT_EQ(imest_can_publish(&pub, &r), static_cast<int>(N));       // window 3: none
+  EXPECT_EQ(imest_can_publish(&pub, &r), static_cast<int>(N - 2u)); // window 2: 2 queued
+  EXPECT_EQ(imest_can_publish(&pub, &r), static_cast<int>(N));      // window 3: none
   EXPECT_EQ(pub.tx_failed, 2u * N - 2u);
   // recovery: the queue drains, the next window partly goes out
   hcan.bus_off = 0;
@@ -1028,7 +1065,8 @@ TEST(CanCallbackPort, Stm32ExampleQueuesDrainsAndRefusesWhenBusOff) {
 
 // ---------------------------------------------------------------- SocketCAN
 
-TEST(SocketCan, ErrorsAreClear) {
+TEST(SocketCan, ErrorsAreClear)
+{
   imest_socketcan sc;
   int rc = imest_socketcan_open(&sc, "vcan0");
   if (rc == -EAFNOSUPPORT || rc == -EPROTONOSUPPORT) {
@@ -1065,7 +1103,8 @@ TEST(SocketCan, ErrorsAreClear) {
 // The application publishes each result imest_background() returns; what
 // arrives decodes to that result, verdicts and all. The estimator itself
 // sends nothing.
-TEST(CanPublish, ApplicationPublishesEveryBackgroundResult) {
+TEST(CanPublish, ApplicationPublishesEveryBackgroundResult)
+{
   static imest_t s;
   imest_config_t cfg;
   imest_config_default(&cfg);
@@ -1095,7 +1134,8 @@ TEST(CanPublish, ApplicationPublishesEveryBackgroundResult) {
       }
       for (; fed < p.frames.size(); fed++) {
         imest_can_window_t win;
-        if (imest_can_rx_feed(&rx, &p.frames[fed], &win, nullptr) & IMEST_CAN_EV_WINDOW) windows.push_back(win);
+        if (imest_can_rx_feed(&rx, &p.frames[fed], &win, nullptr) & IMEST_CAN_EV_WINDOW)
+          windows.push_back(win);
       }
     }
   }

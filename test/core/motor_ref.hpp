@@ -14,13 +14,16 @@ struct MotorRef {
   double t = 0;
 
   double M() const { return std::sqrt((1 - sigma) * ls * lr); }
-  void u_ab(double tt, double &ua, double &ub) const {
+  void u_ab(double tt, double &ua, double &ub) const
+  {
     const double a = std::sqrt(2.0 / 3.0) * vll, w = 2 * M_PI * f * tt;
-    const double u1 = a * std::cos(w), u2 = a * std::cos(w - 2 * M_PI / 3), u3 = a * std::cos(w + 2 * M_PI / 3);
+    const double u1 = a * std::cos(w), u2 = a * std::cos(w - 2 * M_PI / 3),
+                 u3 = a * std::cos(w + 2 * M_PI / 3);
     ua = std::sqrt(2.0 / 3.0) * (u1 - 0.5 * u2 - 0.5 * u3);
     ub = std::sqrt(2.0 / 3.0) * (std::sqrt(3.0) / 2) * (u2 - u3);
   }
-  void deriv(double tt, const double *s, double *d) const {
+  void deriv(double tt, const double *s, double *d) const
+  {
     const double m = M(), beta = m / (sigma * ls * lr);
     const double gamma = rs / (sigma * ls) + (1 - sigma) / (sigma * tr);
     double ua, ub;
@@ -34,7 +37,8 @@ struct MotorRef {
     d[4] = (torque - load - b * w) / j;
     d[5] = w;
   }
-  void step(double h) {
+  void step(double h)
+  {
     double k1[6], k2[6], k3[6], k4[6], y[6];
     deriv(t, x, k1);
     for (int i = 0; i < 6; ++i) y[i] = x[i] + 0.5 * h * k1[i];
@@ -47,11 +51,16 @@ struct MotorRef {
     t += h;
   }
   // phase quantities of the current state
-  void phases(double u[3], double i[3]) const {
+  void phases(double u[3], double i[3]) const
+  {
     double ua, ub;
     u_ab(t, ua, ub);
     const double k = std::sqrt(2.0 / 3.0);
-    u[0] = k * ua; u[1] = k * (-0.5 * ua + std::sqrt(3.0) / 2 * ub); u[2] = k * (-0.5 * ua - std::sqrt(3.0) / 2 * ub);
-    i[0] = k * x[0]; i[1] = k * (-0.5 * x[0] + std::sqrt(3.0) / 2 * x[1]); i[2] = k * (-0.5 * x[0] - std::sqrt(3.0) / 2 * x[1]);
+    u[0] = k * ua;
+    u[1] = k * (-0.5 * ua + std::sqrt(3.0) / 2 * ub);
+    u[2] = k * (-0.5 * ua - std::sqrt(3.0) / 2 * ub);
+    i[0] = k * x[0];
+    i[1] = k * (-0.5 * x[0] + std::sqrt(3.0) / 2 * x[1]);
+    i[2] = k * (-0.5 * x[0] - std::sqrt(3.0) / 2 * x[1]);
   }
 };

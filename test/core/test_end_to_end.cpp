@@ -17,7 +17,8 @@ struct RunOut {
 };
 
 // Runs the motor for `seconds`, feeding exact samples at fs from t_start on.
-RunOut run(MotorRef &mot, double seconds, double t_start, bool at_rest, float window_s = 1.0f) {
+RunOut run(MotorRef &mot, double seconds, double t_start, bool at_rest, float window_s = 1.0f)
+{
   const double fs = 4000.0;
   const int sub = 16;
   imest_config_t cfg;
@@ -48,13 +49,14 @@ RunOut run(MotorRef &mot, double seconds, double t_start, bool at_rest, float wi
   }
   return out;
 }
-}  // namespace
+} // namespace
 
 // Paper's experiment 2 operating point with exact samples, record starting
 // mid-run: the first window is warm-up (123 samples for the filters and
 // 3183 for the offset tracker not used: invalid, more than half of it), and
 // every later window recovers T_R and R_S.
-TEST(EndToEnd, LoadedSteadyStateRecoversTrAndRs) {
+TEST(EndToEnd, LoadedSteadyStateRecoversTrAndRs)
+{
   MotorRef mot;
   mot.vll = 115;
   mot.f = 30;
@@ -76,7 +78,8 @@ TEST(EndToEnd, LoadedSteadyStateRecoversTrAndRs) {
 
 // Paper's experiment 1: 60 Hz applied at standstill. The run-up window is
 // valid; once at no-load speed the slip is ~0 and T_R is unobservable.
-TEST(EndToEnd, RunUpValidThenZeroSlipInvalid) {
+TEST(EndToEnd, RunUpValidThenZeroSlipInvalid)
+{
   MotorRef mot;
   RunOut r = run(mot, 3.0, 0.0, true);
   ASSERT_EQ(r.res.size(), 3u);
@@ -90,7 +93,8 @@ TEST(EndToEnd, RunUpValidThenZeroSlipInvalid) {
 }
 
 // No supply at all: no current, a clear reason, never a number marked valid.
-TEST(EndToEnd, NoCurrentIsInvalidWithReason) {
+TEST(EndToEnd, NoCurrentIsInvalidWithReason)
+{
   MotorRef mot;
   mot.vll = 0;
   RunOut r = run(mot, 2.0, 0.0, true);

@@ -9,21 +9,23 @@ extern "C" {
 }
 
 namespace {
-imest_config_t small_config() {
+imest_config_t small_config()
+{
   imest_config_t cfg;
   imest_config_default(&cfg);
   cfg.pole_pairs = 2;
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
   cfg.fs_hz = 4000.0f;
-  cfg.window_s = 0.1f;  // 400 samples
+  cfg.window_s = 0.1f; // 400 samples
   // the filter warm-up alone (123 samples); the offset tracker's longer
   // first-start warm-up has its own test below
   cfg.dc_block_hz = 0.0f;
   return cfg;
 }
 // a rotating current/voltage at constant speed (no physics needed here)
-void feed(imest_t *s, int n, int &k, float amp = 1.0f) {
+void feed(imest_t *s, int n, int &k, float amp = 1.0f)
+{
   for (int j = 0; j < n; ++j, ++k) {
     const float ph = 2 * (float)M_PI * 30.0f * (float)k / 4000.0f;
     const float u[3] = {100 * std::cos(ph), 100 * std::cos(ph - 2.0944f), 100 * std::cos(ph + 2.0944f)};
@@ -31,9 +33,10 @@ void feed(imest_t *s, int n, int &k, float amp = 1.0f) {
     imest_isr_abc(s, u, i, std::fmod(0.5f * ph, 6.2831853f));
   }
 }
-}  // namespace
+} // namespace
 
-TEST(Handoff, InitRejectsBadConfigNamingTheField) {
+TEST(Handoff, InitRejectsBadConfigNamingTheField)
+{
   imest_config_t cfg = small_config();
   const char *field = nullptr;
   EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_OK);
@@ -53,7 +56,8 @@ TEST(Handoff, InitRejectsBadConfigNamingTheField) {
   EXPECT_STREQ(field, "filter_hz");
 }
 
-TEST(Handoff, IsrSignalsExactlyAtWindowEnds) {
+TEST(Handoff, IsrSignalsExactlyAtWindowEnds)
+{
   imest_config_t cfg = small_config();
   static imest_t s;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
@@ -77,29 +81,31 @@ TEST(Handoff, IsrSignalsExactlyAtWindowEnds) {
   EXPECT_EQ(completed, 3);
 }
 
-TEST(Handoff, OverrunIsCountedAndVisibleNeverTorn) {
+TEST(Handoff, OverrunIsCountedAndVisibleNeverTorn)
+{
   imest_config_t cfg = small_config();
   static imest_t s;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   imest_result_t r;
   int k = 0;
-  feed(&s, 400 * 3, k);  // three windows, background never ran
-  EXPECT_EQ(imest_overruns(&s), 2u);  // window 0 handed over; 1 and 2 dropped
+  feed(&s, 400 * 3, k);              // three windows, background never ran
+  EXPECT_EQ(imest_overruns(&s), 2u); // window 0 handed over; 1 and 2 dropped
   ASSERT_EQ(imest_background(&s, &r), 1);
   EXPECT_EQ(r.seq, 0u);
   EXPECT_EQ(imest_background(&s, &r), 0);
   feed(&s, 400, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.seq, 3u);  // the gap shows the dropped windows 1 and 2
+  EXPECT_EQ(r.seq, 3u); // the gap shows the dropped windows 1 and 2
   EXPECT_EQ(r.overruns, 2u);
   EXPECT_TRUE(r.flags & IMEST_FLAG_OVERRUN);
   EXPECT_EQ(r.samples, 400u);
   EXPECT_EQ(r.used_samples, 400u);
 }
 
-TEST(Handoff, WarmupIsMarkedAndStartAtRestSkipsIt) {
+TEST(Handoff, WarmupIsMarkedAndStartAtRestSkipsIt)
+{
   imest_config_t cfg = small_config();
-  cfg.window_s = 0.05f;  // 200 samples: the 123-sample warm-up is most of it
+  cfg.window_s = 0.05f; // 200 samples: the 123-sample warm-up is most of it
   static imest_t s;
   imest_result_t r;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
@@ -138,7 +144,8 @@ TEST(Handoff, WarmupIsMarkedAndStartAtRestSkipsIt) {
   EXPECT_EQ(r.used_samples, 400u);
 }
 
-TEST(Handoff, NonFiniteSampleInvalidatesItsWindowAndRecovers) {
+TEST(Handoff, NonFiniteSampleInvalidatesItsWindowAndRecovers)
+{
   imest_config_t cfg = small_config();
   cfg.start_at_rest = 1;
   static imest_t s;
@@ -162,7 +169,8 @@ TEST(Handoff, NonFiniteSampleInvalidatesItsWindowAndRecovers) {
   if (r.valid) EXPECT_TRUE(std::isfinite(r.tr_s));
 }
 
-TEST(Handoff, EncoderJumpAndSaturationAreFlagged) {
+TEST(Handoff, EncoderJumpAndSaturationAreFlagged)
+{
   imest_config_t cfg = small_config();
   cfg.start_at_rest = 1;
   cfg.i_limit_a = 5.0f;
@@ -172,7 +180,7 @@ TEST(Handoff, EncoderJumpAndSaturationAreFlagged) {
   int k = 0;
   feed(&s, 100, k);
   const float u[3] = {0, 0, 0}, i[3] = {0, 0, 0};
-  imest_isr_abc(&s, u, i, 5.0f);  // angle jumps by ~2.6 rad in one sample
+  imest_isr_abc(&s, u, i, 5.0f); // angle jumps by ~2.6 rad in one sample
   ++k;
   feed(&s, 299, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
@@ -186,13 +194,14 @@ TEST(Handoff, EncoderJumpAndSaturationAreFlagged) {
   EXPECT_EQ(r.status, IMEST_REASON_ADC_SATURATION);
 }
 
-TEST(Handoff, FlushHandsOverAShortWindowWithItsOwnEndTime) {
-  imest_config_t cfg = small_config();  // 400-sample windows
+TEST(Handoff, FlushHandsOverAShortWindowWithItsOwnEndTime)
+{
+  imest_config_t cfg = small_config(); // 400-sample windows
   cfg.start_at_rest = 1;
   static imest_t s;
   imest_result_t r;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
-  EXPECT_EQ(imest_isr_flush(&s), 0);  // nothing to hand over
+  EXPECT_EQ(imest_isr_flush(&s), 0); // nothing to hand over
   int k = 0;
   feed(&s, 400 + 250, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
@@ -213,10 +222,11 @@ TEST(Handoff, FlushHandsOverAShortWindowWithItsOwnEndTime) {
 // for it too: 123 filter samples + 5 tau of the 1 Hz high-pass (3183
 // samples). A restart after a fault waits for the filters only, since the
 // tracker keeps its state; a start at rest waits for nothing.
-TEST(Handoff, OffsetTrackerLengthensOnlyTheFirstWarmup) {
+TEST(Handoff, OffsetTrackerLengthensOnlyTheFirstWarmup)
+{
   imest_config_t cfg = small_config();
   cfg.dc_block_hz = 1.0f;
-  cfg.window_s = 1.0f;  // 4000 samples
+  cfg.window_s = 1.0f; // 4000 samples
   static imest_t s;
   imest_result_t r;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
@@ -239,7 +249,7 @@ TEST(Handoff, OffsetTrackerLengthensOnlyTheFirstWarmup) {
   k = 0;
   feed(&s, 4000, k);
   ASSERT_EQ(imest_background(&s, &r), 1);
-  EXPECT_EQ(r.used_samples, 4000u - 42u);  // 0.01f s = 39.99.. samples, rounded down, + 3
+  EXPECT_EQ(r.used_samples, 4000u - 42u); // 0.01f s = 39.99.. samples, rounded down, + 3
   cfg.warmup_s = 0.0f;
   cfg.start_at_rest = 1;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);

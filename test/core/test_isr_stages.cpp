@@ -12,10 +12,11 @@ extern "C" {
 #include "isr_transform.h"
 }
 
-TEST(IsrTransform, SinCosWithin4e7OverSeveralTurns) {
+TEST(IsrTransform, SinCosWithin4e7OverSeveralTurns)
+{
   double worst = 0;
   for (int k = -200000; k <= 200000; ++k) {
-    const float x = (float)(k * 1.0e-4);  // -20 .. 20 rad
+    const float x = (float)(k * 1.0e-4); // -20 .. 20 rad
     float s, c;
     isr_sincos(x, &s, &c);
     worst = std::max(worst, std::fabs((double)s - std::sin((double)x)));
@@ -24,7 +25,8 @@ TEST(IsrTransform, SinCosWithin4e7OverSeveralTurns) {
   EXPECT_LT(worst, 4e-7);
 }
 
-TEST(IsrTransform, WrapPiKeepsAngleModulo2Pi) {
+TEST(IsrTransform, WrapPiKeepsAngleModulo2Pi)
+{
   for (double x : {-100.0, -7.0, -3.2, -0.1, 0.0, 0.1, 3.2, 7.0, 100.0, 1000.0}) {
     const double w = isr_wrap_pi((float)x);
     EXPECT_LE(std::fabs(w), M_PI + 1e-5) << x;
@@ -32,7 +34,8 @@ TEST(IsrTransform, WrapPiKeepsAngleModulo2Pi) {
   }
 }
 
-TEST(IsrTransform, ClarkeIsPowerInvariant) {
+TEST(IsrTransform, ClarkeIsPowerInvariant)
+{
   // balanced set with line-to-line rms 230 V -> alpha/beta amplitude 230
   for (int k = 0; k < 50; ++k) {
     const double ph = k * 0.3, a = std::sqrt(2.0 / 3.0) * 230;
@@ -46,7 +49,8 @@ TEST(IsrTransform, ClarkeIsPowerInvariant) {
 }
 
 // Product of the two sections vs the direct-form coefficients of docs/METHOD.md §8.
-static void check_design(double fc, const double b[4], const double a[4]) {
+static void check_design(double fc, const double b[4], const double a[4])
+{
   imest_config_t cfg;
   imest_config_default(&cfg);
   cfg.pole_pairs = 2;
@@ -70,7 +74,8 @@ static void check_design(double fc, const double b[4], const double a[4]) {
   }
 }
 
-TEST(IsrFilter, DesignMatchesMathMdCoefficients) {
+TEST(IsrFilter, DesignMatchesMathMdCoefficients)
+{
   const double b500[4] = {0.03168934384971104, 0.09506803154913313, 0.09506803154913313, 0.03168934384971104};
   const double a500[4] = {1, -1.459029062228061, 0.9103690002900687, -0.19782518726431944};
   const double b100[4] = {4.1654613907575e-4, 1.24963841722724e-3, 1.24963841722724e-3, 4.1654613907575e-4};
@@ -83,7 +88,8 @@ TEST(IsrFilter, DesignMatchesMathMdCoefficients) {
 }
 
 // Central differences of the filtered signal against a float64 filter run.
-TEST(IsrFilter, DerivativesAreTimeAlignedCentralDifferences) {
+TEST(IsrFilter, DerivativesAreTimeAlignedCentralDifferences)
+{
   imest_config_t cfg;
   imest_config_default(&cfg);
   cfg.pole_pairs = 2;
@@ -115,13 +121,14 @@ TEST(IsrFilter, DerivativesAreTimeAlignedCentralDifferences) {
     }
   }
   // signal: |x| ~ 2.5, |dx| ~ 113 /s, |d2x| ~ 6400 /s^2
-  EXPECT_LT(worst_x, 2e-5);   // float32 SOS rounding, ~1e-5 relative
+  EXPECT_LT(worst_x, 2e-5); // float32 SOS rounding, ~1e-5 relative
   EXPECT_LT(worst_dx, 1.5e-2);
-  EXPECT_LT(worst_d2, 40.0);  // float32 rounding of x_f times 1/T^2 = 1.6e7
+  EXPECT_LT(worst_d2, 40.0); // float32 rounding of x_f times 1/T^2 = 1.6e7
 }
 
 // The 7 regressor columns and y against docs/METHOD.md §2 written out in float64.
-TEST(IsrRegressor, MatchesMathMdFormulas) {
+TEST(IsrRegressor, MatchesMathMdFormulas)
+{
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-1, 1);
   imest_config_t cfg;
@@ -147,16 +154,26 @@ TEST(IsrRegressor, MatchesMathMdFormulas) {
     double W[2][8], y[2];
     y[0] = d2ix - n * w * diy - n * wp * iy - n * n * m * w * w * ix - dux / vs;
     y[1] = d2iy + n * w * dix + n * wp * ix - n * n * m * w * w * iy - duy / vs;
-    W[0][0] = -dix; W[1][0] = -diy;
-    W[0][1] = -dix + n * (1 + m) * w * iy + ux / vs; W[1][1] = -diy - n * (1 + m) * w * ix + uy / vs;
-    W[0][2] = m * ix; W[1][2] = m * iy;
-    W[0][3] = -ix; W[1][3] = -iy;
-    W[0][4] = n * wp * (diy - uy / vs) + n * n * (w * wp * ix - w * w * dix + w * w * ux / vs) + n * n * n * (1 + m) * w * w * w * iy;
-    W[1][4] = -n * wp * (dix - ux / vs) + n * n * (w * wp * iy - w * w * diy + w * w * uy / vs) - n * n * n * (1 + m) * w * w * w * ix;
-    W[0][5] = n * wp * iy - n * n * w * w * ix; W[1][5] = -n * wp * ix - n * n * w * w * iy;
-    W[0][6] = n * n * (w * wp * ix - w * w * dix); W[1][6] = n * n * (w * wp * iy - w * w * diy);
-    W[0][7] = n * n * (w * wp * dix - w * w * d2ix + (w * w * dux - w * wp * ux) / vs) + n * n * n * w * w * w * diy;
-    W[1][7] = n * n * (w * wp * diy - w * w * d2iy + (w * w * duy - w * wp * uy) / vs) - n * n * n * w * w * w * dix;
+    W[0][0] = -dix;
+    W[1][0] = -diy;
+    W[0][1] = -dix + n * (1 + m) * w * iy + ux / vs;
+    W[1][1] = -diy - n * (1 + m) * w * ix + uy / vs;
+    W[0][2] = m * ix;
+    W[1][2] = m * iy;
+    W[0][3] = -ix;
+    W[1][3] = -iy;
+    W[0][4] = n * wp * (diy - uy / vs) + n * n * (w * wp * ix - w * w * dix + w * w * ux / vs) +
+              n * n * n * (1 + m) * w * w * w * iy;
+    W[1][4] = -n * wp * (dix - ux / vs) + n * n * (w * wp * iy - w * w * diy + w * w * uy / vs) -
+              n * n * n * (1 + m) * w * w * w * ix;
+    W[0][5] = n * wp * iy - n * n * w * w * ix;
+    W[1][5] = -n * wp * ix - n * n * w * w * iy;
+    W[0][6] = n * n * (w * wp * ix - w * w * dix);
+    W[1][6] = n * n * (w * wp * iy - w * w * diy);
+    W[0][7] = n * n * (w * wp * dix - w * w * d2ix + (w * w * dux - w * wp * ux) / vs) +
+              n * n * n * w * w * w * diy;
+    W[1][7] = n * n * (w * wp * diy - w * w * d2iy + (w * w * duy - w * wp * uy) / vs) -
+              n * n * n * w * w * w * dix;
     const float c0[7] = {0, 0, 0, 0, 0, 0, 0};
     float zx[8], zy[8];
     isr_regressor(&s, &g, c0, zx, zy);
@@ -176,7 +193,8 @@ TEST(IsrRegressor, MatchesMathMdFormulas) {
   }
 }
 
-TEST(IsrAccumulate, FoldedBlocksEqualFloat64SumsToFewUlps) {
+TEST(IsrAccumulate, FoldedBlocksEqualFloat64SumsToFewUlps)
+{
   std::mt19937 rng(3);
   std::normal_distribution<double> N(0, 1);
   imest_window_t w = {};

@@ -27,7 +27,8 @@ static inline const char *imest_candump_property(const char *line)
   if (rc == IMEST_CANDUMP_ERROR) return (err != NULL && err[0] != '\0') ? NULL : "error without a message";
   if (rc != IMEST_CANDUMP_OK) return "unknown return code";
   if (!(isfinite(t) && t >= 0.0)) return "timestamp not finite and >= 0";
-  if (memchr(iface, '\0', sizeof iface) == NULL || iface[0] == '\0') return "interface name not terminated/empty";
+  if (memchr(iface, '\0', sizeof iface) == NULL || iface[0] == '\0')
+    return "interface name not terminated/empty";
   if (f.dlc > 8u) return "dlc > 8";
   if (f.id & IMEST_CAN_ID_EXT) {
     if ((f.id & ~IMEST_CAN_ID_EXT) > IMEST_CAN_EFF_MASK) return "extended id out of range";
@@ -39,8 +40,10 @@ static inline const char *imest_candump_property(const char *line)
   int n = imest_candump_format(buf, sizeof buf, 0.0, iface, &f);
   if (n < 0) n = imest_candump_format(buf, sizeof buf, 0.0, NULL, &f);
   if (n < 0) return "a parsed frame does not format";
-  if (imest_candump_parse(buf, NULL, NULL, &g, &err) != IMEST_CANDUMP_OK) return "formatted line does not parse";
-  if (g.id != f.id || g.dlc != f.dlc || memcmp(g.data, f.data, f.dlc) != 0) return "round trip changed the frame";
+  if (imest_candump_parse(buf, NULL, NULL, &g, &err) != IMEST_CANDUMP_OK)
+    return "formatted line does not parse";
+  if (g.id != f.id || g.dlc != f.dlc || memcmp(g.data, f.data, f.dlc) != 0)
+    return "round trip changed the frame";
   return NULL;
 }
 
@@ -54,8 +57,10 @@ static inline const char *imest_csv_property(const char *path, long max_lines)
   double v[CSV_NEED];
   if (csv_open(&r, path) != 0) {
     const char *bad = NULL;
-    if (r.err[0] == '\0') bad = "csv_open failed without a message";
-    else if (strncmp(r.err, path, strlen(path)) != 0) bad = "csv_open error does not name the file";
+    if (r.err[0] == '\0')
+      bad = "csv_open failed without a message";
+    else if (strncmp(r.err, path, strlen(path)) != 0)
+      bad = "csv_open error does not name the file";
     csv_close(&r);
     return bad;
   }
@@ -72,8 +77,10 @@ static inline const char *imest_csv_property(const char *path, long max_lines)
   }
   if (bad == NULL && rc == -1) {
     snprintf(want, sizeof want, "%s:%ld: ", path, r.line);
-    if (strncmp(r.err, want, strlen(want)) != 0) bad = "csv_next error does not start with path:line:";
-    else if (r.line < 2 || r.line > max_lines) bad = "csv_next error with a line number outside the file";
+    if (strncmp(r.err, want, strlen(want)) != 0)
+      bad = "csv_next error does not start with path:line:";
+    else if (r.line < 2 || r.line > max_lines)
+      bad = "csv_next error with a line number outside the file";
   }
   if (bad == NULL && rc != -1 && rc != 0 && rc != 1) bad = "csv_next returned an unknown code";
   csv_close(&r);

@@ -18,18 +18,19 @@ namespace rob {
 
 // What reaches imest_isr_abc for one sample; a hook may change any field.
 struct Sample {
-  long n;           // sample index since the rig started
-  int window;       // index of the window this sample belongs to
-  int pos;          // position in that window (0 .. window_n-1)
+  long n;     // sample index since the rig started
+  int window; // index of the window this sample belongs to
+  int pos;    // position in that window (0 .. window_n-1)
   float u[3], i[3];
-  float theta;      // wrapped to [0, 2 pi)
-  bool call_background = true;  // false: the background is "starved" after this sample
+  float theta;                 // wrapped to [0, 2 pi)
+  bool call_background = true; // false: the background is "starved" after this sample
 };
 using Hook = std::function<void(Sample &)>;
 
 // Every result must satisfy this, whatever the input: valid implies finite
 // numbers inside the configured bands.
-inline void expect_sane(const imest_result_t &r, const imest_config_t &cfg, const std::string &what) {
+inline void expect_sane(const imest_result_t &r, const imest_config_t &cfg, const std::string &what)
+{
   // a reported T_R (valid or not) is always a candidate from inside the band
   if (std::isfinite(r.tr_s)) {
     EXPECT_GE(r.tr_s, (double)cfg.tr_min_s) << what;
@@ -58,7 +59,7 @@ struct Rig {
   imsim_sample_t smp{};
   imest_config_t cfg{};
   imest_t est{};
-  std::vector<imest_result_t> res;  // in the order the background produced them
+  std::vector<imest_result_t> res; // in the order the background produced them
   long n = 0;
   unsigned int window_n = 0;
 
@@ -68,7 +69,8 @@ struct Rig {
   // config: the first start waits 0.83 s (filters and offset tracker), so
   // windows 0 and 1 of 0.5 s are warm-up; after a fault only the filters
   // wait (31 ms).
-  explicit Rig(float window_s = 0.5f, double load_nm = 2.064) {
+  explicit Rig(float window_s = 0.5f, double load_nm = 2.064)
+  {
     imsim_config_preset(&sc, "exp2");
     sc.start = IMSIM_START_STEADY;
     sc.thermal = false;
@@ -82,7 +84,8 @@ struct Rig {
     cfg.window_s = window_s;
   }
   // call after changing sc / cfg
-  void start() {
+  void start()
+  {
     ASSERT_EQ(imsim_init(&sim, &sc, &smp), 0) << imsim_error(&sim);
     const char *field = nullptr;
     ASSERT_EQ(imest_config_check(&cfg, &field), IMEST_OK) << (field ? field : "");
@@ -90,7 +93,8 @@ struct Rig {
     window_n = (unsigned)std::lround((double)cfg.window_s * (double)cfg.fs_hz);
   }
   // Runs `windows` more windows; every sample passes through hook (if any).
-  void run(int windows, const Hook &hook = nullptr, const std::function<void(long)> &plant = nullptr) {
+  void run(int windows, const Hook &hook = nullptr, const std::function<void(long)> &plant = nullptr)
+  {
     const long end = n + (long)windows * (long)window_n;
     for (; n < end; ++n) {
       if (plant) plant(n);
@@ -111,7 +115,8 @@ struct Rig {
       imsim_step(&sim, &smp);
     }
   }
-  void drain() {
+  void drain()
+  {
     imest_result_t r;
     while (imest_background(&est, &r) == 1) {
       expect_sane(r, cfg, "seq " + std::to_string(r.seq));
@@ -119,22 +124,26 @@ struct Rig {
     }
   }
   // result of window `seq` (nullptr if it was dropped)
-  const imest_result_t *window(uint32_t seq) const {
+  const imest_result_t *window(uint32_t seq) const
+  {
     for (const auto &r : res)
       if (r.seq == seq) return &r;
     return nullptr;
   }
-  std::string dump() const {
+  std::string dump() const
+  {
     std::string o;
     char b[200];
     for (const auto &r : res) {
-      std::snprintf(b, sizeof b, "  seq %2u %-18s valid %d tr %.5f rs %.4f used %u flags 0x%03x pe %.3g slip %.3g ei %.3g\n",
-                    r.seq, imest_reason_name(r.status), r.valid, r.tr_s, r.rs_ohm, r.used_samples, r.flags,
-                    r.pe_k2_rel, r.slip_ratio, r.e_i);
+      std::snprintf(
+          b, sizeof b,
+          "  seq %2u %-18s valid %d tr %.5f rs %.4f used %u flags 0x%03x pe %.3g slip %.3g ei %.3g\n", r.seq,
+          imest_reason_name(r.status), r.valid, r.tr_s, r.rs_ohm, r.used_samples, r.flags, r.pe_k2_rel,
+          r.slip_ratio, r.e_i);
       o += b;
     }
     return o;
   }
 };
 
-}  // namespace rob
+} // namespace rob

@@ -28,49 +28,69 @@ struct Gen {
   char from(const char *alphabet) { return alphabet[pick((int)std::strlen(alphabet))]; }
 };
 
-const char *const kTokens[] = {"nan", "-inf", "inf", "1e999", "-1e-999", "", " ", "\"1\"", ",,,", "\xEF\xBB\xBF",
-                               "\r", "\n", "\r\n", "0x1p3", "1e", "--1", "+", ".", "1,2", "\"", "\"\"", "t",
-                               "theta", "u_a", "i_c", "\t", "4.9e-324", "1.7976931348623157e308", "#", "(", ")",
-                               "123#", "12345678#", "##", "#R", "vcan0", "(0.0)", "FFFFFFFF", "1FFFFFFF"};
+const char *const kTokens[] = {"nan",       "-inf",
+                               "inf",       "1e999",
+                               "-1e-999",   "",
+                               " ",         "\"1\"",
+                               ",,,",       "\xEF\xBB\xBF",
+                               "\r",        "\n",
+                               "\r\n",      "0x1p3",
+                               "1e",        "--1",
+                               "+",         ".",
+                               "1,2",       "\"",
+                               "\"\"",      "t",
+                               "theta",     "u_a",
+                               "i_c",       "\t",
+                               "4.9e-324",  "1.7976931348623157e308",
+                               "#",         "(",
+                               ")",         "123#",
+                               "12345678#", "##",
+                               "#R",        "vcan0",
+                               "(0.0)",     "FFFFFFFF",
+                               "1FFFFFFF"};
 
 // Random edits of s: flip/insert/delete bytes, splice tokens, truncate, repeat.
-void mutate(Gen &g, std::string &s, int edits, const char *alphabet) {
+void mutate(Gen &g, std::string &s, int edits, const char *alphabet)
+{
   for (int e = 0; e < edits; ++e) {
     const size_t at = s.empty() ? 0 : (size_t)g.pick((int)s.size() + 1);
     switch (g.pick(7)) {
-      case 0:
-        if (!s.empty()) s[std::min(at, s.size() - 1)] = g.pick(4) ? g.from(alphabet) : g.any_byte();
-        break;
-      case 1: s.insert(at, 1, g.pick(4) ? g.from(alphabet) : g.any_byte()); break;
-      case 2:
-        if (!s.empty()) s.erase(std::min(at, s.size() - 1), 1 + (size_t)g.pick(4));
-        break;
-      case 3: s.insert(at, kTokens[g.pick((int)(sizeof kTokens / sizeof kTokens[0]))]); break;
-      case 4: s.resize(at); break;
-      case 5: {
-        const size_t from = at, len = (size_t)g.pick(40);
-        if (from < s.size()) s.insert((size_t)g.pick((int)s.size() + 1), s.substr(from, len));
-        break;
-      }
-      default:
-        if (g.pick(50) == 0) s.insert(at, std::string(70000 + (size_t)g.pick(1000), g.from(alphabet)));
-        break;
+    case 0:
+      if (!s.empty()) s[std::min(at, s.size() - 1)] = g.pick(4) ? g.from(alphabet) : g.any_byte();
+      break;
+    case 1: s.insert(at, 1, g.pick(4) ? g.from(alphabet) : g.any_byte()); break;
+    case 2:
+      if (!s.empty()) s.erase(std::min(at, s.size() - 1), 1 + (size_t)g.pick(4));
+      break;
+    case 3: s.insert(at, kTokens[g.pick((int)(sizeof kTokens / sizeof kTokens[0]))]); break;
+    case 4: s.resize(at); break;
+    case 5: {
+      const size_t from = at, len = (size_t)g.pick(40);
+      if (from < s.size()) s.insert((size_t)g.pick((int)s.size() + 1), s.substr(from, len));
+      break;
+    }
+    default:
+      if (g.pick(50) == 0) s.insert(at, std::string(70000 + (size_t)g.pick(1000), g.from(alphabet)));
+      break;
     }
   }
 }
 
-std::string valid_csv(Gen &g) {
+std::string valid_csv(Gen &g)
+{
   std::vector<std::string> cols = {"t", "u_a", "u_b", "u_c", "i_a", "i_b", "i_c", "theta"};
   for (int x = g.pick(3); x > 0; --x) cols.push_back(g.pick(2) ? "extra" : "\"note\"");
   std::shuffle(cols.begin(), cols.end(), g.rng);
   const char *eol = g.pick(3) ? "\n" : "\r\n";
   std::string s = g.pick(8) ? "" : "\xEF\xBB\xBF";
-  for (size_t k = 0; k < cols.size(); ++k) s += (k ? "," : "") + (g.pick(6) ? cols[k] : " \"" + cols[k] + "\" ");
+  for (size_t k = 0; k < cols.size(); ++k)
+    s += (k ? "," : "") + (g.pick(6) ? cols[k] : " \"" + cols[k] + "\" ");
   s += eol;
   for (int row = g.pick(12); row > 0; --row) {
     for (size_t k = 0; k < cols.size(); ++k) {
       char b[40];
-      std::snprintf(b, sizeof b, "%s%.6g", k ? "," : "", std::uniform_real_distribution<double>(-400, 400)(g.rng));
+      std::snprintf(b, sizeof b, "%s%.6g", k ? "," : "",
+                    std::uniform_real_distribution<double>(-400, 400)(g.rng));
       s += b;
     }
     s += eol;
@@ -78,8 +98,9 @@ std::string valid_csv(Gen &g) {
   return s;
 }
 
-std::string valid_candump(Gen &g) {
-  imest_can_frame_t f {};
+std::string valid_candump(Gen &g)
+{
+  imest_can_frame_t f{};
   f.id = g.pick(2) ? (uint32_t)g.pick(0x800) : ((uint32_t)g.rng() & IMEST_CAN_EFF_MASK) | IMEST_CAN_ID_EXT;
   f.dlc = (uint8_t)g.pick(9);
   for (unsigned k = 0; k < f.dlc; ++k) f.data[k] = (uint8_t)g.pick(256);
@@ -90,23 +111,25 @@ std::string valid_candump(Gen &g) {
   return std::string(buf) + (g.pick(2) ? "\n" : "");
 }
 
-size_t count_lines(const std::string &s) {
+size_t count_lines(const std::string &s)
+{
   size_t n = 1;
   for (char c : s) n += c == '\n';
   return n;
 }
 
-}  // namespace
+} // namespace
 
-TEST(ParsersRandom, CandumpParserOn100000Lines) {
+TEST(ParsersRandom, CandumpParserOn100000Lines)
+{
   Gen g(0xCA4D'0001);
   int ok = 0, err = 0;
   const char *alpha = "()0123456789.#ABCDEFabcdefRr \tvcan";
   for (int n = 0; n < 100000; ++n) {
     std::string line;
-    if (n % 10 == 0) {  // random bytes
+    if (n % 10 == 0) { // random bytes
       for (int k = g.pick(80); k > 0; --k) line += g.any_byte();
-    } else if (n % 10 == 1) {  // random characters of the format
+    } else if (n % 10 == 1) { // random characters of the format
       for (int k = g.pick(80); k > 0; --k) line += g.from(alpha);
     } else {
       line = valid_candump(g);
@@ -121,10 +144,11 @@ TEST(ParsersRandom, CandumpParserOn100000Lines) {
     ok += imest_candump_parse(line.c_str(), nullptr, nullptr, &f, nullptr) == IMEST_CANDUMP_OK;
   }
   std::printf("[ parsers  ] candump: 100000 lines, %d parsed as frames\n", ok);
-  EXPECT_GT(ok, 10000);  // the mutations keep many lines valid: the frame branch is exercised
+  EXPECT_GT(ok, 10000); // the mutations keep many lines valid: the frame branch is exercised
 }
 
-TEST(ParsersRandom, CsvReaderOn3000Files) {
+TEST(ParsersRandom, CsvReaderOn3000Files)
+{
   char path[] = "/tmp/imest_csv_random_XXXXXX";
   const int fd = mkstemp(path);
   ASSERT_GE(fd, 0);

@@ -25,20 +25,22 @@ using namespace rob;
 
 namespace {
 
-constexpr double kTolRel = 0.01;  // 1 %: window-to-window spread of T_R here is ~0.2 %
-constexpr int kMaxRecovery = 2;   // windows after the one in which the fault ends
+constexpr double kTolRel = 0.01; // 1 %: window-to-window spread of T_R here is ~0.2 %
+constexpr int kMaxRecovery = 2;  // windows after the one in which the fault ends
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
 const float kInf = std::numeric_limits<float>::infinity();
-const float kDenorm = 1.0e-40f;  // subnormal float32
+const float kDenorm = 1.0e-40f; // subnormal float32
 constexpr float k2Pi = 6.2831853f;
 
-float wrap(float th) {
+float wrap(float th)
+{
   th = std::fmod(th, k2Pi);
   return th < 0 ? th + k2Pi : th;
 }
 
 // Mean T_R of the valid windows in [first, last].
-double mean_tr(const Rig &r, uint32_t first, uint32_t last) {
+double mean_tr(const Rig &r, uint32_t first, uint32_t last)
+{
   double s = 0;
   int n = 0;
   for (const auto &w : r.res)
@@ -56,14 +58,17 @@ double mean_tr(const Rig &r, uint32_t first, uint32_t last) {
 // strict = false: only the first recovery is checked, not that every later
 // window is valid (see DISABLED_IfocLoadedSteadyStateEveryWindowValid).
 int check_fault(const Rig &r, const char *name, uint32_t fault_first, uint32_t fault_last, int expect,
-                double pre_tr, bool strict = true) {
+                double pre_tr, bool strict = true)
+{
   SCOPED_TRACE(name);
   EXPECT_TRUE(std::isfinite(pre_tr)) << r.dump();
   for (uint32_t k = fault_first; k <= fault_last; ++k) {
     const imest_result_t *w = r.window(k);
-    if (w == nullptr) continue;  // dropped (overrun)
+    if (w == nullptr) continue; // dropped (overrun)
     EXPECT_FALSE(w->valid) << "window " << k << "\n" << r.dump();
-    if (expect != 0) EXPECT_EQ(w->status, expect) << "window " << k << " is " << imest_reason_name(w->status) << "\n" << r.dump();
+    if (expect != 0)
+      EXPECT_EQ(w->status, expect) << "window " << k << " is " << imest_reason_name(w->status) << "\n"
+                                   << r.dump();
   }
   int recovery = -1;
   double tr_after = std::nan("");
@@ -76,29 +81,38 @@ int check_fault(const Rig &r, const char *name, uint32_t fault_first, uint32_t f
     }
     if (strict && after >= kMaxRecovery) {
       EXPECT_TRUE(w.valid) << "window " << w.seq << " (" << after << " after the fault) is "
-                           << imest_reason_name(w.status) << "\n" << r.dump();
+                           << imest_reason_name(w.status) << "\n"
+                           << r.dump();
     }
     if (w.valid) EXPECT_NEAR(w.tr_s, pre_tr, kTolRel * pre_tr) << "window " << w.seq << "\n" << r.dump();
   }
   EXPECT_GE(recovery, 1) << r.dump();
   EXPECT_LE(recovery, kMaxRecovery) << r.dump();
   std::printf("[ robust   ] %-44s status %-17s recovery %d window(s), T_R %.5f -> %.5f s\n", name,
-              r.window(fault_first) ? imest_reason_name(r.window(fault_first)->status) : "(dropped)", recovery,
-              pre_tr, tr_after);
+              r.window(fault_first) ? imest_reason_name(r.window(fault_first)->status) : "(dropped)",
+              recovery, pre_tr, tr_after);
   return recovery;
 }
 
 enum Chan { kCurrent, kVoltage, kAngle };
-const char *chan_name(Chan c) { return c == kCurrent ? "current" : c == kVoltage ? "voltage" : "angle"; }
-void put(Sample &s, Chan c, float v) {
-  if (c == kCurrent) s.i[1] = v;
-  else if (c == kVoltage) s.u[2] = v;
-  else s.theta = v;
+const char *chan_name(Chan c)
+{
+  return c == kCurrent ? "current" : c == kVoltage ? "voltage" : "angle";
+}
+void put(Sample &s, Chan c, float v)
+{
+  if (c == kCurrent)
+    s.i[1] = v;
+  else if (c == kVoltage)
+    s.u[2] = v;
+  else
+    s.theta = v;
 }
 
 // Three clean windows, then a burst of `len` corrupted samples starting at
 // position `pos` of window 3, then clean windows up to window 8.
-void bad_value_case(Chan c, float v, int expect, int pos = 700, int len = 3) {
+void bad_value_case(Chan c, float v, int expect, int pos = 700, int len = 3)
+{
   Rig r;
   r.start();
   r.run(3);
@@ -117,17 +131,19 @@ void bad_value_case(Chan c, float v, int expect, int pos = 700, int len = 3) {
   if (expect != 0) EXPECT_LT(w->used_samples, r.window_n);
 }
 
-}  // namespace
+} // namespace
 
 // ---------------------------------------------------------------------------
 // NaN, Inf, huge values: input fault
 
-TEST(RobustInput, NonFiniteSamplesAreInputFaults) {
+TEST(RobustInput, NonFiniteSamplesAreInputFaults)
+{
   for (Chan c : {kCurrent, kVoltage, kAngle})
     for (float v : {kNaN, kInf, -kInf}) bad_value_case(c, v, IMEST_REASON_INPUT_FAULT);
 }
 
-TEST(RobustInput, HugeSamplesAreInputFaults) {
+TEST(RobustInput, HugeSamplesAreInputFaults)
+{
   // beyond i_absurd_a (1e4) / u_absurd_v (1e5) / the 1e8 rad angle bound
   for (float v : {1.0e30f, FLT_MAX, -FLT_MAX, 1.5e4f}) bad_value_case(kCurrent, v, IMEST_REASON_INPUT_FAULT);
   for (float v : {1.0e30f, FLT_MAX, -2.0e5f}) bad_value_case(kVoltage, v, IMEST_REASON_INPUT_FAULT);
@@ -137,7 +153,8 @@ TEST(RobustInput, HugeSamplesAreInputFaults) {
 // A single-sample spike below the absurd limits cannot be told from a real
 // sample; it corrupts its window, which must then be invalid (the solve's
 // quality indices catch it), and the next window is clean.
-TEST(RobustInput, PlausibleSpikeInvalidatesOnlyItsWindow) {
+TEST(RobustInput, PlausibleSpikeInvalidatesOnlyItsWindow)
+{
   for (float v : {20.0f, 1000.0f, 9999.0f}) bad_value_case(kCurrent, v, 0, 700, 1);
   for (float v : {1000.0f, 9.0e4f}) bad_value_case(kVoltage, v, 0, 700, 1);
 }
@@ -147,7 +164,8 @@ TEST(RobustInput, PlausibleSpikeInvalidatesOnlyItsWindow) {
 // warm-up (30 ms) that window may still be valid; with a warm-up longer than
 // half a window (here 0.3 s of 0.5 s) it is invalid as warmup, and the one
 // after is valid.
-TEST(RobustInput, FaultAtWindowEndSpillsWarmupIntoNextWindow) {
+TEST(RobustInput, FaultAtWindowEndSpillsWarmupIntoNextWindow)
+{
   for (float warmup_s : {0.0f, 0.3f}) {
     SCOPED_TRACE(warmup_s);
     Rig r;
@@ -162,8 +180,9 @@ TEST(RobustInput, FaultAtWindowEndSpillsWarmupIntoNextWindow) {
     ASSERT_NE(w4, nullptr);
     EXPECT_TRUE(w4->flags & IMEST_FLAG_WARMUP) << r.dump();
     EXPECT_LT(w4->used_samples, r.window_n);
-    const int rec = check_fault(r, warmup_s > 0 ? "NaN at window end, warm-up 0.3 s" : "NaN at window end, default warm-up",
-                                3, 3, IMEST_REASON_INPUT_FAULT, pre);
+    const int rec = check_fault(
+        r, warmup_s > 0 ? "NaN at window end, warm-up 0.3 s" : "NaN at window end, default warm-up", 3, 3,
+        IMEST_REASON_INPUT_FAULT, pre);
     if (warmup_s > 0) {
       EXPECT_EQ(w4->status, IMEST_REASON_WARMUP) << r.dump();
       EXPECT_EQ(rec, 2);
@@ -172,7 +191,8 @@ TEST(RobustInput, FaultAtWindowEndSpillsWarmupIntoNextWindow) {
 }
 
 // A fault lasting longer than a window: every window it touches is invalid.
-TEST(RobustInput, LongFaultBurstOverSeveralWindows) {
+TEST(RobustInput, LongFaultBurstOverSeveralWindows)
+{
   Rig r;
   r.start();
   r.run(3);
@@ -189,7 +209,8 @@ TEST(RobustInput, LongFaultBurstOverSeveralWindows) {
 // ---------------------------------------------------------------------------
 // Denormals
 
-TEST(RobustDenormal, DenormalCurrentsAndVoltagesAreNoCurrent) {
+TEST(RobustDenormal, DenormalCurrentsAndVoltagesAreNoCurrent)
+{
   Rig r;
   r.start();
   r.run(3);
@@ -220,7 +241,8 @@ TEST(RobustDenormal, DenormalCurrentsAndVoltagesAreNoCurrent) {
 
 // A denormal angle is the angle 0: replacing every exact 0 of the encoder by a
 // denormal changes nothing.
-TEST(RobustDenormal, DenormalAngleIsZero) {
+TEST(RobustDenormal, DenormalAngleIsZero)
+{
   Rig a, b;
   a.start();
   b.start();
@@ -252,7 +274,7 @@ TEST(RobustDenormal, DenormalAngleIsZero) {
   });
   for (const auto &w : c.res) {
     EXPECT_FALSE(w.flags & (IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ENCODER_FAULT));
-    if (w.seq > 1) EXPECT_EQ(w.status, IMEST_REASON_STANDSTILL) << c.dump();  // 0, 1: first-start warm-up
+    if (w.seq > 1) EXPECT_EQ(w.status, IMEST_REASON_STANDSTILL) << c.dump(); // 0, 1: first-start warm-up
   }
 }
 
@@ -262,7 +284,8 @@ TEST(RobustDenormal, DenormalAngleIsZero) {
 // Current: the sensor range is 3 A (rated-load phase peak 2.3 A); a 1 s
 // overload at 1.6x rated torque drives the current into the ADC limit. The
 // simulator clips exactly like the ADC (top code), and i_limit_a is that code.
-TEST(RobustSaturation, CurrentClippedByTheAdcDuringAnOverload) {
+TEST(RobustSaturation, CurrentClippedByTheAdcDuringAnOverload)
+{
   Rig r;
   r.sc.i_range_a = 3.0;
   const double lsb = 2.0 * r.sc.i_range_a / 4096.0;
@@ -272,22 +295,25 @@ TEST(RobustSaturation, CurrentClippedByTheAdcDuringAnOverload) {
   const double pre = mean_tr(r, 1, 2);
   const long on = 3L * r.window_n + 500, off = on + 4000;
   long clipped = 0;
-  r.run(7, [&](Sample &s) {
-                for (int k = 0; k < 3; ++k) clipped += std::fabs(s.i[k]) >= r.cfg.i_limit_a;
-              },
-        [&](long n) {
-          if (n == on) imsim_set_load(&r.sim, 1.6 * 2.064);
-          if (n == off) imsim_set_load(&r.sim, 2.064);
-        });
+  r.run(
+      7,
+      [&](Sample &s) {
+        for (int k = 0; k < 3; ++k) clipped += std::fabs(s.i[k]) >= r.cfg.i_limit_a;
+      },
+      [&](long n) {
+        if (n == on) imsim_set_load(&r.sim, 1.6 * 2.064);
+        if (n == off) imsim_set_load(&r.sim, 2.064);
+      });
   EXPECT_GT(clipped, 100);
   // the overload samples end at window 5 (position 500): windows 3..5 clip
   check_fault(r, "current ADC clipped (1 s overload)", 3, 5, IMEST_REASON_ADC_SATURATION, pre);
 }
 
 // Voltage: a sensor offset burst pushes the voltage channel into its limit.
-TEST(RobustSaturation, VoltageClippedAtTheLimit) {
+TEST(RobustSaturation, VoltageClippedAtTheLimit)
+{
   Rig r;
-  r.cfg.u_limit_v = 120.0f;  // phase peak of exp2 is ~94 V
+  r.cfg.u_limit_v = 120.0f; // phase peak of exp2 is ~94 V
   r.start();
   r.run(3);
   const double pre = mean_tr(r, 1, 2);
@@ -300,7 +326,8 @@ TEST(RobustSaturation, VoltageClippedAtTheLimit) {
 // ---------------------------------------------------------------------------
 // Encoder
 
-TEST(RobustEncoder, GlitchBurstIsAnEncoderFault) {
+TEST(RobustEncoder, GlitchBurstIsAnEncoderFault)
+{
   // 1000 wrong counts (1.53 rad) for 3 samples, then the right angle again
   Rig r;
   r.start();
@@ -312,7 +339,8 @@ TEST(RobustEncoder, GlitchBurstIsAnEncoderFault) {
   check_fault(r, "encoder glitch 1000 counts x3", 3, 3, IMEST_REASON_ENCODER_FAULT, pre);
 }
 
-TEST(RobustEncoder, OffsetJumpIsAnEncoderFaultThenSameEstimate) {
+TEST(RobustEncoder, OffsetJumpIsAnEncoderFaultThenSameEstimate)
+{
   // the angle jumps by 1 rad and keeps the offset (lost index pulse): the
   // model is rotation invariant, so T_R after the jump equals T_R before
   Rig r;
@@ -325,7 +353,8 @@ TEST(RobustEncoder, OffsetJumpIsAnEncoderFaultThenSameEstimate) {
   check_fault(r, "encoder offset jump 1 rad", 3, 3, IMEST_REASON_ENCODER_FAULT, pre);
 }
 
-TEST(RobustEncoder, SubThresholdGlitchInvalidatesOnlyItsWindow) {
+TEST(RobustEncoder, SubThresholdGlitchInvalidatesOnlyItsWindow)
+{
   // 400 counts (0.61 rad) in one sample: 2450 rad/s, below the 3000 rad/s
   // speed limit, so not detectable per sample; the window must not be valid
   Rig r;
@@ -338,7 +367,8 @@ TEST(RobustEncoder, SubThresholdGlitchInvalidatesOnlyItsWindow) {
   check_fault(r, "encoder glitch 400 counts x1 (undetectable)", 3, 3, 0, pre);
 }
 
-TEST(RobustEncoder, OneCountGlitchesDoNotMatter) {
+TEST(RobustEncoder, OneCountGlitchesDoNotMatter)
+{
   // an encoder that bounces by +-1 count now and then stays valid
   Rig r;
   r.start();
@@ -360,7 +390,8 @@ TEST(RobustEncoder, OneCountGlitchesDoNotMatter) {
 // DC at standstill (supply at 0 Hz, line-line voltage vll_v): no rotor
 // currents, every window after the first-start warm-up (windows 0, 1) is
 // standstill.
-static void expect_standstill_with_dc(double vll_v) {
+static void expect_standstill_with_dc(double vll_v)
+{
   Rig r;
   r.sc.freq_hz = 0.0;
   r.sc.vll_v = vll_v;
@@ -374,17 +405,24 @@ static void expect_standstill_with_dc(double vll_v) {
 }
 
 // DC magnetisation at standstill: i_rms ~4 A.
-TEST(RobustCondition, StandstillWithDcExcitation) { expect_standstill_with_dc(20.0); }
+TEST(RobustCondition, StandstillWithDcExcitation)
+{
+  expect_standstill_with_dc(20.0);
+}
 
 // DC at the magnetising current of this motor (i_rms ~2 A, 12-bit sensors):
 // the old slip measure (rms current rate) read ~0.07 from noise alone and the
 // window came out no_root; the rotation-rate measure reads ~0 -> standstill.
-TEST(RobustCondition, StandstillAtMagnetisingCurrent) { expect_standstill_with_dc(10.0); }
+TEST(RobustCondition, StandstillAtMagnetisingCurrent)
+{
+  expect_standstill_with_dc(10.0);
+}
 
 // Field-oriented drive magnetised at rest (speed reference 0): the encoder
 // dithers by one count, then the drive accelerates to 850 rpm with rated
 // load: valid within 2 windows.
-TEST(RobustCondition, StandstillThenRunUnderIfoc) {
+TEST(RobustCondition, StandstillThenRunUnderIfoc)
+{
   Rig ref;
   ref.start();
   ref.run(3);
@@ -413,7 +451,8 @@ TEST(RobustCondition, StandstillThenRunUnderIfoc) {
 // then reported poorly_determined: never a wrong valid result, but lost
 // windows. The V/f supply at the same operating point loses none (40 of 40
 // valid). Enable when the selection prefers the well-determined minimum.
-TEST(RobustCondition, IfocLoadedSteadyStateEveryWindowValid) {
+TEST(RobustCondition, IfocLoadedSteadyStateEveryWindowValid)
+{
   Rig r;
   r.sc.supply = IMSIM_SUPPLY_IFOC;
   r.sc.start = IMSIM_START_REST;
@@ -429,7 +468,8 @@ TEST(RobustCondition, IfocLoadedSteadyStateEveryWindowValid) {
 // At rest under IFOC the encoder toggles by one count (1.5 mrad = 6 rad/s for
 // one sample); the standstill test uses the window's mean speed, in which
 // that averages to zero (an rms speed measure called it zero_slip).
-TEST(RobustCondition, IfocAtRestIsStandstill) {
+TEST(RobustCondition, IfocAtRestIsStandstill)
+{
   Rig r;
   r.sc.supply = IMSIM_SUPPLY_IFOC;
   r.sc.start = IMSIM_START_REST;
@@ -444,7 +484,8 @@ TEST(RobustCondition, IfocAtRestIsStandstill) {
 
 // Drive disabled for 2 s: zero voltage, the current sensors read ADC noise
 // around 0, the rotor coasts; then re-enabled.
-TEST(RobustCondition, NoCurrentThenReenabled) {
+TEST(RobustCondition, NoCurrentThenReenabled)
+{
   Rig r;
   r.start();
   r.run(3);
@@ -468,7 +509,8 @@ TEST(RobustCondition, NoCurrentThenReenabled) {
 }
 
 // No load at constant speed: slip ~0, T_R unobservable; then rated load.
-TEST(RobustCondition, ZeroSlipThenLoad) {
+TEST(RobustCondition, ZeroSlipThenLoad)
+{
   Rig ref;
   ref.start();
   ref.run(3);
@@ -485,7 +527,8 @@ TEST(RobustCondition, ZeroSlipThenLoad) {
 // ---------------------------------------------------------------------------
 // Overrun: the background does not run for 3 windows
 
-TEST(RobustOverrun, StarvedBackgroundDropsWindowsAndRecovers) {
+TEST(RobustOverrun, StarvedBackgroundDropsWindowsAndRecovers)
+{
   Rig r;
   r.start();
   r.run(3);
@@ -508,7 +551,8 @@ TEST(RobustOverrun, StarvedBackgroundDropsWindowsAndRecovers) {
 // ---------------------------------------------------------------------------
 // Band: never a valid T_R outside [tr_min_s, tr_max_s] (T_R here is 0.119 s)
 
-TEST(RobustBand, NoValidResultOutsideTheTrBand) {
+TEST(RobustBand, NoValidResultOutsideTheTrBand)
+{
   for (auto band : {std::pair<float, float>{0.13f, 10.0f}, std::pair<float, float>{1e-3f, 0.11f}}) {
     Rig r;
     r.cfg.tr_min_s = band.first;
@@ -522,7 +566,8 @@ TEST(RobustBand, NoValidResultOutsideTheTrBand) {
     for (const auto &w : r.res) {
       EXPECT_FALSE(w.valid) << r.dump();
       if (!(w.flags & IMEST_FLAG_WARMUP)) {
-        EXPECT_TRUE(w.status == IMEST_REASON_NO_ROOT || w.status == IMEST_REASON_POORLY_DETERMINED) << r.dump();
+        EXPECT_TRUE(w.status == IMEST_REASON_NO_ROOT || w.status == IMEST_REASON_POORLY_DETERMINED)
+            << r.dump();
       }
     }
   }
@@ -533,7 +578,8 @@ TEST(RobustBand, NoValidResultOutsideTheTrBand) {
 // an arbitrary value (NaN, Inf, huge, denormal, random) in a random channel.
 // Every result is checked by expect_sane; afterwards the estimator recovers.
 
-TEST(RobustStorm, RandomFaultsNeverGiveAWrongValidResult) {
+TEST(RobustStorm, RandomFaultsNeverGiveAWrongValidResult)
+{
   for (unsigned seed : {1u, 2u, 3u}) {
     SCOPED_TRACE(seed);
     Rig r;
@@ -542,15 +588,19 @@ TEST(RobustStorm, RandomFaultsNeverGiveAWrongValidResult) {
     const double pre = mean_tr(r, 1, 2);
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> uni(0.0f, 1.0f);
-    const float specials[] = {kNaN, kInf, -kInf, FLT_MAX, -FLT_MAX, 1e30f, kDenorm, -kDenorm, 0.0f, 1e4f, -1e5f, 1e8f};
+    const float specials[] = {kNaN,    kInf,     -kInf, FLT_MAX, -FLT_MAX, 1e30f,
+                              kDenorm, -kDenorm, 0.0f,  1e4f,    -1e5f,    1e8f};
     r.run(13, [&](Sample &s) {
       if (s.window < 3 || s.window > 12 || uni(rng) >= 0.01f) return;
       const int which = (int)(uni(rng) * 7.0f);
       float v = uni(rng) < 0.5f ? specials[(int)(uni(rng) * 12.0f) % 12]
                                 : (uni(rng) - 0.5f) * std::pow(10.0f, uni(rng) * 12.0f - 3.0f);
-      if (which < 3) s.i[which] = v;
-      else if (which < 6) s.u[which - 3] = v;
-      else s.theta = v;
+      if (which < 3)
+        s.i[which] = v;
+      else if (which < 6)
+        s.u[which - 3] = v;
+      else
+        s.theta = v;
     });
     check_fault(r, "random fault storm", 3, 12, 0, pre);
   }
@@ -563,7 +613,8 @@ TEST(RobustStorm, RandomFaultsNeverGiveAWrongValidResult) {
 // and 1 V on the voltages: without the offset high-pass R_S comes out about
 // 20 % high in windows that look valid; with it (the default) every window
 // after the first-start warm-up is within the steady-state accuracy.
-TEST(RobustSensor, OffsetsAreRemovedByDefault) {
+TEST(RobustSensor, OffsetsAreRemovedByDefault)
+{
   for (float hz : {1.0f, 0.0f}) {
     SCOPED_TRACE(hz);
     Rig r;
@@ -579,7 +630,7 @@ TEST(RobustSensor, OffsetsAreRemovedByDefault) {
     double worst_rs = 0, worst_tr = 0;
     int valid = 0;
     for (const auto &w : r.res) {
-      if (w.seq <= 1 || !w.valid) continue;  // 0, 1: first-start warm-up
+      if (w.seq <= 1 || !w.valid) continue; // 0, 1: first-start warm-up
       ++valid;
       worst_tr = std::max(worst_tr, std::fabs(w.tr_s / 0.12 - 1));
       worst_rs = std::max(worst_rs, std::fabs(w.rs_ohm / 5.04 - 1));
@@ -589,7 +640,7 @@ TEST(RobustSensor, OffsetsAreRemovedByDefault) {
       EXPECT_LT(worst_tr, 0.005) << r.dump();
       EXPECT_LT(worst_rs, 0.01) << r.dump();
     } else {
-      EXPECT_GT(worst_rs, 0.05) << r.dump();  // what the default protects against
+      EXPECT_GT(worst_rs, 0.05) << r.dump(); // what the default protects against
     }
   }
 }

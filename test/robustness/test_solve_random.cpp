@@ -22,7 +22,7 @@ extern "C" {
 
 namespace {
 
-constexpr double kM = 0.6237;  // M*beta of the paper's motor (any positive value will do)
+constexpr double kM = 0.6237; // M*beta of the paper's motor (any positive value will do)
 
 struct Gen {
   std::mt19937_64 rng;
@@ -30,24 +30,39 @@ struct Gen {
   double uni(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); }
   int pick(int n) { return (int)(rng() % (uint64_t)n); }
   double gauss() { return std::normal_distribution<double>(0.0, 1.0)(rng); }
-  double bits() {
+  double bits()
+  {
     const uint64_t u = rng();
     double d;
     std::memcpy(&d, &u, sizeof d);
     return d;
   }
-  double special() {
+  double special()
+  {
     static const double v[] = {std::numeric_limits<double>::quiet_NaN(),
                                -std::numeric_limits<double>::quiet_NaN(),
                                std::numeric_limits<double>::infinity(),
                                -std::numeric_limits<double>::infinity(),
-                               0.0, -0.0, 4.9e-324, -4.9e-324, 2.2e-308, DBL_MAX, -DBL_MAX, 1e300, -1e300,
-                               1e-300, 1.0, -1.0, 1e30, 1e-30};
+                               0.0,
+                               -0.0,
+                               4.9e-324,
+                               -4.9e-324,
+                               2.2e-308,
+                               DBL_MAX,
+                               -DBL_MAX,
+                               1e300,
+                               -1e300,
+                               1e-300,
+                               1.0,
+                               -1.0,
+                               1e30,
+                               1e-30};
     return v[pick((int)(sizeof v / sizeof v[0]))];
   }
 };
 
-void kvec(double k1, double k2, double K[8]) {
+void kvec(double k1, double k2, double K[8])
+{
   K[0] = k1;
   K[1] = k2;
   K[2] = k2 * k2;
@@ -61,7 +76,8 @@ void kvec(double k1, double k2, double K[8]) {
 // R_W, R_Wy, R_y from `rows` random rows of W (column 2 = -m column 3, as the
 // solve expects), y = W K(k1, k2) + noise. rank < 8: W built from that many
 // random directions only.
-bg_sums_t structured(Gen &g, int rows, int rank, double noise, double m) {
+bg_sums_t structured(Gen &g, int rows, int rank, double noise, double m)
+{
   bg_sums_t s{};
   double colscale[8], basis[8][8];
   for (int j = 0; j < 8; ++j) colscale[j] = std::pow(10.0, g.uni(-3, 3));
@@ -90,13 +106,15 @@ bg_sums_t structured(Gen &g, int rows, int rank, double noise, double m) {
   return s;
 }
 
-double *entry(bg_sums_t &s, int k) {  // 0..72
+double *entry(bg_sums_t &s, int k)
+{ // 0..72
   if (k < 64) return &s.rw[k / 8][k % 8];
   if (k < 72) return &s.rwy[k - 64];
   return &s.ry;
 }
 
-bg_solve_cfg_t default_cfg() {
+bg_solve_cfg_t default_cfg()
+{
   bg_solve_cfg_t c{};
   c.sigma = 0.096;
   c.ls_h = 0.2908;
@@ -106,23 +124,30 @@ bg_solve_cfg_t default_cfg() {
   return c;
 }
 
-std::string hexdump(const bg_sums_t &s, const bg_solve_cfg_t &c) {
+std::string hexdump(const bg_sums_t &s, const bg_solve_cfg_t &c)
+{
   std::string o;
   char b[64];
   const double *p = &s.rw[0][0];
   for (int k = 0; k < 73; ++k) {
-    std::snprintf(b, sizeof b, "%a%s", k < 64 ? p[k] : k < 72 ? s.rwy[k - 64] : s.ry, k % 8 == 7 ? "\n" : " ");
+    std::snprintf(b, sizeof b, "%a%s",
+                  k < 64   ? p[k]
+                  : k < 72 ? s.rwy[k - 64]
+                           : s.ry,
+                  k % 8 == 7 ? "\n" : " ");
     o += b;
   }
-  std::snprintf(b, sizeof b, "\ncfg %a %a %a %a %a\n", c.sigma, c.ls_h, c.tr_nominal_s, c.tr_min_s, c.tr_max_s);
+  std::snprintf(b, sizeof b, "\ncfg %a %a %a %a %a\n", c.sigma, c.ls_h, c.tr_nominal_s, c.tr_min_s,
+                c.tr_max_s);
   return o + b;
 }
 
-}  // namespace
+} // namespace
 
-TEST(SolveRandom, PropertyHoldsOn20000SeededCases) {
+TEST(SolveRandom, PropertyHoldsOn20000SeededCases)
+{
 #if defined(__SANITIZE_ADDRESS__)
-  const int kCases = 6000;  // same generator, fewer cases under ASan
+  const int kCases = 6000; // same generator, fewer cases under ASan
 #else
   const int kCases = 20000;
 #endif
@@ -134,51 +159,51 @@ TEST(SolveRandom, PropertyHoldsOn20000SeededCases) {
     bg_solve_cfg_t cfg = default_cfg();
     const int kind = n % 8;
     switch (kind) {
-      case 0:  // raw bit patterns
-        for (int k = 0; k < 73; ++k) *entry(s, k) = g.bits();
-        break;
-      case 1:  // special values everywhere
-        for (int k = 0; k < 73; ++k) *entry(s, k) = g.pick(3) ? g.special() : g.gauss();
-        break;
-      case 2:  // structured, full rank, noise from 1e-8 to 1
-        s = structured(g, 8 + g.pick(200), 8, std::pow(10.0, g.uni(-8, 0)), kM);
-        break;
-      case 3:  // rank deficient (also zero rows: rank 0)
-        s = structured(g, 1 + g.pick(100), g.pick(8), std::pow(10.0, g.uni(-8, 0)), kM);
-        break;
-      case 4: {  // scaled by 1e+-30 (and beyond, to overflow)
-        s = structured(g, 8 + g.pick(50), 8, 1e-3, kM);
-        const double f = std::pow(10.0, g.uni(-300, 300) * (g.pick(2) ? 0.1 : 1.0));
-        for (int k = 0; k < 73; ++k) *entry(s, k) *= f;
-        break;
-      }
-      case 5: {  // sign flips: of single entries, of R_W, of R_y
-        s = structured(g, 8 + g.pick(50), 8, 1e-3, kM);
-        const int how = g.pick(3);
-        if (how == 0)
-          for (int t = 1 + g.pick(4); t > 0; --t) *entry(s, g.pick(73)) *= -1;
-        else if (how == 1)
-          for (int k = 0; k < 64; ++k) *entry(s, k) *= -1;
-        else
-          s.ry = -s.ry;
-        break;
-      }
-      case 6:  // one or two entries poisoned
-        s = structured(g, 8 + g.pick(50), 8, 1e-3, kM);
-        for (int t = 1 + g.pick(2); t > 0; --t) *entry(s, g.pick(73)) = g.pick(2) ? g.special() : g.bits();
-        break;
-      default: {  // random motor constants, band and m (some invalid)
-        s = structured(g, 8 + g.pick(50), g.pick(4) ? 8 : 6, 1e-4, g.pick(5) ? g.uni(0, 5) : g.special());
-        cfg.sigma = g.pick(8) ? g.uni(0.0, 1.0) : g.special();
-        cfg.ls_h = g.pick(8) ? std::pow(10.0, g.uni(-4, 1)) : g.special();
-        cfg.tr_nominal_s = g.pick(8) ? std::pow(10.0, g.uni(-4, 2)) : g.special();
-        cfg.tr_min_s = g.pick(8) ? std::pow(10.0, g.uni(-5, 0)) : g.special();
-        cfg.tr_max_s = g.pick(8) ? cfg.tr_min_s * std::pow(10.0, g.uni(-1, 5)) : g.special();
-        break;
-      }
+    case 0: // raw bit patterns
+      for (int k = 0; k < 73; ++k) *entry(s, k) = g.bits();
+      break;
+    case 1: // special values everywhere
+      for (int k = 0; k < 73; ++k) *entry(s, k) = g.pick(3) ? g.special() : g.gauss();
+      break;
+    case 2: // structured, full rank, noise from 1e-8 to 1
+      s = structured(g, 8 + g.pick(200), 8, std::pow(10.0, g.uni(-8, 0)), kM);
+      break;
+    case 3: // rank deficient (also zero rows: rank 0)
+      s = structured(g, 1 + g.pick(100), g.pick(8), std::pow(10.0, g.uni(-8, 0)), kM);
+      break;
+    case 4: { // scaled by 1e+-30 (and beyond, to overflow)
+      s = structured(g, 8 + g.pick(50), 8, 1e-3, kM);
+      const double f = std::pow(10.0, g.uni(-300, 300) * (g.pick(2) ? 0.1 : 1.0));
+      for (int k = 0; k < 73; ++k) *entry(s, k) *= f;
+      break;
+    }
+    case 5: { // sign flips: of single entries, of R_W, of R_y
+      s = structured(g, 8 + g.pick(50), 8, 1e-3, kM);
+      const int how = g.pick(3);
+      if (how == 0)
+        for (int t = 1 + g.pick(4); t > 0; --t) *entry(s, g.pick(73)) *= -1;
+      else if (how == 1)
+        for (int k = 0; k < 64; ++k) *entry(s, k) *= -1;
+      else
+        s.ry = -s.ry;
+      break;
+    }
+    case 6: // one or two entries poisoned
+      s = structured(g, 8 + g.pick(50), 8, 1e-3, kM);
+      for (int t = 1 + g.pick(2); t > 0; --t) *entry(s, g.pick(73)) = g.pick(2) ? g.special() : g.bits();
+      break;
+    default: { // random motor constants, band and m (some invalid)
+      s = structured(g, 8 + g.pick(50), g.pick(4) ? 8 : 6, 1e-4, g.pick(5) ? g.uni(0, 5) : g.special());
+      cfg.sigma = g.pick(8) ? g.uni(0.0, 1.0) : g.special();
+      cfg.ls_h = g.pick(8) ? std::pow(10.0, g.uni(-4, 1)) : g.special();
+      cfg.tr_nominal_s = g.pick(8) ? std::pow(10.0, g.uni(-4, 2)) : g.special();
+      cfg.tr_min_s = g.pick(8) ? std::pow(10.0, g.uni(-5, 0)) : g.special();
+      cfg.tr_max_s = g.pick(8) ? cfg.tr_min_s * std::pow(10.0, g.uni(-1, 5)) : g.special();
+      break;
+    }
     }
     bg_solve_out_t out;
-    std::memset(&out, 0xA5, sizeof out);  // garbage in: the solve must set what it reports
+    std::memset(&out, 0xA5, sizeof out); // garbage in: the solve must set what it reports
     const int rc = bg_solve(&s, &cfg, &out);
     const char *bad = solve_property(rc, &cfg, &out);
     if (rc >= 0 && rc < 32) by_status[rc]++;
@@ -186,7 +211,8 @@ TEST(SolveRandom, PropertyHoldsOn20000SeededCases) {
     if (bad != nullptr) {
       ++failures;
       ADD_FAILURE() << "case " << n << " (kind " << kind << "): " << bad << " (status " << rc << ", tr "
-                    << out.tr_s << ")\n" << hexdump(s, cfg);
+                    << out.tr_s << ")\n"
+                    << hexdump(s, cfg);
     }
   }
   std::printf("[ solve    ] %d cases: ok %d, numeric %d, no_root %d, config %d; most work %u of %u\n", kCases,
@@ -197,7 +223,8 @@ TEST(SolveRandom, PropertyHoldsOn20000SeededCases) {
 }
 
 // NULL arguments: an error status, no crash.
-TEST(SolveRandom, NullArguments) {
+TEST(SolveRandom, NullArguments)
+{
   bg_sums_t s{};
   bg_solve_cfg_t cfg = default_cfg();
   bg_solve_out_t out;

@@ -16,7 +16,8 @@
 #include "imsim_cli.h"
 
 namespace {
-int parse(std::vector<std::string> in, imsim_config_t &c, imsim_cli_opts_t &o, std::string *err = nullptr) {
+int parse(std::vector<std::string> in, imsim_config_t &c, imsim_cli_opts_t &o, std::string *err = nullptr)
+{
   // the parsed options point into argv (as with a real main): keep it alive
   static std::vector<std::string> args;
   args = std::move(in);
@@ -28,14 +29,16 @@ int parse(std::vector<std::string> in, imsim_config_t &c, imsim_cli_opts_t &o, s
   if (err) *err = e;
   return r;
 }
-}  // namespace
+} // namespace
 
-TEST(SimCli, FlagsSetTheConfig) {
+TEST(SimCli, FlagsSetTheConfig)
+{
   imsim_config_t c;
   imsim_cli_opts_t o;
-  ASSERT_EQ(parse({"--duration", "3.5", "--fs", "8000", "--out", "x.csv", "--pole-pairs", "3", "--ls", "0.3",
-                   "--lr", "0.31", "--sigma", "0.1", "--rs", "4.5", "--tr", "0.11", "--j", "0.002", "--b", "0.0002",
-                   "--supply", "pwm", "--vll", "220", "--freq", "50", "--load-nm", "1.5", "--ideal-sensors"},
+  ASSERT_EQ(parse({"--duration", "3.5",  "--fs",   "8000",  "--out",     "x.csv",  "--pole-pairs",   "3",
+                   "--ls",       "0.3",  "--lr",   "0.31",  "--sigma",   "0.1",    "--rs",           "4.5",
+                   "--tr",       "0.11", "--j",    "0.002", "--b",       "0.0002", "--supply",       "pwm",
+                   "--vll",      "220",  "--freq", "50",    "--load-nm", "1.5",    "--ideal-sensors"},
                   c, o),
             0);
   EXPECT_EQ(c.duration_s, 3.5);
@@ -74,12 +77,14 @@ TEST(SimCli, FlagsSetTheConfig) {
   EXPECT_NE(e.find("exp1|exp2|4kw|11kw|15kw|37kw|75kw"), std::string::npos) << e;
 }
 
-TEST(SimCli, PresetAppliesFirstWhateverItsPosition) {
+TEST(SimCli, PresetAppliesFirstWhateverItsPosition)
+{
   imsim_config_t c;
   imsim_cli_opts_t o;
-  ASSERT_EQ(parse({"--vll", "100", "--preset", "exp2", "--seed=7", "--supply=ifoc", "--ifoc-tr", "0.1"}, c, o), 0);
-  EXPECT_EQ(c.vll_v, 100);    // explicit flag wins over the preset
-  EXPECT_EQ(c.freq_hz, 30);   // from exp2
+  ASSERT_EQ(
+      parse({"--vll", "100", "--preset", "exp2", "--seed=7", "--supply=ifoc", "--ifoc-tr", "0.1"}, c, o), 0);
+  EXPECT_EQ(c.vll_v, 100);  // explicit flag wins over the preset
+  EXPECT_EQ(c.freq_hz, 30); // from exp2
   EXPECT_EQ(c.load_nm, 2.064);
   EXPECT_EQ(c.duration_s, 3600);
   EXPECT_EQ(c.seed, 7u);
@@ -91,29 +96,33 @@ TEST(SimCli, PresetAppliesFirstWhateverItsPosition) {
   EXPECT_EQ(c.duration_s, 2);
 }
 
-TEST(SimCli, BadFlagsAreRejectedWithAMessage) {
+TEST(SimCli, BadFlagsAreRejectedWithAMessage)
+{
   imsim_config_t c;
   imsim_cli_opts_t o;
   std::string e;
   const std::vector<std::vector<std::string>> bad = {
-      {"--bogus"},          {"--fs"},          {"--fs", "abc"},      {"--fs", "-5"},   {"--sigma", "1.2"},
-      {"--supply", "dc"},   {"--preset", "x"}, {"--duration", "1x"}, {"positional"},   {"--pole-pairs", "2.5"},
-      {"--ideal-sensors=1"}, {"--tr", "nan"}, {"--adc-bits", "40"}};
+      {"--bogus"},           {"--fs"},          {"--fs", "abc"},      {"--fs", "-5"}, {"--sigma", "1.2"},
+      {"--supply", "dc"},    {"--preset", "x"}, {"--duration", "1x"}, {"positional"}, {"--pole-pairs", "2.5"},
+      {"--ideal-sensors=1"}, {"--tr", "nan"},   {"--adc-bits", "40"}};
   for (const auto &b : bad) {
     EXPECT_NE(parse(b, c, o, &e), 0) << b[0];
     EXPECT_FALSE(e.empty()) << b[0];
   }
 }
 
-TEST(SimCli, HeaderStartsWithTheContractColumns) {
+TEST(SimCli, HeaderStartsWithTheContractColumns)
+{
   const std::string h = imsim_cli_header();
   EXPECT_EQ(h.rfind("t,u_a,u_b,u_c,i_a,i_b,i_c,theta,T_R_true_s,R_S_true_ohm,speed_rad_s,torque_nm", 0), 0u);
 }
 
 #ifdef IMEST_SIM_EXE
-TEST(SimCli, ExecutableWritesCsvAndFailsOnBadFlags) {
+TEST(SimCli, ExecutableWritesCsvAndFailsOnBadFlags)
+{
   const std::string out = ::testing::TempDir() + "imsim_cli_test.csv";
-  const std::string cmd = std::string(IMEST_SIM_EXE) + " --preset exp1 --duration 0.01 --ideal-sensors --out " + out;
+  const std::string cmd =
+      std::string(IMEST_SIM_EXE) + " --preset exp1 --duration 0.01 --ideal-sensors --out " + out;
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   std::ifstream f(out);
   std::string header, row;
@@ -126,27 +135,30 @@ TEST(SimCli, ExecutableWritesCsvAndFailsOnBadFlags) {
   EXPECT_NEAR(ua, std::sqrt(2.0 / 3.0) * 230, 1e-6);
   int rows = 1;
   while (std::getline(f, row)) ++rows;
-  EXPECT_EQ(rows, 41);  // t = 0 .. 0.01 at 4 kHz
+  EXPECT_EQ(rows, 41); // t = 0 .. 0.01 at 4 kHz
   const std::string badcmd = std::string(IMEST_SIM_EXE) + " --fs nope > /dev/null 2>&1";
   EXPECT_NE(std::system(badcmd.c_str()), 0);
-  const std::string badcfg = std::string(IMEST_SIM_EXE) + " --supply pwm --carrier-hz 9999 --duration 0.01 > /dev/null 2>&1";
+  const std::string badcfg =
+      std::string(IMEST_SIM_EXE) + " --supply pwm --carrier-hz 9999 --duration 0.01 > /dev/null 2>&1";
   EXPECT_NE(std::system(badcfg.c_str()), 0);
   std::remove(out.c_str());
 }
 #endif
 
 namespace {
-std::set<std::string> flags_in(const std::string &text) {
+std::set<std::string> flags_in(const std::string &text)
+{
   std::set<std::string> out;
   const std::regex re("--[a-z0-9][a-z0-9-]*");
   for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator(); ++it)
-    if (it->str() != "--opt") out.insert(it->str());  // "--opt value and --opt=value"
+    if (it->str() != "--opt") out.insert(it->str()); // "--opt value and --opt=value"
   return out;
 }
-}  // namespace
+} // namespace
 
 // The parser, --help and sim/README.md's CLI section name the same flags.
-TEST(SimCli, HelpAndReadmeListEveryFlag) {
+TEST(SimCli, HelpAndReadmeListEveryFlag)
+{
   const char *names[256];
   const size_t n = imsim_cli_flags(names, 256);
   ASSERT_LE(n, 256u);
@@ -178,7 +190,8 @@ TEST(SimCli, HelpAndReadmeListEveryFlag) {
 
 #ifdef IMEST_SIM_EXE
 namespace {
-int run_capture(const std::string &args, std::string &err_text) {
+int run_capture(const std::string &args, std::string &err_text)
+{
   // one file per process and call: CTest runs the cases of this file in parallel
   static int calls = 0;
   const std::string errf = ::testing::TempDir() + "imsim_cli_stderr_" + std::to_string(getpid()) + "_" +
@@ -191,11 +204,12 @@ int run_capture(const std::string &args, std::string &err_text) {
   std::remove(errf.c_str());
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
-}  // namespace
+} // namespace
 
 // Exit status 2 for a configuration refused with an explanation; 0 with a warning for a clipped
 // modulation; 1 for an output that cannot be written.
-TEST(SimCli, SaysWhatIsWrong) {
+TEST(SimCli, SaysWhatIsWrong)
+{
   std::string e;
   EXPECT_EQ(run_capture("--supply pwm --vmeas inst --duration 0.01 --out -", e), 2);
   EXPECT_NE(e.find("zero vector"), std::string::npos) << e;
@@ -214,7 +228,8 @@ TEST(SimCli, SaysWhatIsWrong) {
 #ifdef IMEST_SIM_EXE
 // A drive preset writes the duty and bus columns: duties in [0, 1] from this row to the next,
 // the bus through its 12-bit ADC.
-TEST(SimCli, DrivePresetWritesDutyAndBusColumns) {
+TEST(SimCli, DrivePresetWritesDutyAndBusColumns)
+{
   const std::string out = ::testing::TempDir() + "imsim_cli_drive.csv";
   std::string e;
   ASSERT_EQ(run_capture("--preset 4kw --duration 0.01 --out " + out, e), 0) << e;
@@ -236,7 +251,7 @@ TEST(SimCli, DrivePresetWritesDutyAndBusColumns) {
     EXPECT_NEAR(v[30], 560.0, 2.0);
     ++rows;
   }
-  EXPECT_EQ(rows, 81);  // 8 kHz
+  EXPECT_EQ(rows, 81); // 8 kHz
   std::remove(out.c_str());
   EXPECT_EQ(run_capture("--supply pwm --timing firmware --duration 0.01 --out -", e), 2);
   EXPECT_NE(e.find("integer multiple"), std::string::npos) << e;

@@ -11,33 +11,38 @@
 using namespace simtest;
 
 namespace {
-std::array<double, 3> zero_sequence_free(const std::array<double, 3> &v) {
+std::array<double, 3> zero_sequence_free(const std::array<double, 3> &v)
+{
   const double m = (v[0] + v[1] + v[2]) / 3.0;
   return {v[0] - m, v[1] - m, v[2] - m};
 }
 
 // Phase-to-neutral voltage that a drive forms from its duties and bus sample.
-std::array<double, 3> duty_voltage(const imsim_sample_t &s) {
+std::array<double, 3> duty_voltage(const imsim_sample_t &s)
+{
   return zero_sequence_free({s.vdc_v * s.duty[0], s.vdc_v * s.duty[1], s.vdc_v * s.duty[2]});
 }
 
 // Mean leg voltage over a PWM period of the inverter model, current of constant sign i:
 // the dead time moves one edge per period by td (against the current), the devices drop.
-double leg_mean(const imsim_config_t &c, double d, double i) {
+double leg_mean(const imsim_config_t &c, double d, double i)
+{
   const double td = c.dead_time_s * c.carrier_hz;
   if (i > 0) {
-    const double high = c.vdc_v - (c.v_switch_v + c.r_switch_ohm * i), low = -(c.v_diode_v + c.r_diode_ohm * i);
+    const double high = c.vdc_v - (c.v_switch_v + c.r_switch_ohm * i),
+                 low = -(c.v_diode_v + c.r_diode_ohm * i);
     return (d - td) * high + (1 - d + td) * low;
   }
   const double high = c.vdc_v + c.v_diode_v - c.r_diode_ohm * i, low = c.v_switch_v - c.r_switch_ohm * i;
   return (d + td) * high + (1 - d - td) * low;
 }
-}  // namespace
+} // namespace
 
 // Ideal inverter: the duties of row k and its bus sample give exactly the volt-seconds applied
 // during [t_k, t_k+1) (truth of row k+1), for both integrators, both modulations, one or two
 // PWM periods per sample, open and closed loop (IFOC).
-TEST(SimDrive, DutyVoltageEqualsAppliedVoltSecondsIdealInverter) {
+TEST(SimDrive, DutyVoltageEqualsAppliedVoltSecondsIdealInverter)
+{
   struct Case {
     const char *what;
     bool moments;
@@ -56,7 +61,7 @@ TEST(SimDrive, DutyVoltageEqualsAppliedVoltSecondsIdealInverter) {
     c.fs_hz = cs.fs;
     c.supply = cs.supply;
     if (cs.supply == IMSIM_SUPPLY_IFOC) c.start = IMSIM_START_REST;
-    if (cs.mod == IMSIM_MOD_SPWM) c.vll_v = 330;  // sine-triangle reaches 343 V on 560 V
+    if (cs.mod == IMSIM_MOD_SPWM) c.vll_v = 330; // sine-triangle reaches 343 V on 560 V
     const auto s = run(c, long(0.2 * cs.fs));
     ASSERT_FALSE(s.empty()) << cs.what;
     double maxd = 0, maxv = 0, dmin = 1, dmax = 0;
@@ -71,8 +76,9 @@ TEST(SimDrive, DutyVoltageEqualsAppliedVoltSecondsIdealInverter) {
       EXPECT_EQ(s[k].vdc_v, 560.0);
     }
     EXPECT_LT(maxd, 1e-9 * 560) << cs.what;
-    std::printf("[ duty     ] %-26s max |v(d, v_dc) - applied| %.1e V (max |v| %.0f V)\n", cs.what, maxd, maxv);
-    EXPECT_GT(maxv, 100.0) << cs.what;  // a real voltage, not a trivial agreement
+    std::printf("[ duty     ] %-26s max |v(d, v_dc) - applied| %.1e V (max |v| %.0f V)\n", cs.what, maxd,
+                maxv);
+    EXPECT_GT(maxv, 100.0) << cs.what; // a real voltage, not a trivial agreement
     EXPECT_GE(dmin, 0.0) << cs.what;
     EXPECT_LE(dmax, 1.0) << cs.what;
     imsim_pwm_stats_t st;
@@ -86,12 +92,13 @@ TEST(SimDrive, DutyVoltageEqualsAppliedVoltSecondsIdealInverter) {
 // With dead time and device drops the applied volt-seconds depart from the duty voltage by the
 // inverter model's error: per leg, for i > 0 about -(t_d f_c V_dc + d V_sw + (1 - d) V_d) (plus
 // the slopes), for i < 0 the opposite sign; the phase voltage sees it without its zero sequence.
-TEST(SimDrive, DeadTimeAndDropsGiveTheModelsVoltageError) {
+TEST(SimDrive, DeadTimeAndDropsGiveTheModelsVoltageError)
+{
   for (const bool moments : {true, false}) {
     imsim_config_t c = ideal("4kw");
     add_inverter_errors(c);
     c.pwm_moments = moments;
-    c.vll_v = 300;  // duties within [0.12, 0.88]: both edges of every period whole
+    c.vll_v = 300; // duties within [0.12, 0.88]: both edges of every period whole
     const auto s = run(c, 1600);
     ASSERT_FALSE(s.empty());
     double maxd = 0, maxerr = 0;
@@ -101,7 +108,7 @@ TEST(SimDrive, DeadTimeAndDropsGiveTheModelsVoltageError) {
       std::array<double, 3> leg_err{};
       for (int p = 0; p < 3; ++p) {
         const double d = s[k].duty[p], i = s[k].i_abc_true[p];
-        ok = ok && std::fabs(i) > 1.5;  // no zero crossing within the period
+        ok = ok && std::fabs(i) > 1.5; // no zero crossing within the period
         leg_err[p] = leg_mean(c, d, i) - d * c.vdc_v;
       }
       if (!ok) continue;
@@ -113,13 +120,15 @@ TEST(SimDrive, DeadTimeAndDropsGiveTheModelsVoltageError) {
         maxd = std::max(maxd, std::fabs(actual - e[p]));
         maxerr = std::max(maxerr, std::fabs(actual));
         // sign of the leg error before the zero sequence: against the current
-        if (s[k].i_abc_true[p] > 0) pos += leg_err[p] < -(2e-6 * 8000 * 560) ? 1 : 0;
-        else neg += leg_err[p] > 2e-6 * 8000 * 560 ? 1 : 0;
+        if (s[k].i_abc_true[p] > 0)
+          pos += leg_err[p] < -(2e-6 * 8000 * 560) ? 1 : 0;
+        else
+          neg += leg_err[p] > 2e-6 * 8000 * 560 ? 1 : 0;
       }
     }
     EXPECT_GT(used, 500) << moments;
-    EXPECT_GT(maxerr, 8.0) << moments;   // about (4/3) t_d f_c V_dc at the peak: a real error
-    EXPECT_LT(maxd, 0.02) << moments;    // the model's formula, to the drops' current variation
+    EXPECT_GT(maxerr, 8.0) << moments; // about (4/3) t_d f_c V_dc at the peak: a real error
+    EXPECT_LT(maxd, 0.02) << moments;  // the model's formula, to the drops' current variation
     EXPECT_EQ(pos + neg, 3 * used) << moments;
     std::printf("[ inverter ] moments=%d rows=%d max |error| %.3f V, max |error - formula| %.2e V\n", moments,
                 used, maxerr, maxd);
@@ -128,7 +137,8 @@ TEST(SimDrive, DeadTimeAndDropsGiveTheModelsVoltageError) {
 
 // Firmware timing: a command set after sample k is applied during [t_k+1, t_k+2): it shows in
 // the duty column of row k+1 and in the applied volt-seconds of row k+2, not earlier.
-TEST(SimDrive, ExternalCommandAppliedOneSampleLater) {
+TEST(SimDrive, ExternalCommandAppliedOneSampleLater)
+{
   imsim_config_t c = ideal("4kw");
   c.supply = IMSIM_SUPPLY_EXT;
   c.start = IMSIM_START_REST;
@@ -137,7 +147,7 @@ TEST(SimDrive, ExternalCommandAppliedOneSampleLater) {
   ASSERT_EQ(imsim_init(&sim, &c, &s[0]), 0);
   for (int p = 0; p < 3; ++p) EXPECT_EQ(s[0].duty[p], 0.5);
   imsim_step(&sim, &s[1]);
-  imsim_step(&sim, &s[2]);  // sample k = 2
+  imsim_step(&sim, &s[2]); // sample k = 2
   const double d[3] = {0.6, 0.45, 0.45};
   ASSERT_EQ(imsim_set_duty(&sim, d), 0);
   for (int k = 3; k < 8; ++k) imsim_step(&sim, &s[k]);
@@ -145,16 +155,17 @@ TEST(SimDrive, ExternalCommandAppliedOneSampleLater) {
   EXPECT_EQ(s[2].duty[0], 0.5);
   EXPECT_EQ(s[3].duty[0], 0.6);
   EXPECT_EQ(s[3].duty[1], 0.45);
-  EXPECT_NEAR(s[3].u_abc_true[0], 0.0, 1e-9);           // [t_2, t_3): still 0.5
-  EXPECT_NEAR(s[4].u_abc_true[0], 0.1 * 560, 1e-9);     // [t_3, t_4): the new duties
+  EXPECT_NEAR(s[3].u_abc_true[0], 0.0, 1e-9);       // [t_2, t_3): still 0.5
+  EXPECT_NEAR(s[4].u_abc_true[0], 0.1 * 560, 1e-9); // [t_3, t_4): the new duties
   EXPECT_NEAR(s[4].u_abc_true[1], -0.05 * 560, 1e-9);
-  EXPECT_EQ(s[7].duty[0], 0.6);                         // holds until the next command
+  EXPECT_EQ(s[7].duty[0], 0.6); // holds until the next command
 }
 
 // External voltage commands in closed loop: a PI holding a DC current at standstill (the
 // commissioning's first step). In steady state the commanded phase voltage equals
 // R_S I plus the inverter's error, which the PI has to supply.
-TEST(SimDrive, ExternalPiHoldsDcCurrentAtStandstill) {
+TEST(SimDrive, ExternalPiHoldsDcCurrentAtStandstill)
+{
   for (const bool inverter_errors : {false, true}) {
     imsim_config_t c = ideal("4kw");
     c.supply = IMSIM_SUPPLY_EXT;
@@ -164,12 +175,12 @@ TEST(SimDrive, ExternalPiHoldsDcCurrentAtStandstill) {
     static imsim_t sim;
     imsim_sample_t s;
     ASSERT_EQ(imsim_init(&sim, &c, &s), 0);
-    const double i_ref = 5.0;  // A in phase a, -2.5 A in b and c
+    const double i_ref = 5.0; // A in phase a, -2.5 A in b and c
     const double sl = c.sigma * c.ls_h, wbw = 2 * kPi * 200;
-    const double kp = sl * wbw, ki = c.rs_ohm * wbw;  // PI in alpha-beta on the measured current
+    const double kp = sl * wbw, ki = c.rs_ohm * wbw; // PI in alpha-beta on the measured current
     double integ[2] = {0, 0};
     const double iref_ab[2] = {std::sqrt(1.5) * i_ref, 0.0};
-    const long n = long(2.5 * c.fs_hz), tail = long(0.2 * c.fs_hz);  // 20 T_R: flux settled
+    const long n = long(2.5 * c.fs_hz), tail = long(0.2 * c.fs_hz); // 20 T_R: flux settled
     double v_cmd = 0, i_meas = 0, err_model = 0, d_mean[3] = {0, 0, 0};
     for (long k = 0; k < n; ++k) {
       double iab[2];
@@ -196,7 +207,7 @@ TEST(SimDrive, ExternalPiHoldsDcCurrentAtStandstill) {
       }
     }
     EXPECT_NEAR(i_meas, i_ref, 1e-3 * i_ref) << inverter_errors;
-    EXPECT_NEAR(std::fabs(s.speed_rad_s), 0.0, 1e-6);  // DC field: no torque at standstill
+    EXPECT_NEAR(std::fabs(s.speed_rad_s), 0.0, 1e-6); // DC field: no torque at standstill
     // V_cmd = R_S I - (inverter error without its zero sequence)
     // to the ripple: the valley samples are the period means only up to its curvature
     EXPECT_NEAR(v_cmd, c.rs_ohm * i_meas - err_model, 2e-3) << inverter_errors;
@@ -209,13 +220,15 @@ TEST(SimDrive, ExternalPiHoldsDcCurrentAtStandstill) {
       EXPECT_NEAR(v_cmd, c.rs_ohm * i_meas, 1e-5 * c.rs_ohm * i_ref);
       EXPECT_EQ(err_model, 0.0);
     }
-    std::printf("[ DC PI    ] errors=%d I_a %.5f A, V_cmd %.4f V = R_S I %.4f V + model %.4f V %+.1e V; duties %.4f %.4f %.4f\n",
-                inverter_errors, i_meas, v_cmd, c.rs_ohm * i_meas, -err_model, v_cmd - (c.rs_ohm * i_meas - err_model),
-                d_mean[0], d_mean[1], d_mean[2]);
+    std::printf("[ DC PI    ] errors=%d I_a %.5f A, V_cmd %.4f V = R_S I %.4f V + model %.4f V %+.1e V; "
+                "duties %.4f %.4f %.4f\n",
+                inverter_errors, i_meas, v_cmd, c.rs_ohm * i_meas, -err_model,
+                v_cmd - (c.rs_ohm * i_meas - err_model), d_mean[0], d_mean[1], d_mean[2]);
   }
 }
 
-TEST(SimDrive, SetCommandsRefusedOutsideExternalSupply) {
+TEST(SimDrive, SetCommandsRefusedOutsideExternalSupply)
+{
   imsim_config_t c = ideal("4kw");
   static imsim_t sim;
   ASSERT_EQ(imsim_init(&sim, &c, nullptr), 0);
@@ -228,7 +241,7 @@ TEST(SimDrive, SetCommandsRefusedOutsideExternalSupply) {
   const double bad[3] = {0.5, NAN, 0.5};
   EXPECT_EQ(imsim_set_duty(&sim, bad), -1);
   EXPECT_EQ(imsim_set_voltage(&sim, bad), -1);
-  const double over[3] = {1.5, 0.5, -0.2};  // clipped to [0, 1] and counted
+  const double over[3] = {1.5, 0.5, -0.2}; // clipped to [0, 1] and counted
   EXPECT_EQ(imsim_set_duty(&sim, over), 0);
   imsim_sample_t s;
   imsim_step(&sim, &s);
@@ -243,7 +256,8 @@ TEST(SimDrive, SetCommandsRefusedOutsideExternalSupply) {
 
 // The bus through its ADC: 12 bit over 0..800 V, 1 LSB noise from its own stream (the phase
 // channels do not change when it is added); exact with ideal sensors; NaN without PWM.
-TEST(SimDrive, BusVoltageSample) {
+TEST(SimDrive, BusVoltageSample)
+{
   imsim_config_t c = ideal("4kw");
   c.ideal_sensors = false;
   const auto s = run(c, 4000);
@@ -266,10 +280,11 @@ TEST(SimDrive, BusVoltageSample) {
 
 // Timing refused where it cannot hold: firmware timing samples at a valley once every N
 // carrier periods, and needs the PWM inverter.
-TEST(SimDrive, FirmwareTimingConfigurationChecks) {
+TEST(SimDrive, FirmwareTimingConfigurationChecks)
+{
   imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
-  c.timing = IMSIM_TIMING_FIRMWARE;  // 10 kHz carrier, 4 kHz samples: 2.5 periods per sample
+  c.timing = IMSIM_TIMING_FIRMWARE; // 10 kHz carrier, 4 kHz samples: 2.5 periods per sample
   static imsim_t sim;
   EXPECT_NE(imsim_init(&sim, &c, nullptr), 0);
   EXPECT_NE(std::string(imsim_error(&sim)).find("integer multiple"), std::string::npos);

@@ -10,7 +10,8 @@ namespace {
 struct Err {
   double di, dpsi, dw, dth, imax;
 };
-Err compare(imsim_config_t fast, double seconds, int ref_substeps) {
+Err compare(imsim_config_t fast, double seconds, int ref_substeps)
+{
   static imsim_t a, b;
   imsim_config_t ref = fast;
   ref.integrator = IMSIM_INTEGRATOR_RK4;
@@ -30,13 +31,14 @@ Err compare(imsim_config_t fast, double seconds, int ref_substeps) {
   }
   return e;
 }
-}  // namespace
+} // namespace
 
-TEST(SimIntegrator, Rk4ReferenceIsConverged) {
+TEST(SimIntegrator, Rk4ReferenceIsConverged)
+{
   imsim_config_t c = ideal("exp1");
   c.integrator = IMSIM_INTEGRATOR_RK4;
   c.rk4_substeps = 8;
-  const Err e = compare(c, 0.2, 16);  // RK4 x8 against RK4 x16, DOL start
+  const Err e = compare(c, 0.2, 16); // RK4 x8 against RK4 x16, DOL start
   EXPECT_LT(e.di, 1e-10);
   EXPECT_LT(e.dw, 1e-9);
 }
@@ -44,20 +46,21 @@ TEST(SimIntegrator, Rk4ReferenceIsConverged) {
 // Ideal sine, DOL start (the hardest case: omega'' ~ 3e6 rad/s^3). Error vs step size and
 // the observed order of convergence (expected 3: omega frozen at its predicted step mean
 // plus the leading Magnus term, Hermite quadrature for the mechanics).
-TEST(SimIntegrator, SineConvergesWithStepSizeThirdOrder) {
+TEST(SimIntegrator, SineConvergesWithStepSizeThirdOrder)
+{
   imsim_config_t c = ideal("exp1");
   double prev = 0;
   for (int sps : {1, 2, 4, 8}) {
     c.steps_per_sample = sps;
     const Err e = compare(c, 0.25, 32 / sps);
-    if (sps == 1) EXPECT_LT(e.di, 1e-4);  // h = 250 us
+    if (sps == 1) EXPECT_LT(e.di, 1e-4); // h = 250 us
     if (prev > 0) {
       const double order = std::log2(prev / e.di);
       EXPECT_GT(order, 2.5) << "sps " << sps;
     }
     prev = e.di;
   }
-  c.steps_per_sample = 0;  // default: 5 steps per sample, h = 50 us
+  c.steps_per_sample = 0; // default: 5 steps per sample, h = 50 us
   const Err e = compare(c, 0.5, 16);
   EXPECT_LT(e.di / e.imax, 1e-7);
   EXPECT_LT(e.dw, 1e-5);
@@ -67,7 +70,8 @@ TEST(SimIntegrator, SineConvergesWithStepSizeThirdOrder) {
 // PWM: the fast integrator integrates piecewise between the switching instants (event-exact),
 // the reference too; they must agree to the integrator tolerance, also with dead time and
 // the AA filter states.
-TEST(SimIntegrator, PwmEventExactAgainstReference) {
+TEST(SimIntegrator, PwmEventExactAgainstReference)
+{
   imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
   c.pwm_moments = false;
@@ -92,7 +96,8 @@ TEST(SimIntegrator, PwmEventExactAgainstReference) {
 // The default one-step-per-half-period variant (pwm_moments) is exact for the electrical part
 // with frozen speed but misses part of the torque ripple inside the half period: documented
 // error ~3e-5 relative (DOL start), ~1e-4 A at the exp2 operating point.
-TEST(SimIntegrator, PwmMomentsVariantDocumentedError) {
+TEST(SimIntegrator, PwmMomentsVariantDocumentedError)
+{
   imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
   c.pwm_moments = true;
@@ -103,12 +108,13 @@ TEST(SimIntegrator, PwmMomentsVariantDocumentedError) {
   const Err g = compare(d, 3.0, 4);
   EXPECT_LT(g.di, 2e-4);
   c.start = IMSIM_START_STEADY;
-  c.j_kgm2 = 1e6;  // frozen speed: electrical part exact
+  c.j_kgm2 = 1e6; // frozen speed: electrical part exact
   const Err f = compare(c, 0.05, 8);
   EXPECT_LT(f.di, 1e-10);
 }
 
-TEST(SimIntegrator, IfocClosedLoopAgainstReference) {
+TEST(SimIntegrator, IfocClosedLoopAgainstReference)
+{
   imsim_config_t c = ideal("exp2");
   c.supply = IMSIM_SUPPLY_IFOC;
   c.pwm_moments = false;
@@ -121,7 +127,8 @@ TEST(SimIntegrator, IfocClosedLoopAgainstReference) {
 // integrators decide each piece's leg voltages from the currents at its start, so they agree
 // to the integrator tolerance. The default moments variant decides once per half period (the
 // currents at its start): near a current zero crossing it can differ by a dead-time pulse.
-TEST(SimIntegrator, InverterModelAgainstReference) {
+TEST(SimIntegrator, InverterModelAgainstReference)
+{
   imsim_config_t c = ideal("4kw");
   add_inverter_errors(c);
   c.pwm_moments = false;
@@ -130,7 +137,8 @@ TEST(SimIntegrator, InverterModelAgainstReference) {
   EXPECT_LT(e.dw, 1e-6);
   c.pwm_moments = true;
   e = compare(c, 0.1, 4);
-  std::printf("[ moments  ] inverter errors, 4 kW rated, 0.1 s: max |di| %.2e A (%.1e of peak), max |dw| %.2e rad/s\n",
+  std::printf("[ moments  ] inverter errors, 4 kW rated, 0.1 s: max |di| %.2e A (%.1e of peak), max |dw| "
+              "%.2e rad/s\n",
               e.di, e.di / e.imax, e.dw);
   EXPECT_LT(e.di / e.imax, 2e-3);
 }

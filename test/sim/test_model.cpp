@@ -11,7 +11,8 @@ namespace {
 struct Ec {
   double speed_rpm, i_rms, torque;
 };
-Ec equivalent_circuit(const imsim_config_t &c, double vll, double f, double load) {
+Ec equivalent_circuit(const imsim_config_t &c, double vll, double f, double load)
+{
   const double m = std::sqrt((1 - c.sigma) * c.ls_h * c.lr_h);
   const double lls = c.ls_h - m, llr = c.lr_h - m, rr = c.lr_h / c.tr_s;
   const double we = 2 * kPi * f, ws = we / c.pole_pairs;
@@ -29,18 +30,23 @@ Ec equivalent_circuit(const imsim_config_t &c, double vll, double f, double load
     const double mid = 0.5 * (lo + hi);
     eval(mid, irms, te);
     const double w = ws * (1 - mid);
-    if (te - load - c.b_nms * w > 0) hi = mid;
-    else lo = mid;
+    if (te - load - c.b_nms * w > 0)
+      hi = mid;
+    else
+      lo = mid;
   }
   const double slip = 0.5 * (lo + hi);
   eval(slip, irms, te);
   return {ws * (1 - slip) * 60 / (2 * kPi), irms, te};
 }
-}  // namespace
+} // namespace
 
-TEST(SimModel, SteadyStateMatchesEquivalentCircuit) {
+TEST(SimModel, SteadyStateMatchesEquivalentCircuit)
+{
   const imsim_config_t c = ideal();
-  struct Case { double vll, f, load; } cases[] = {{230, 60, 2.064}, {115, 30, 2.064}, {230, 60, 0.5}, {200, 50, 1.5}};
+  struct Case {
+    double vll, f, load;
+  } cases[] = {{230, 60, 2.064}, {115, 30, 2.064}, {230, 60, 0.5}, {200, 50, 1.5}};
   for (const auto &k : cases) {
     imsim_steady_t st;
     ASSERT_EQ(imsim_steady_state(&c, k.vll, k.f, k.load, &st), 0);
@@ -51,7 +57,8 @@ TEST(SimModel, SteadyStateMatchesEquivalentCircuit) {
   }
 }
 
-TEST(SimModel, NameplateFiguresOfMathSection9) {
+TEST(SimModel, NameplateFiguresOfMathSection9)
+{
   const imsim_config_t c = ideal();
   imsim_steady_t st;
   ASSERT_EQ(imsim_steady_state(&c, 230, 60, 2.064, &st), 0);
@@ -64,12 +71,13 @@ TEST(SimModel, NameplateFiguresOfMathSection9) {
 
 // Time domain: started in the phasor steady state, the simulation must stay there (slip,
 // current amplitude and torque), which checks integrator and steady-state solver together.
-TEST(SimModel, TimeDomainHoldsEquivalentCircuitSteadyState) {
+TEST(SimModel, TimeDomainHoldsEquivalentCircuitSteadyState)
+{
   imsim_config_t c = ideal();
   c.load_nm = 2.064;
   c.start = IMSIM_START_STEADY;
   const Ec ec = equivalent_circuit(c, 230, 60, 2.064);
-  const auto s = run(c, 4000);  // 1 s
+  const auto s = run(c, 4000); // 1 s
   ASSERT_FALSE(s.empty());
   for (size_t k = 0; k < s.size(); k += 97) {
     EXPECT_NEAR(s[k].speed_rad_s * 30 / kPi, ec.speed_rpm, 1e-5);
@@ -78,9 +86,10 @@ TEST(SimModel, TimeDomainHoldsEquivalentCircuitSteadyState) {
   }
 }
 
-TEST(SimModel, DirectOnLineStartOfExp1) {
+TEST(SimModel, DirectOnLineStartOfExp1)
+{
   const imsim_config_t c = ideal("exp1");
-  const auto s = run(c, 8000);  // 2 s
+  const auto s = run(c, 8000); // 2 s
   ASSERT_FALSE(s.empty());
   double peak = 0;
   double t_at_speed = -1;
@@ -88,9 +97,9 @@ TEST(SimModel, DirectOnLineStartOfExp1) {
     for (double i : x.i_abc_true) peak = std::max(peak, std::fabs(i));
     if (t_at_speed < 0 && x.speed_rad_s > 0.95 * 2 * kPi * 30) t_at_speed = x.t;
   }
-  EXPECT_NEAR(peak, 16.4, 0.05);          // docs/METHOD.md §9
+  EXPECT_NEAR(peak, 16.4, 0.05); // docs/METHOD.md §9
   EXPECT_GT(t_at_speed, 0.03);
-  EXPECT_LT(t_at_speed, 0.08);            // "at speed in about 50 ms"
+  EXPECT_LT(t_at_speed, 0.08); // "at speed in about 50 ms"
   imsim_steady_t st;
   ASSERT_EQ(imsim_steady_state(&c, 230, 60, 0, &st), 0);
   EXPECT_NEAR(s.back().speed_rad_s, st.speed_rad_s, 1e-6);
@@ -101,24 +110,29 @@ TEST(SimModel, DirectOnLineStartOfExp1) {
 
 // Energy balance: input energy = magnetic + kinetic energy change + copper losses + friction
 // + load work. Densely sampled smooth supply, Simpson quadrature.
-TEST(SimModel, EnergyBalance) {
+TEST(SimModel, EnergyBalance)
+{
   imsim_config_t c = ideal("exp1");
   c.fs_hz = 40000;
   c.steps_per_sample = 1;
   c.load_nm = 0.8;
   c.load_on_s = 0.1;
   c.load_ramp_s = 0.0;
-  const long n = 12000;  // 0.3 s, even number of intervals
+  const long n = 12000; // 0.3 s, even number of intervals
   const auto s = run(c, n);
   ASSERT_FALSE(s.empty());
   const double m = std::sqrt((1 - c.sigma) * c.ls_h * c.lr_h);
   const double sl = c.sigma * c.ls_h;
-  auto p_in = [](const imsim_sample_t &x) { return x.u_ab_true[0] * x.i_ab_true[0] + x.u_ab_true[1] * x.i_ab_true[1]; };
+  auto p_in = [](const imsim_sample_t &x) {
+    return x.u_ab_true[0] * x.i_ab_true[0] + x.u_ab_true[1] * x.i_ab_true[1];
+  };
   auto p_out = [&](const imsim_sample_t &x) {
-    return x.p_cu_stator_w + x.p_cu_rotor_w + c.b_nms * x.speed_rad_s * x.speed_rad_s + x.load_nm * x.speed_rad_s;
+    return x.p_cu_stator_w + x.p_cu_rotor_w + c.b_nms * x.speed_rad_s * x.speed_rad_s +
+           x.load_nm * x.speed_rad_s;
   };
   auto stored = [&](const imsim_sample_t &x) {
-    return 0.5 * sl * std::norm(iab(x)) + 0.5 * std::norm(psiab(x)) / c.lr_h + 0.5 * c.j_kgm2 * x.speed_rad_s * x.speed_rad_s;
+    return 0.5 * sl * std::norm(iab(x)) + 0.5 * std::norm(psiab(x)) / c.lr_h +
+           0.5 * c.j_kgm2 * x.speed_rad_s * x.speed_rad_s;
   };
   (void)m;
   // The load steps at t = 0.1 s (a sample instant, 4000): integrate the two parts separately.
@@ -130,7 +144,9 @@ TEST(SimModel, EnergyBalance) {
   // Load torque is held over each sample period at its mid-interval value, so at the step
   // sample the recorded load_nm is the new value; integrate piecewise around it.
   const double e_in = simpson(p_in, 0, 4000) + simpson(p_in, 4000, n);
-  auto p_out_before = [&](const imsim_sample_t &x) { return p_out(x) - (x.t >= 0.1 - 1e-12 ? x.load_nm * x.speed_rad_s : 0.0); };
+  auto p_out_before = [&](const imsim_sample_t &x) {
+    return p_out(x) - (x.t >= 0.1 - 1e-12 ? x.load_nm * x.speed_rad_s : 0.0);
+  };
   const double e_out = simpson(p_out_before, 0, 4000) + simpson(p_out, 4000, n);
   const double de = stored(s.back()) - stored(s.front());
   EXPECT_GT(e_in, 50.0);

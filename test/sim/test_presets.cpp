@@ -14,9 +14,10 @@ namespace {
 const char *const kDrives[] = {"4kw", "11kw", "15kw", "37kw", "75kw"};
 }
 
-TEST(SimPresets, RatedPointNearCatalogue) {
-  std::printf("[ presets  ] %-5s %9s %9s %8s %8s %7s %7s %8s %8s\n", "", "n_cat", "n_model", "I_cat", "I_model",
-              "T_R", "sigma", "T_bd/T_n", "I0/I_n");
+TEST(SimPresets, RatedPointNearCatalogue)
+{
+  std::printf("[ presets  ] %-5s %9s %9s %8s %8s %7s %7s %8s %8s\n", "", "n_cat", "n_model", "I_cat",
+              "I_model", "T_R", "sigma", "T_bd/T_n", "I0/I_n");
   for (const char *name : kDrives) {
     imsim_config_t c;
     ASSERT_EQ(imsim_config_preset(&c, name), 0) << name;
@@ -41,13 +42,14 @@ TEST(SimPresets, RatedPointNearCatalogue) {
     EXPECT_GT(lo, 2.5 * c.rated_torque_nm) << name;
     // sensors sized from the nameplate: about 2.5 x rated peak current
     EXPECT_NEAR(c.i_range_a / (std::sqrt(2.0) * c.rated_current_a), 2.5, 0.2) << name;
-    std::printf("[ presets  ] %-5s %9.1f %9.1f %8.1f %8.2f %7.3f %7.4f %8.2f %8.2f\n", name, c.rated_speed_rpm,
-                st.speed_rpm, c.rated_current_a, st.i_rms_phase, c.tr_s, c.sigma, lo / c.rated_torque_nm,
-                s0.i_rms_phase / c.rated_current_a);
+    std::printf("[ presets  ] %-5s %9.1f %9.1f %8.1f %8.2f %7.3f %7.4f %8.2f %8.2f\n", name,
+                c.rated_speed_rpm, st.speed_rpm, c.rated_current_a, st.i_rms_phase, c.tr_s, c.sigma,
+                lo / c.rated_torque_nm, s0.i_rms_phase / c.rated_current_a);
   }
 }
 
-TEST(SimPresets, DefaultDriveRunsAtTheSteadyState) {
+TEST(SimPresets, DefaultDriveRunsAtTheSteadyState)
+{
   for (const char *name : kDrives) {
     imsim_config_t c;
     ASSERT_EQ(imsim_config_preset(&c, name), 0) << name;

@@ -9,14 +9,16 @@
 using namespace simtest;
 
 namespace {
-struct Rot {  // rotor-frame signals and derivatives
+struct Rot { // rotor-frame signals and derivatives
   cd i, di, d2i, u, du;
   double w, dw;
 };
 
 // rms(y - W K) / rms(y) over the records, K built from (gamma, tr).
-double residual_ratio(const std::vector<Rot> &r, double np, double s, double m, double gamma, double tr) {
-  const std::array<double, 8> K = {gamma, 1 / tr, 1 / (tr * tr), gamma / tr, tr, gamma * tr, gamma * tr * tr, tr * tr};
+double residual_ratio(const std::vector<Rot> &r, double np, double s, double m, double gamma, double tr)
+{
+  const std::array<double, 8> K = {gamma, 1 / tr,     1 / (tr * tr),   gamma / tr,
+                                   tr,    gamma * tr, gamma * tr * tr, tr * tr};
   const double n = np;
   double e2 = 0, y2 = 0;
   for (const Rot &q : r) {
@@ -26,24 +28,28 @@ double residual_ratio(const std::vector<Rot> &r, double np, double s, double m, 
     const double dux = q.du.real(), duy = q.du.imag();
     const double y1 = d2ix - n * w * diy - n * wd * iy - n * n * m * w * w * ix - dux / s;
     const double y2v = d2iy + n * w * dix + n * wd * ix - n * n * m * w * w * iy - duy / s;
-    std::array<double, 8> W1 = {
-        -dix,
-        -dix + n * (1 + m) * w * iy + ux / s,
-        m * ix,
-        -ix,
-        n * wd * (diy - uy / s) + n * n * (w * wd * ix - w * w * dix + w * w * ux / s) + n * n * n * (1 + m) * w * w * w * iy,
-        n * wd * iy - n * n * w * w * ix,
-        n * n * (w * wd * ix - w * w * dix),
-        n * n * (w * wd * dix - w * w * d2ix + (w * w * dux - w * wd * ux) / s) + n * n * n * w * w * w * diy};
-    std::array<double, 8> W2 = {
-        -diy,
-        -diy - n * (1 + m) * w * ix + uy / s,
-        m * iy,
-        -iy,
-        -n * wd * (dix - ux / s) + n * n * (w * wd * iy - w * w * diy + w * w * uy / s) - n * n * n * (1 + m) * w * w * w * ix,
-        -n * wd * ix - n * n * w * w * iy,
-        n * n * (w * wd * iy - w * w * diy),
-        n * n * (w * wd * diy - w * w * d2iy + (w * w * duy - w * wd * uy) / s) - n * n * n * w * w * w * dix};
+    std::array<double, 8> W1 = {-dix,
+                                -dix + n * (1 + m) * w * iy + ux / s,
+                                m * ix,
+                                -ix,
+                                n * wd * (diy - uy / s) +
+                                    n * n * (w * wd * ix - w * w * dix + w * w * ux / s) +
+                                    n * n * n * (1 + m) * w * w * w * iy,
+                                n * wd * iy - n * n * w * w * ix,
+                                n * n * (w * wd * ix - w * w * dix),
+                                n * n * (w * wd * dix - w * w * d2ix + (w * w * dux - w * wd * ux) / s) +
+                                    n * n * n * w * w * w * diy};
+    std::array<double, 8> W2 = {-diy,
+                                -diy - n * (1 + m) * w * ix + uy / s,
+                                m * iy,
+                                -iy,
+                                -n * wd * (dix - ux / s) +
+                                    n * n * (w * wd * iy - w * w * diy + w * w * uy / s) -
+                                    n * n * n * (1 + m) * w * w * w * ix,
+                                -n * wd * ix - n * n * w * w * iy,
+                                n * n * (w * wd * iy - w * w * diy),
+                                n * n * (w * wd * diy - w * w * d2iy + (w * w * duy - w * wd * uy) / s) -
+                                    n * n * n * w * w * w * dix};
     double r1 = y1, r2 = y2v;
     for (int k = 0; k < 8; ++k) {
       r1 -= W1[size_t(k)] * K[size_t(k)];
@@ -54,14 +60,15 @@ double residual_ratio(const std::vector<Rot> &r, double np, double s, double m, 
   }
   return std::sqrt(e2 / y2);
 }
-}  // namespace
+} // namespace
 
 // Model-exact derivatives from the simulated state (eq. (1) differentiated here, independently),
 // rotated with the exact derivative of the rotation.
-TEST(SimRegressor, ExactDerivativesSatisfyYEqualsWK) {
+TEST(SimRegressor, ExactDerivativesSatisfyYEqualsWK)
+{
   imsim_config_t c = ideal("exp1");
   c.fs_hz = 20000;
-  const auto smp = run(c, 4000);  // 0.2 s DOL start
+  const auto smp = run(c, 4000); // 0.2 s DOL start
   ASSERT_FALSE(smp.empty());
   const double np = c.pole_pairs, sl = c.sigma * c.ls_h;
   const double M = std::sqrt((1 - c.sigma) * c.ls_h * c.lr_h);
@@ -78,7 +85,7 @@ TEST(SimRegressor, ExactDerivativesSatisfyYEqualsWK) {
     const cd di = u / sl - gamma * i + beta * (1 / tr - j * np * w) * psi;
     const cd dpsi = (M / tr) * i + (-1 / tr + j * np * w) * psi;
     const cd d2i = du / sl - gamma * di + beta * (1 / tr - j * np * w) * dpsi - j * np * wd * beta * psi;
-    const cd r = std::exp(-j * np * th);  // x_xy = r x_ab
+    const cd r = std::exp(-j * np * th); // x_xy = r x_ab
     const double ph = np * w, phd = np * wd;
     Rot q;
     q.i = r * i;
@@ -101,11 +108,12 @@ TEST(SimRegressor, ExactDerivativesSatisfyYEqualsWK) {
 // The same with derivatives taken by finite differences of the simulated (sampled) currents
 // and angle: checks that the simulator's trajectory itself obeys the model to the accuracy
 // the estimator can see.
-TEST(SimRegressor, FiniteDifferenceDerivativesOfSimulatedTrajectory) {
+TEST(SimRegressor, FiniteDifferenceDerivativesOfSimulatedTrajectory)
+{
   imsim_config_t c = ideal("exp1");
   c.fs_hz = 100000;
   c.steps_per_sample = 1;
-  const auto smp = run(c, 20000);  // 0.2 s
+  const auto smp = run(c, 20000); // 0.2 s
   ASSERT_FALSE(smp.empty());
   const double np = c.pole_pairs, sl = c.sigma * c.ls_h;
   const double tr = c.tr_s, gamma = c.rs_ohm / sl + (1 - c.sigma) / (c.sigma * tr);
@@ -124,7 +132,9 @@ TEST(SimRegressor, FiniteDifferenceDerivativesOfSimulatedTrajectory) {
   (void)we;
   for (size_t k = 400; k + 3 < smp.size(); ++k) {
     auto d1 = [&](auto &v) { return (v[k - 2] - 8.0 * v[k - 1] + 8.0 * v[k + 1] - v[k + 2]) / (12 * T); };
-    auto d2 = [&](auto &v) { return (-v[k - 2] + 16.0 * v[k - 1] - 30.0 * v[k] + 16.0 * v[k + 1] - v[k + 2]) / (12 * T * T); };
+    auto d2 = [&](auto &v) {
+      return (-v[k - 2] + 16.0 * v[k - 1] - 30.0 * v[k] + 16.0 * v[k + 1] - v[k + 2]) / (12 * T * T);
+    };
     Rot q;
     q.i = ixy[k];
     q.di = d1(ixy);

@@ -8,7 +8,8 @@
 
 using namespace simtest;
 
-TEST(SimSupply, SineConventionAtSamples) {
+TEST(SimSupply, SineConventionAtSamples)
+{
   imsim_config_t c = ideal("exp1");
   const auto s = run(c, 200);
   ASSERT_FALSE(s.empty());
@@ -20,34 +21,37 @@ TEST(SimSupply, SineConventionAtSamples) {
     EXPECT_NEAR(x.u_abc[2], a * std::cos(ph - 4 * kPi / 3), 1e-9);
     EXPECT_NEAR(x.i_abc[0] + x.i_abc[1] + x.i_abc[2], 0.0, 1e-12);
   }
-  EXPECT_GT(s.back().theta, 0.0);  // rotates with the a-b-c field
+  EXPECT_GT(s.back().theta, 0.0); // rotates with the a-b-c field
 }
 
-TEST(SimSupply, TransformsRoundTripPowerInvariant) {
+TEST(SimSupply, TransformsRoundTripPowerInvariant)
+{
   const double abc[3] = {1.0, -0.3, -0.7};
   double ab[2], back[3];
   imsim_abc_to_ab(abc, ab);
   imsim_ab_to_abc(ab, back);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(back[k], abc[k], 1e-15);
-  EXPECT_NEAR(ab[0] * ab[0] + ab[1] * ab[1], 1.0 + 0.09 + 0.49, 1e-14);  // sum-free input: power invariant
+  EXPECT_NEAR(ab[0] * ab[0] + ab[1] * ab[1], 1.0 + 0.09 + 0.49, 1e-14); // sum-free input: power invariant
 }
 
 // PWM: the volt-second average over the carrier period equals the sampled sinusoidal
 // reference (regular sampling at the half-period centres), the instantaneous sample is a zero
 // vector, and without dead time the commanded and actual averages coincide.
-TEST(SimSupply, PwmVoltageMeasurementConventions) {
+TEST(SimSupply, PwmVoltageMeasurementConventions)
+{
   imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
   auto s = run(c, 400);
   ASSERT_FALSE(s.empty());
-  const double T = 1e-4;  // carrier period
+  const double T = 1e-4; // carrier period
   for (size_t k = 1; k < s.size(); ++k) {
     const auto &x = s[k];
     // average over [t - T, t] of the reference sampled at the two half-period centres
     const double t1 = x.t - 0.75 * T, t2 = x.t - 0.25 * T;
     for (int p = 0; p < 3; ++p) {
-      const double ref = 0.5 * std::sqrt(2.0 / 3.0) * 230 *
-                         (std::cos(2 * kPi * 60 * t1 - 2 * kPi * p / 3) + std::cos(2 * kPi * 60 * t2 - 2 * kPi * p / 3));
+      const double ref =
+          0.5 * std::sqrt(2.0 / 3.0) * 230 *
+          (std::cos(2 * kPi * 60 * t1 - 2 * kPi * p / 3) + std::cos(2 * kPi * 60 * t2 - 2 * kPi * p / 3));
       EXPECT_NEAR(x.u_abc[p], ref, 1e-9);
       EXPECT_NEAR(x.u_abc_true[p], x.u_abc[p], 1e-9);
     }
@@ -62,16 +66,18 @@ TEST(SimSupply, PwmVoltageMeasurementConventions) {
   c.dead_time_s = 2e-6;
   s = run(c, 800);
   double maxd = 0;
-  for (size_t k = 400; k < s.size(); ++k) maxd = std::max(maxd, std::fabs(s[k].u_abc_true[0] - s[k].u_abc[0]));
+  for (size_t k = 400; k < s.size(); ++k)
+    maxd = std::max(maxd, std::fabs(s[k].u_abc_true[0] - s[k].u_abc[0]));
   EXPECT_GT(maxd, 2.0);
   EXPECT_LT(maxd, 400 * 2e-6 / 5e-5 * 1.01);
 }
 
-TEST(SimSensors, QuantisationClippingAndEncoder) {
+TEST(SimSensors, QuantisationClippingAndEncoder)
+{
   imsim_config_t c = ideal("exp1");
   c.ideal_sensors = false;
   c.noise_lsb = 0;
-  c.i_range_a = 10;  // clips the DOL start (peak 16.4 A)
+  c.i_range_a = 10; // clips the DOL start (peak 16.4 A)
   const auto s = run(c, 4000);
   ASSERT_FALSE(s.empty());
   const double lsb_i = 20.0 / 4096, lsb_u = 800.0 / 4096;
@@ -81,8 +87,10 @@ TEST(SimSensors, QuantisationClippingAndEncoder) {
     for (int p = 0; p < 3; ++p) {
       maxi = std::max(maxi, x.i_abc[p]);
       mini = std::min(mini, x.i_abc[p]);
-      if (std::fabs(x.i_abc_true[p]) < 10 - lsb_i) EXPECT_LE(std::fabs(x.i_abc[p] - x.i_abc_true[p]), 0.5 * lsb_i + 1e-12);
-      else ++clipped;
+      if (std::fabs(x.i_abc_true[p]) < 10 - lsb_i)
+        EXPECT_LE(std::fabs(x.i_abc[p] - x.i_abc_true[p]), 0.5 * lsb_i + 1e-12);
+      else
+        ++clipped;
       EXPECT_LE(std::fabs(x.u_abc[p] - x.u_abc_true[p]), 0.5 * lsb_u + 1e-12);
       EXPECT_NEAR(std::remainder(x.i_abc[p], lsb_i), 0.0, 1e-12);
     }
@@ -96,10 +104,11 @@ TEST(SimSensors, QuantisationClippingAndEncoder) {
   EXPECT_NEAR(mini, -10, 1e-12);
 }
 
-TEST(SimSensors, NoiseLevelAndSeedReproducibility) {
+TEST(SimSensors, NoiseLevelAndSeedReproducibility)
+{
   imsim_config_t c;
   imsim_config_preset(&c, "exp1");
-  c.vll_v = 0;  // motor at rest, zero currents: the ADC output is pure noise
+  c.vll_v = 0; // motor at rest, zero currents: the ADC output is pure noise
   c.noise_lsb = 3.0;
   auto a = run(c, 4000), b = run(c, 4000);
   c.seed = 2;
@@ -120,7 +129,8 @@ TEST(SimSensors, NoiseLevelAndSeedReproducibility) {
 
 // AA filter (2nd-order Butterworth): steady-state 60 Hz gain and phase of the measured
 // current against the true current.
-TEST(SimSensors, AntiAliasFilterResponse) {
+TEST(SimSensors, AntiAliasFilterResponse)
+{
   imsim_config_t c = ideal("exp1");
   c.ideal_sensors = false;
   c.adc_bits = 30;
@@ -136,7 +146,7 @@ TEST(SimSensors, AntiAliasFilterResponse) {
   for (size_t k = 0; k < s.size(); k += 50) {
     double ab[2];
     imsim_abc_to_ab(s[k].i_abc, ab);
-    EXPECT_NEAR(std::abs(cd(ab[0], ab[1]) - H * iab(s[k])), 0.0, 4e-8);  // 30-bit ADC LSB 3.7e-8 A
+    EXPECT_NEAR(std::abs(cd(ab[0], ab[1]) - H * iab(s[k])), 0.0, 4e-8); // 30-bit ADC LSB 3.7e-8 A
     imsim_abc_to_ab(s[k].u_abc, ab);
     EXPECT_NEAR(std::abs(cd(ab[0], ab[1]) - H * cd(s[k].u_ab_true[0], s[k].u_ab_true[1])), 0.0, 1e-6);
   }
@@ -144,7 +154,8 @@ TEST(SimSensors, AntiAliasFilterResponse) {
 
 // IFOC: tuned controller keeps |psi_R| at its reference; a detuned T_R (set at run time)
 // moves the flux off the reference.
-TEST(SimIfoc, TunedHoldsFluxDetunedDoesNot) {
+TEST(SimIfoc, TunedHoldsFluxDetunedDoesNot)
+{
   imsim_config_t c = ideal("exp2");
   c.supply = IMSIM_SUPPLY_IFOC;
   static imsim_t sim;
@@ -159,12 +170,13 @@ TEST(SimIfoc, TunedHoldsFluxDetunedDoesNot) {
   for (int k = 0; k < 4000 * 2; ++k) imsim_step(&sim, &s);
   EXPECT_DOUBLE_EQ(s.ifoc_tr_s, 0.06);
   EXPECT_GT(std::fabs(s.psi_r_wb - s.ifoc_flux_ref_wb), 0.05 * s.ifoc_flux_ref_wb);
-  EXPECT_NEAR(s.speed_rad_s * 30 / kPi, 850, 2.0);  // speed loop still holds speed
+  EXPECT_NEAR(s.speed_rad_s * 30 / kPi, 850, 2.0); // speed loop still holds speed
 }
 
 // A bus too low for the reference clips the modulation; the statistics say how often and
 // which bus the reference needs (sine-triangle: 2 sqrt(2/3) V_ll = 375.6 V at 230 V).
-TEST(SimSupply, PwmClippingIsCounted) {
+TEST(SimSupply, PwmClippingIsCounted)
+{
   imsim_config_t c = ideal("exp1");
   c.supply = IMSIM_SUPPLY_PWM;
   static imsim_t sim;
@@ -177,8 +189,10 @@ TEST(SimSupply, PwmClippingIsCounted) {
     imsim_get_pwm_stats(&sim, &st);
     EXPECT_EQ(st.half_periods, 400u * 5u);
     EXPECT_NEAR(st.vdc_needed_v, 2 * std::sqrt(2.0 / 3.0) * 230, 0.01);
-    if (vdc == 400.0) EXPECT_EQ(st.clipped_half_periods, 0u);
-    else EXPECT_EQ(st.clipped_half_periods, st.half_periods);  // some leg beyond +-150 V at every instant
+    if (vdc == 400.0)
+      EXPECT_EQ(st.clipped_half_periods, 0u);
+    else
+      EXPECT_EQ(st.clipped_half_periods, st.half_periods); // some leg beyond +-150 V at every instant
   }
   c.supply = IMSIM_SUPPLY_SINE;
   ASSERT_EQ(imsim_init(&sim, &c, nullptr), 0);

@@ -8,7 +8,8 @@ using namespace simtest;
 // Paper: T_R 0.115 -> 0.09 s, R_S 5 -> 5.8 ohm over ~1 h at rated load (ratios 0.7826, 1.16).
 // Ideal V/f supply, coarse sampling (500 Hz, 1 ms steps) to keep the test fast; the thermal
 // model only sees the copper losses, which this reproduces.
-TEST(SimThermal, OneHourOfExp2ReachesPaperTargets) {
+TEST(SimThermal, OneHourOfExp2ReachesPaperTargets)
+{
   imsim_config_t c;
   imsim_config_preset(&c, "exp2");
   c.ideal_sensors = true;
@@ -27,7 +28,7 @@ TEST(SimThermal, OneHourOfExp2ReachesPaperTargets) {
   EXPECT_NEAR(s.t, 3600.0, 1e-9);
   EXPECT_NEAR(s.tr_s / 0.12, 0.09 / 0.115, 0.01);
   EXPECT_NEAR(s.rs_ohm / 5.04, 5.8 / 5.0, 0.01);
-  EXPECT_GT(tr_10min, s.tr_s);  // monotone heating
+  EXPECT_GT(tr_10min, s.tr_s); // monotone heating
   EXPECT_LT(tr_10min, 0.12);
   EXPECT_GT(s.temp_stator_c, 50.0);
   EXPECT_NEAR(s.load_nm, 2.064, 1e-12);
@@ -35,7 +36,8 @@ TEST(SimThermal, OneHourOfExp2ReachesPaperTargets) {
   EXPECT_NEAR(s.speed_rad_s * 30 / kPi, 843, 3);
 }
 
-TEST(SimThermal, NoThermalKeepsParametersAndSpeedupScalesTime) {
+TEST(SimThermal, NoThermalKeepsParametersAndSpeedupScalesTime)
+{
   imsim_config_t c;
   imsim_config_preset(&c, "exp2");
   c.ideal_sensors = true;
@@ -47,7 +49,7 @@ TEST(SimThermal, NoThermalKeepsParametersAndSpeedupScalesTime) {
   EXPECT_DOUBLE_EQ(s.back().tr_s, 0.12);
   EXPECT_DOUBLE_EQ(s.back().rs_ohm, 5.04);
   c.thermal = true;
-  c.thermal_speedup = 60;  // 60 s behave like one hour
+  c.thermal_speedup = 60; // 60 s behave like one hour
   s = run(c, 500 * 60);
   EXPECT_LT(s.back().tr_s, 0.12 * 0.85);
 }

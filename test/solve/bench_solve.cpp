@@ -13,7 +13,8 @@
 #include "bg_select.h"
 #include "bg_tables.h"
 
-int main(int argc, char **argv) {
+int main(int argc, char **argv)
+{
   const long reps = (argc > 1) ? std::atol(argv[1]) : 20000;
   std::ifstream f(IMEST_TESTVECTOR);
   const auto j = nlohmann::json::parse(f);
@@ -47,7 +48,7 @@ int main(int argc, char **argv) {
 #endif
   std::printf("bg_solve (%s Sturm chain): %.2f us per solve over %ld repetitions; T_R = %.9g s\n", chain, us,
               reps, o.tr_s);
-  std::printf("roots %u, work %u (Sturm %u, bisect %u, polish %u, quality %u); no allocation\n", o.n_roots, o.work,
-              st.roots.sturm_evals, st.roots.bisect_steps, st.roots.polish_evals, st.quality_evals);
+  std::printf("roots %u, work %u (Sturm %u, bisect %u, polish %u, quality %u); no allocation\n", o.n_roots,
+              o.work, st.roots.sturm_evals, st.roots.bisect_steps, st.roots.polish_evals, st.quality_evals);
   return 0;
 }

@@ -26,7 +26,8 @@
 
 namespace solvetest {
 
-inline const nlohmann::json &testvector() {
+inline const nlohmann::json &testvector()
+{
   static const nlohmann::json j = [] {
     std::ifstream f(IMEST_TESTVECTOR);
     return nlohmann::json::parse(f);
@@ -34,7 +35,8 @@ inline const nlohmann::json &testvector() {
   return j;
 }
 
-inline bg_sums_t tv_sums() {
+inline bg_sums_t tv_sums()
+{
   const auto &j = testvector();
   bg_sums_t s{};
   for (int i = 0; i < 8; ++i) {
@@ -45,7 +47,8 @@ inline bg_sums_t tv_sums() {
   return s;
 }
 
-inline bg_solve_cfg_t default_cfg(double sigma = 0.096, double ls = 0.2908) {
+inline bg_solve_cfg_t default_cfg(double sigma = 0.096, double ls = 0.2908)
+{
   bg_solve_cfg_t c{};
   c.sigma = sigma;
   c.ls_h = ls;
@@ -56,7 +59,8 @@ inline bg_solve_cfg_t default_cfg(double sigma = 0.096, double ls = 0.2908) {
 }
 
 // K = [K1..K8] from (K1, K2)
-inline void kvec(long double k1, long double k2, long double K[8]) {
+inline void kvec(long double k1, long double k2, long double K[8])
+{
   K[0] = k1;
   K[1] = k2;
   K[2] = k2 * k2;
@@ -68,7 +72,8 @@ inline void kvec(long double k1, long double k2, long double K[8]) {
 }
 
 // E_p^2 = R_y - 2 R_Wy'K + K'R_W K in long double (independent of the e-tables).
-inline long double e_ref(const bg_sums_t &s, long double k1, long double k2) {
+inline long double e_ref(const bg_sums_t &s, long double k1, long double k2)
+{
   long double K[8];
   kvec(k1, k2, K);
   long double e = s.ry;
@@ -80,7 +85,8 @@ inline long double e_ref(const bg_sums_t &s, long double k1, long double k2) {
 }
 
 // Exact K1 minimiser of E for fixed K2: E = A K1^2 + B K1 + C.
-inline long double k1_opt_ref(const bg_sums_t &s, long double k2, long double *profile = nullptr) {
+inline long double k1_opt_ref(const bg_sums_t &s, long double k2, long double *profile = nullptr)
+{
   const long double u[8] = {0, k2, k2 * k2, 0, 1 / k2, 0, 0, 1 / (k2 * k2)};
   const long double v[8] = {1, 0, 0, k2, 0, 1 / k2, 1 / (k2 * k2), 0};
   long double vRv = 0, vRu = 0, gv = 0;
@@ -112,7 +118,8 @@ struct Sample {
 };
 
 // W (2x8) and, with y := W K_true + noise, the sums. Formulas of docs/METHOD.md §2.
-inline void regressor(const Motor &mo, const Sample &q, double W[2][8]) {
+inline void regressor(const Motor &mo, const Sample &q, double W[2][8])
+{
   const double n = mo.np, m = mo.m(), s = mo.s(), w = q.w, wp = q.dw;
   W[0][0] = -q.dix;
   W[1][0] = -q.diy;
@@ -130,14 +137,17 @@ inline void regressor(const Motor &mo, const Sample &q, double W[2][8]) {
   W[1][5] = -n * wp * q.ix - n * n * w * w * q.iy;
   W[0][6] = n * n * (w * wp * q.ix - w * w * q.dix);
   W[1][6] = n * n * (w * wp * q.iy - w * w * q.diy);
-  W[0][7] = n * n * (w * wp * q.dix - w * w * q.d2ix + (w * w * q.dux - w * wp * q.ux) / s) + n * n * n * w * w * w * q.diy;
-  W[1][7] = n * n * (w * wp * q.diy - w * w * q.d2iy + (w * w * q.duy - w * wp * q.uy) / s) - n * n * n * w * w * w * q.dix;
+  W[0][7] = n * n * (w * wp * q.dix - w * w * q.d2ix + (w * w * q.dux - w * wp * q.ux) / s) +
+            n * n * n * w * w * w * q.diy;
+  W[1][7] = n * n * (w * wp * q.diy - w * w * q.d2iy + (w * w * q.duy - w * wp * q.uy) / s) -
+            n * n * n * w * w * w * q.dix;
 }
 
 // Random but realistic window: signals are sums of a few random sinusoids with
 // amplitudes typical of a 30..60 Hz drive (currents ~2 A, voltages ~150 V,
 // speed ~100..180 rad/s); y = W K_true + relative noise. Sums in float64.
-inline bg_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double noise_rel, int nsamp = 2000) {
+inline bg_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double noise_rel, int nsamp = 2000)
+{
   std::uniform_real_distribution<double> U(0, 1);
   const double fs = 4000.0;
   struct Sin {
@@ -165,7 +175,7 @@ inline bg_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double no
   std::normal_distribution<double> N(0, 1);
   for (int n = 0; n < nsamp; ++n) {
     const double t = n / fs;
-    Sample q{ev(six, t, 0), ev(siy, t, 0), ev(six, t, 1), ev(siy, t, 1), ev(six, t, 2), ev(siy, t, 2),
+    Sample q{ev(six, t, 0), ev(siy, t, 0), ev(six, t, 1), ev(siy, t, 1), ev(six, t, 2),     ev(siy, t, 2),
              ev(sux, t, 0), ev(suy, t, 0), ev(sux, t, 1), ev(suy, t, 1), w0 + ev(sw, t, 0), ev(sw, t, 1)};
     double W[2][8];
     regressor(mo, q, W);
@@ -200,7 +210,8 @@ inline bg_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double no
 // spurious minimum at K2 ~ n_p w). steady: nearly constant speed and slowly
 // varying rotor-frame currents (a loaded steady state), else synthetic_sums'.
 inline bg_sums_t eiv_sums(std::mt19937_64 &rng, const Motor &mo, double d2_noise_rel, int nsamp = 2000,
-                             bool steady = false) {
+                          bool steady = false)
+{
   std::uniform_real_distribution<double> U(0, 1);
   const double fs = 4000.0;
   struct Sin {
@@ -237,7 +248,7 @@ inline bg_sums_t eiv_sums(std::mt19937_64 &rng, const Motor &mo, double d2_noise
   std::normal_distribution<double> N(0, 1);
   for (int n = 0; n < nsamp; ++n) {
     const double t = n / fs;
-    Sample q{ev(six, t, 0), ev(siy, t, 0), ev(six, t, 1), ev(siy, t, 1), ev(six, t, 2), ev(siy, t, 2),
+    Sample q{ev(six, t, 0), ev(siy, t, 0), ev(six, t, 1), ev(siy, t, 1), ev(six, t, 2),     ev(siy, t, 2),
              ev(sux, t, 0), ev(suy, t, 0), ev(sux, t, 1), ev(suy, t, 1), w0 + ev(sw, t, 0), ev(sw, t, 1)};
     double W[2][8];
     regressor(mo, q, W);
@@ -270,4 +281,4 @@ inline bg_sums_t eiv_sums(std::mt19937_64 &rng, const Motor &mo, double d2_noise
   return S;
 }
 
-}  // namespace solvetest
+} // namespace solvetest

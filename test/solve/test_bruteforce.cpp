@@ -27,12 +27,14 @@ struct Bf {
 };
 
 // weight of the speed-normalised cost: E_w = E_p^2 K2^4 / (K2^2 + c)^2
-long double wgt(long double k2, double c) {
+long double wgt(long double k2, double c)
+{
   const long double d = k2 * k2 + c;
   return k2 * k2 * k2 * k2 / (d * d);
 }
 
-Bf brute_force(const bg_sums_t &s, const bg_solve_cfg_t &cfg) {
+Bf brute_force(const bg_sums_t &s, const bg_solve_cfg_t &cfg)
+{
   const double wc = cfg.weight_c;
   const int N = 20000;
   const double lo = std::log(1 / cfg.tr_max_s), hi = std::log(1 / cfg.tr_min_s);
@@ -51,7 +53,8 @@ Bf brute_force(const bg_sums_t &s, const bg_solve_cfg_t &cfg) {
     }
   }
   if (best <= 0 || best >= N - 1 || !adm[(size_t)best - 1] || !adm[(size_t)best + 1]) return {false, 0, 0, 0};
-  long double a = std::exp(lo + (hi - lo) * (best - 1) / (N - 1)), b = std::exp(lo + (hi - lo) * (best + 1) / (N - 1));
+  long double a = std::exp(lo + (hi - lo) * (best - 1) / (N - 1)),
+              b = std::exp(lo + (hi - lo) * (best + 1) / (N - 1));
   const long double g = 0.6180339887498948482L;
   auto f = [&](long double k2) {
     long double e;
@@ -80,7 +83,8 @@ Bf brute_force(const bg_sums_t &s, const bg_solve_cfg_t &cfg) {
   return {true, (double)k1, (double)k2, (double)(e * wgt(k2, wc))};
 }
 
-int companion_roots_in_band(const bg_sums_t &s, const bg_solve_cfg_t &cfg) {
+int companion_roots_in_band(const bg_sums_t &s, const bg_solve_cfg_t &cfg)
+{
   bg_tables_t t;
   if (bg_tables_build(&s, cfg.tr_nominal_s, &t) != IMEST_OK) return -1;
   if (cfg.weight_c > 0) bg_tables_weight(&t, cfg.weight_c);
@@ -97,14 +101,16 @@ int companion_roots_in_band(const bg_sums_t &s, const bg_solve_cfg_t &cfg) {
     const double k2 = z.real() * t.s;
     if (std::fabs(z.imag()) <= 1e-7 * std::abs(z) && k2 >= 1 / cfg.tr_max_s && k2 <= 1 / cfg.tr_min_s) {
       ++n;
-      if (std::getenv("SOLVE_DUMP")) std::printf("  companion root K2 = %.17g (im %.3g)\n", k2, z.imag() * t.s);
+      if (std::getenv("SOLVE_DUMP"))
+        std::printf("  companion root K2 = %.17g (im %.3g)\n", k2, z.imag() * t.s);
     }
   }
   return n;
 }
 
 void check_case(const bg_sums_t &s, const bg_solve_cfg_t &cfg, const char *name, int *skipped,
-                double *worst_k2, double *worst_e) {
+                double *worst_k2, double *worst_e)
+{
   bg_solve_out_t o;
   const int st = bg_solve(&s, &cfg, &o);
   const Bf bf = brute_force(s, cfg);
@@ -112,8 +118,8 @@ void check_case(const bg_sums_t &s, const bg_solve_cfg_t &cfg, const char *name,
   unsigned in_band = 0;
   for (unsigned i = 0; i < o.n_roots; ++i)
     in_band += o.roots_k2[i] >= 1 / cfg.tr_max_s && o.roots_k2[i] <= 1 / cfg.tr_min_s;
-  EXPECT_EQ((int)in_band, companion_roots_in_band(s, cfg)) << name << " roots " << o.n_roots << " first "
-                                                          << o.roots_k2[0];
+  EXPECT_EQ((int)in_band, companion_roots_in_band(s, cfg))
+      << name << " roots " << o.n_roots << " first " << o.roots_k2[0];
   if (!bf.ok) {
     ++*skipped;
     return;
@@ -129,9 +135,10 @@ void check_case(const bg_sums_t &s, const bg_solve_cfg_t &cfg, const char *name,
   EXPECT_LE(o.e_w, bf.e + 1e-9 * (bf.e + 1e-3 * s.ry)) << name;
 }
 
-}  // namespace
+} // namespace
 
-TEST(BruteForce, Testvector) {
+TEST(BruteForce, Testvector)
+{
   int skipped = 0;
   double wk = 0, we = 0;
   check_case(tv_sums(), default_cfg(), "testvector", &skipped, &wk, &we);
@@ -139,7 +146,8 @@ TEST(BruteForce, Testvector) {
   std::printf("[brute-force] testvector: K2 rel diff %.2g, E rel diff %.2g\n", wk, we);
 }
 
-TEST(BruteForce, RealisticRandomSums) {
+TEST(BruteForce, RealisticRandomSums)
+{
   std::mt19937_64 rng(424242);
   std::uniform_real_distribution<double> U(0, 1);
   int skipped = 0, n = 0, near_true = 0;
@@ -158,9 +166,10 @@ TEST(BruteForce, RealisticRandomSums) {
     if (bg_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
     ++n;
   }
-  std::printf("[brute-force] %d realistic windows: %d skipped (minimum at band edge / K1 boundary), worst K2 rel "
-              "diff %.2g, worst E rel diff %.2g; %d within 5 %% of the true T_R\n",
-              n, skipped, wk, we, near_true);
+  std::printf(
+      "[brute-force] %d realistic windows: %d skipped (minimum at band edge / K1 boundary), worst K2 rel "
+      "diff %.2g, worst E rel diff %.2g; %d within 5 %% of the true T_R\n",
+      n, skipped, wk, we, near_true);
   EXPECT_LE(skipped, n / 10);
 }
 
@@ -168,7 +177,8 @@ TEST(BruteForce, RealisticRandomSums) {
 // current-weighted n_p^2 w^2, as the background task sets it): the solver's
 // selection is the global admissible minimum of E_w; the roots in the band of
 // the degree-19 weighted resultant equal the companion's.
-TEST(BruteForce, WeightedCostRealisticRandomSums) {
+TEST(BruteForce, WeightedCostRealisticRandomSums)
+{
   std::mt19937_64 rng(8675309);
   std::uniform_real_distribution<double> U(0, 1);
   int skipped = 0, n = 0, near_true = 0;
@@ -183,15 +193,17 @@ TEST(BruteForce, WeightedCostRealisticRandomSums) {
     cfg.weight_c = bg_solve_weight_c(&s);
     ASSERT_GT(cfg.weight_c, 0.0);
     char name[80];
-    std::snprintf(name, sizeof name, "weighted case %d (T_R %.3f, noise %.1e, c %.3g)", it, mo.tr, noise, cfg.weight_c);
+    std::snprintf(name, sizeof name, "weighted case %d (T_R %.3f, noise %.1e, c %.3g)", it, mo.tr, noise,
+                  cfg.weight_c);
     check_case(s, cfg, name, &skipped, &wk, &we);
     bg_solve_out_t o;
     if (bg_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
     ++n;
   }
-  std::printf("[brute-force, weighted] %d realistic windows: %d skipped, worst K2 rel diff %.2g, worst E_w rel diff "
-              "%.2g; %d within 5 %% of the true T_R\n",
-              n, skipped, wk, we, near_true);
+  std::printf(
+      "[brute-force, weighted] %d realistic windows: %d skipped, worst K2 rel diff %.2g, worst E_w rel diff "
+      "%.2g; %d within 5 %% of the true T_R\n",
+      n, skipped, wk, we, near_true);
   EXPECT_LE(skipped, n / 10);
 }
 
@@ -201,7 +213,8 @@ TEST(BruteForce, WeightedCostRealisticRandomSums) {
 // with 12-bit sensors, docs/METHOD.md §9) the paper's E_p^2 minimum is pulled
 // towards small T_R (the spurious K2 ~ n_p w in the limit: at 400 x some
 // windows land there); the speed-normalised E_w stays at the true T_R.
-TEST(WeightedCost, ErrorsInVariablesPullThePapersMinimumTowardsSmallTR) {
+TEST(WeightedCost, ErrorsInVariablesPullThePapersMinimumTowardsSmallTR)
+{
   std::mt19937_64 rng(2024);
   int paper_off = 0, weighted_true = 0, n = 0;
   double worst_w = 0;
@@ -214,12 +227,12 @@ TEST(WeightedCost, ErrorsInVariablesPullThePapersMinimumTowardsSmallTR) {
     cfg.weight_c = bg_solve_weight_c(&s);
     const int sw = bg_solve(&s, &cfg, &ow);
     if (n < 3)
-      std::printf("[weighted] case %d: n_p w %.1f 1/s; paper T_R %.5f s, weighted T_R %.5f s (true %.3f)\n", it,
-                  std::sqrt(cfg.weight_c), op.tr_s, ow.tr_s, mo.tr);
+      std::printf("[weighted] case %d: n_p w %.1f 1/s; paper T_R %.5f s, weighted T_R %.5f s (true %.3f)\n",
+                  it, std::sqrt(cfg.weight_c), op.tr_s, ow.tr_s, mo.tr);
     ++n;
     ASSERT_EQ(sw, IMEST_OK);
-    if (sp == IMEST_OK) EXPECT_LT(op.tr_s, mo.tr) << it;  // biased towards small T_R
-    if (sp != IMEST_OK || op.tr_s < 0.95 * mo.tr) ++paper_off;  // or no admissible root at all
+    if (sp == IMEST_OK) EXPECT_LT(op.tr_s, mo.tr) << it;       // biased towards small T_R
+    if (sp != IMEST_OK || op.tr_s < 0.95 * mo.tr) ++paper_off; // or no admissible root at all
     const double ew = std::fabs(ow.tr_s - mo.tr) / mo.tr;
     worst_w = std::max(worst_w, ew);
     if (ew < 0.02) ++weighted_true;
@@ -227,8 +240,9 @@ TEST(WeightedCost, ErrorsInVariablesPullThePapersMinimumTowardsSmallTR) {
     EXPECT_NEAR(ow.e, (double)e_ref(s, ow.k1, ow.k2), 1e-9 * s.ry) << it;
     EXPECT_LT(ow.e_w, ow.e) << it;
   }
-  std::printf("[weighted] %d windows: paper's cost > 5 %% low in %d; weighted within 2 %% in %d (worst %.2g %%)\n", n,
-              paper_off, weighted_true, 100 * worst_w);
+  std::printf(
+      "[weighted] %d windows: paper's cost > 5 %% low in %d; weighted within 2 %% in %d (worst %.2g %%)\n", n,
+      paper_off, weighted_true, 100 * worst_w);
   EXPECT_GE(paper_off, n / 2);
   EXPECT_EQ(weighted_true, n);
 }

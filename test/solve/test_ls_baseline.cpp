@@ -9,7 +9,8 @@
 
 #include "solve_util.hpp"
 
-TEST(LsBaseline, ConstrainedBeatsOverParameterisedLs) {
+TEST(LsBaseline, ConstrainedBeatsOverParameterisedLs)
+{
   const bg_sums_t s = solvetest::tv_sums();
   const int cols[7] = {0, 1, 3, 4, 5, 6, 7};
   Eigen::MatrixXd A(7, 7);
@@ -22,7 +23,7 @@ TEST(LsBaseline, ConstrainedBeatsOverParameterisedLs) {
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
   svd.setThreshold(1e-12);
   const Eigen::VectorXd z = svd.solve(b);
-  const Eigen::VectorXd x = z.cwiseProduct(d);  // K1, K2, K4..K8 (K3 folded into K4)
+  const Eigen::VectorXd x = z.cwiseProduct(d); // K1, K2, K4..K8 (K3 folded into K4)
   const double tr_ls = 1 / x[1], tr_ls_k5 = x[3];
   const Eigen::VectorXd sv = svd.singularValues();
   bg_solve_out_t o;

@@ -10,9 +10,13 @@
 
 namespace {
 
-double R(const bg_sums_t &s, int i, int j) { return s.rw[i - 1][j - 1]; }
+double R(const bg_sums_t &s, int i, int j)
+{
+  return s.rw[i - 1][j - 1];
+}
 
-bg_sums_t random_psd(std::mt19937_64 &rng, bool structured, double m) {
+bg_sums_t random_psd(std::mt19937_64 &rng, bool structured, double m)
+{
   std::normal_distribution<double> N(0, 1);
   double A[12][8];
   for (auto &row : A)
@@ -25,15 +29,16 @@ bg_sums_t random_psd(std::mt19937_64 &rng, bool structured, double m) {
   for (int i = 0; i < 8; ++i) {
     for (int j = 0; j < 8; ++j)
       for (int k = 0; k < 12; ++k) s.rw[i][j] += A[k][i] * A[k][j];
-    for (int k = 0; k < 12; ++k) s.rwy[i] += A[k][i] * y[k];  // R_Wy = A'y: structured with A
+    for (int k = 0; k < 12; ++k) s.rwy[i] += A[k][i] * y[k]; // R_Wy = A'y: structured with A
   }
   s.ry = 10 + std::fabs(N(rng));
   return s;
 }
 
-}  // namespace
+} // namespace
 
-TEST(Resultant, GenericDegree20) {
+TEST(Resultant, GenericDegree20)
+{
   std::mt19937_64 rng(7);
   for (int it = 0; it < 500; ++it) {
     const bg_sums_t s = random_psd(rng, false, 0);
@@ -41,7 +46,7 @@ TEST(Resultant, GenericDegree20) {
     bg_tables_scaled(&s, 0, 0, 0, &t);
     double rw[22];
     bg_resultant(&t, rw, 1);
-    EXPECT_EQ(rw[0], 0.0);  // weight 0: r_w = kappa r
+    EXPECT_EQ(rw[0], 0.0); // weight 0: r_w = kappa r
     const double *r = rw + 1;
     double mag = 0;
     for (int k = 0; k < 21; ++k) mag = std::max(mag, std::fabs(r[k]));
@@ -64,7 +69,8 @@ TEST(Resultant, GenericDegree20) {
   }
 }
 
-TEST(Resultant, StructuredDegree18) {
+TEST(Resultant, StructuredDegree18)
+{
   std::mt19937_64 rng(11);
   const double m = (1 - 0.096) / 0.096;
   for (int it = 0; it < 500; ++it) {
@@ -95,7 +101,8 @@ TEST(Resultant, StructuredDegree18) {
 // e1[7]^2) = 32 R44 (R33 R44 - R34^2) = 0) and r_w[19] = r[18] (cw-free).
 // Defining property: r_w(kappa) = a1^2 p2w(k = -a0/a1) with
 // p2w = (kappa^2 + cw) dP/dkappa - 4 kappa P, P = sum (e2 k^2 + e1 k + e0) kappa^m.
-TEST(Resultant, WeightedStructuredDegree19) {
+TEST(Resultant, WeightedStructuredDegree19)
+{
   std::mt19937_64 rng(13);
   std::uniform_real_distribution<double> U(0, 1);
   const double m = (1 - 0.096) / 0.096;

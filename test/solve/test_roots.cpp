@@ -49,13 +49,14 @@ namespace {
 using cd = std::complex<long double>;
 
 struct Poly {
-  std::vector<double> c;  // ascending
-  bool separated;         // all distinct roots >= 1e-3 relative apart, all simple
+  std::vector<double> c; // ascending
+  bool separated;        // all distinct roots >= 1e-3 relative apart, all simple
 };
 
 // coefficients of prod (x - r) over real roots and complex pairs, in long double
-std::vector<double> from_roots(const std::vector<long double> &real, const std::vector<cd> &pairs, long double lead,
-                               int zero_mult) {
+std::vector<double> from_roots(const std::vector<long double> &real, const std::vector<cd> &pairs,
+                               long double lead, int zero_mult)
+{
   std::vector<long double> p{lead};
   auto mul = [&](const std::vector<long double> &f) {
     std::vector<long double> q(p.size() + f.size() - 1, 0);
@@ -69,7 +70,8 @@ std::vector<double> from_roots(const std::vector<long double> &real, const std::
   return std::vector<double>(p.begin(), p.end());
 }
 
-Poly make_poly(std::mt19937_64 &rng, int family) {
+Poly make_poly(std::mt19937_64 &rng, int family)
+{
   std::uniform_real_distribution<double> U(0, 1);
   auto logu = [&](double lo, double hi) { return std::pow(10.0, lo + (hi - lo) * U(rng)); };
   const int deg = 1 + (int)(U(rng) * 20);
@@ -90,85 +92,85 @@ Poly make_poly(std::mt19937_64 &rng, int family) {
   };
   int zero_mult = 0;
   switch (family) {
-    case 0: {  // random coefficients, some exactly zero
+  case 0: { // random coefficients, some exactly zero
+    Poly p;
+    p.separated = false;
+    p.c.resize((size_t)deg + 1);
+    std::normal_distribution<double> N(0, 1);
+    for (auto &v : p.c) v = (U(rng) < 0.25) ? 0.0 : N(rng) * logu(-2, 2);
+    if (p.c.back() == 0.0) p.c.back() = 1.0;
+    return p;
+  }
+  case 1: { // separated positive roots in [1e-3, 1e3]
+    const int np = (int)(U(rng) * std::min(deg, 8) + 0.5);
+    for (int k = 0; k < np; ++k) real.push_back(logu(-3, 3));
+    fill_rest(np);
+    break;
+  }
+  case 2: { // clusters of 2..3 close simple roots, separation 1e-6 .. 1e-2
+    int used = 0;
+    while (used + 3 <= std::min(deg, 12)) {
+      const double x = logu(-2, 2), sep = logu(-6, -2);
+      const int m = 2 + (U(rng) < 0.5);
+      for (int k = 0; k < m; ++k) real.push_back(x * (1 + k * sep));
+      used += m;
+    }
+    if (used == 0) real.push_back(logu(-2, 2)), used = 1;
+    separated = false;
+    fill_rest(used);
+    break;
+  }
+  case 3: { // double and triple roots
+    int used = 0;
+    while (used + 3 <= std::min(deg, 12)) {
+      const double x = logu(-2, 2);
+      const int m = 2 + (U(rng) < 0.4);
+      for (int k = 0; k < m; ++k) real.push_back(x);
+      used += m;
+      if (U(rng) < 0.5) real.push_back(logu(-2, 2)), ++used;
+    }
+    if (used == 0) real.push_back(1.5), real.push_back(1.5), used = 2;
+    separated = false;
+    fill_rest(used);
+    break;
+  }
+  case 4: { // roots near 0 and large roots
+    const int np = 1 + (int)(U(rng) * std::min(deg - 1, 6));
+    for (int k = 0; k < np; ++k) real.push_back(U(rng) < 0.5 ? logu(-8, -4) : logu(4, 8));
+    fill_rest(np);
+    break;
+  }
+  case 5: { // roots near 1 (the p / reversed-p split), incl. exactly 1
+    const int np = 1 + (int)(U(rng) * std::min(deg - 1, 3));
+    for (int k = 0; k < np; ++k) {
+      const double d = (k == 0 && U(rng) < 0.3) ? 0.0 : logu(-12, -3) * (U(rng) < 0.5 ? -1 : 1);
+      real.push_back(1.0L + (long double)d * (1 + k));
+    }
+    std::sort(real.begin(), real.end());
+    for (size_t k = 1; k < real.size(); ++k)
+      if ((real[k] - real[k - 1]) / real[k] < 1e-3) separated = false;
+    fill_rest(np);
+    break;
+  }
+  default: { // exact zeros: roots at 0, sparse polynomials like a x^k - b
+    if (U(rng) < 0.5) {
       Poly p;
-      p.separated = false;
-      p.c.resize((size_t)deg + 1);
-      std::normal_distribution<double> N(0, 1);
-      for (auto &v : p.c) v = (U(rng) < 0.25) ? 0.0 : N(rng) * logu(-2, 2);
-      if (p.c.back() == 0.0) p.c.back() = 1.0;
+      p.separated = true;
+      const int k = 1 + (int)(U(rng) * 19);
+      p.c.assign((size_t)k + 1, 0.0);
+      p.c[0] = -logu(-3, 3);
+      p.c[(size_t)k] = logu(-3, 3);
+      zero_mult = (int)(U(rng) * 3);
+      if (zero_mult + k > 20) zero_mult = 20 - k;
+      p.c.insert(p.c.begin(), (size_t)zero_mult, 0.0);
       return p;
     }
-    case 1: {  // separated positive roots in [1e-3, 1e3]
-      const int np = (int)(U(rng) * std::min(deg, 8) + 0.5);
-      for (int k = 0; k < np; ++k) real.push_back(logu(-3, 3));
-      fill_rest(np);
-      break;
-    }
-    case 2: {  // clusters of 2..3 close simple roots, separation 1e-6 .. 1e-2
-      int used = 0;
-      while (used + 3 <= std::min(deg, 12)) {
-        const double x = logu(-2, 2), sep = logu(-6, -2);
-        const int m = 2 + (U(rng) < 0.5);
-        for (int k = 0; k < m; ++k) real.push_back(x * (1 + k * sep));
-        used += m;
-      }
-      if (used == 0) real.push_back(logu(-2, 2)), used = 1;
-      separated = false;
-      fill_rest(used);
-      break;
-    }
-    case 3: {  // double and triple roots
-      int used = 0;
-      while (used + 3 <= std::min(deg, 12)) {
-        const double x = logu(-2, 2);
-        const int m = 2 + (U(rng) < 0.4);
-        for (int k = 0; k < m; ++k) real.push_back(x);
-        used += m;
-        if (U(rng) < 0.5) real.push_back(logu(-2, 2)), ++used;
-      }
-      if (used == 0) real.push_back(1.5), real.push_back(1.5), used = 2;
-      separated = false;
-      fill_rest(used);
-      break;
-    }
-    case 4: {  // roots near 0 and large roots
-      const int np = 1 + (int)(U(rng) * std::min(deg - 1, 6));
-      for (int k = 0; k < np; ++k) real.push_back(U(rng) < 0.5 ? logu(-8, -4) : logu(4, 8));
-      fill_rest(np);
-      break;
-    }
-    case 5: {  // roots near 1 (the p / reversed-p split), incl. exactly 1
-      const int np = 1 + (int)(U(rng) * std::min(deg - 1, 3));
-      for (int k = 0; k < np; ++k) {
-        const double d = (k == 0 && U(rng) < 0.3) ? 0.0 : logu(-12, -3) * (U(rng) < 0.5 ? -1 : 1);
-        real.push_back(1.0L + (long double)d * (1 + k));
-      }
-      std::sort(real.begin(), real.end());
-      for (size_t k = 1; k < real.size(); ++k)
-        if ((real[k] - real[k - 1]) / real[k] < 1e-3) separated = false;
-      fill_rest(np);
-      break;
-    }
-    default: {  // exact zeros: roots at 0, sparse polynomials like a x^k - b
-      if (U(rng) < 0.5) {
-        Poly p;
-        p.separated = true;
-        const int k = 1 + (int)(U(rng) * 19);
-        p.c.assign((size_t)k + 1, 0.0);
-        p.c[0] = -logu(-3, 3);
-        p.c[(size_t)k] = logu(-3, 3);
-        zero_mult = (int)(U(rng) * 3);
-        if (zero_mult + k > 20) zero_mult = 20 - k;
-        p.c.insert(p.c.begin(), (size_t)zero_mult, 0.0);
-        return p;
-      }
-      const int np = (int)(U(rng) * std::min(deg, 5));
-      for (int k = 0; k < np; ++k) real.push_back(logu(-2, 2));
-      zero_mult = std::min(3, deg - np);
-      fill_rest(np + zero_mult);
-      break;
-    }
+    const int np = (int)(U(rng) * std::min(deg, 5));
+    for (int k = 0; k < np; ++k) real.push_back(logu(-2, 2));
+    zero_mult = std::min(3, deg - np);
+    fill_rest(np + zero_mult);
+    break;
+  }
   }
   if (separated) {
     std::vector<long double> pos;
@@ -184,21 +186,22 @@ Poly make_poly(std::mt19937_64 &rng, int family) {
   return p;
 }
 
-double abs_sum(const std::vector<double> &c, double x) {
+double abs_sum(const std::vector<double> &c, double x)
+{
   double p = 0;
   for (int k = (int)c.size() - 1; k >= 0; --k) p = p * x + std::fabs(c[(size_t)k]);
   return p;
 }
 
-double deriv(const std::vector<double> &c, double x, int m) {
+double deriv(const std::vector<double> &c, double x, int m)
+{
   long double p = 0;
   for (int k = (int)c.size() - 1; k >= m; --k) {
     long double f = 1;
     for (int i = 0; i < m; ++i) f *= (k - i);
     p = p * x + f * c[(size_t)k];
   }
-  for (int i = 0; i < (int)m && false; ++i) {
-  }
+  for (int i = 0; i < (int)m && false; ++i) {}
   return (double)p;
 }
 
@@ -209,7 +212,8 @@ struct Cluster {
   double diam;
 };
 
-std::vector<Cluster> clusters(const std::vector<std::complex<double>> &ev) {
+std::vector<Cluster> clusters(const std::vector<std::complex<double>> &ev)
+{
   const size_t n = ev.size();
   std::vector<int> id(n);
   for (size_t i = 0; i < n; ++i) id[i] = (int)i;
@@ -238,7 +242,8 @@ std::vector<Cluster> clusters(const std::vector<std::complex<double>> &ev) {
   return out;
 }
 
-std::string coefs(const std::vector<double> &c) {
+std::string coefs(const std::vector<double> &c)
+{
   if (!std::getenv("SOLVE_DUMP")) return "";
   std::string s = " coefs:";
   char b[40];
@@ -249,17 +254,19 @@ std::string coefs(const std::vector<double> &c) {
   return s;
 }
 
-const char *family_name[] = {"random_coeffs", "separated", "clustered", "multiple", "near0_large", "near1",
-                             "zero_coeffs"};
+const char *family_name[] = {"random_coeffs", "separated", "clustered",  "multiple",
+                             "near0_large",   "near1",     "zero_coeffs"};
 
-}  // namespace
+} // namespace
 
-TEST(SturmVsCompanion, RandomFamilies) {
+TEST(SturmVsCompanion, RandomFamilies)
+{
   std::mt19937_64 rng(20240601);
   const int per_family = 600;
   unsigned max_evals = 0, max_bisect = 0, max_polish = 0;
   for (int fam = 0; fam < 7; ++fam) {
-    int n_rescues = 0, n_cases = 0, n_missed = 0, n_must = 0, n_missed_must = 0, n_roots = 0, n_unresolved = 0;
+    int n_rescues = 0, n_cases = 0, n_missed = 0, n_must = 0, n_missed_must = 0, n_roots = 0,
+        n_unresolved = 0;
     double worst_sep_err = 0, worst_backward = 0;
     for (int it = 0; it < per_family; ++it) {
       const Poly P = make_poly(rng, fam);
@@ -301,7 +308,8 @@ TEST(SturmVsCompanion, RandomFamilies) {
       const double u_chain = SOLVE_CHAIN_F32 ? 1e-5 : 1e-12;
       for (const auto &c : cl) {
         const double x = c.mean.real();
-        const bool realpos = x > 0 && (c.all_real || (std::fabs(c.mean.imag()) <= 1e-6 * x && (c.size % 2 == 1)));
+        const bool realpos =
+            x > 0 && (c.all_real || (std::fabs(c.mean.imag()) <= 1e-6 * x && (c.size % 2 == 1)));
         if (!realpos) continue;
         ++expected;
         double fact = 1;
@@ -362,11 +370,11 @@ TEST(SturmVsCompanion, RandomFamilies) {
       }
     }
     std::printf("[sturm-vs-companion] %-13s cases %4d roots found %5d, resolvable %5d (missed %d), "
-                "unresolvable missed %d, unresolved clusters %d, rescues %d, worst rel err %.2g, worst backward err %.2g\n",
-                family_name[fam], n_cases, n_roots, n_must, n_missed_must, n_missed - n_missed_must, n_unresolved, n_rescues,
-                worst_sep_err,
-                worst_backward);
-    if (fam != 4) EXPECT_LE(worst_sep_err, 1e-9) << family_name[fam];  // near 0: companion abs. error
+                "unresolvable missed %d, unresolved clusters %d, rescues %d, worst rel err %.2g, worst "
+                "backward err %.2g\n",
+                family_name[fam], n_cases, n_roots, n_must, n_missed_must, n_missed - n_missed_must,
+                n_unresolved, n_rescues, worst_sep_err, worst_backward);
+    if (fam != 4) EXPECT_LE(worst_sep_err, 1e-9) << family_name[fam]; // near 0: companion abs. error
   }
   std::printf("[sturm-vs-companion] chain %s: max Sturm evals %u, bisect steps %u, polish evals %u\n",
               SOLVE_CHAIN_F32 ? "float32" : "float64", max_evals, max_bisect, max_polish);
@@ -376,7 +384,8 @@ TEST(SturmVsCompanion, RandomFamilies) {
   EXPECT_LE(max_polish, BG_ROOTS_BOUND_POLISH);
 }
 
-TEST(SturmVsCompanion, BadInput) {
+TEST(SturmVsCompanion, BadInput)
+{
   double r[20];
   const double zero[5] = {0, 0, 0, 0, 0};
   EXPECT_EQ(bg_roots_positive(zero, 4, r, 20), -1);
@@ -387,17 +396,17 @@ TEST(SturmVsCompanion, BadInput) {
   EXPECT_EQ(bg_roots_positive(zero, 21, r, 20), -1);
   const double cst[3] = {2, 0, 0};
   EXPECT_EQ(bg_roots_positive(cst, 2, r, 20), 0);
-  const double lin[2] = {-3, 2};  // 2x - 3
+  const double lin[2] = {-3, 2}; // 2x - 3
   ASSERT_EQ(bg_roots_positive(lin, 1, r, 20), 1);
   EXPECT_DOUBLE_EQ(r[0], 1.5);
-  const double one[3] = {1, -2, 1};  // (x-1)^2: double root exactly at the split
+  const double one[3] = {1, -2, 1}; // (x-1)^2: double root exactly at the split
   ASSERT_EQ(bg_roots_positive(one, 2, r, 20), 1);
   EXPECT_NEAR(r[0], 1.0, 1e-12);
-  const double xk[4] = {0, 0, -4, 1};  // x^2 (x - 4)
+  const double xk[4] = {0, 0, -4, 1}; // x^2 (x - 4)
   ASSERT_EQ(bg_roots_positive(xk, 3, r, 20), 1);
   EXPECT_DOUBLE_EQ(r[0], 4.0);
   // max limits the output
-  const double three[4] = {-6, 11, -6, 1};  // (x-1)(x-2)(x-3)
+  const double three[4] = {-6, 11, -6, 1}; // (x-1)(x-2)(x-3)
   ASSERT_EQ(bg_roots_positive(three, 3, r, 2), 2);
   EXPECT_NEAR(r[0], 1.0, 1e-14);
   EXPECT_NEAR(r[1], 2.0, 1e-14);

@@ -24,20 +24,25 @@ using namespace solvetest;
 
 namespace {
 
-double rel(double a, double b) { return std::fabs(a - b) / std::fabs(b); }
+double rel(double a, double b)
+{
+  return std::fabs(a - b) / std::fabs(b);
+}
 
-void abs_conv(const double *a, int na, const double *b, int nb, double *out) {
+void abs_conv(const double *a, int na, const double *b, int nb, double *out)
+{
   for (int k = 0; k < na + nb - 1; ++k) out[k] = 0;
   for (int i = 0; i < na; ++i)
     for (int j = 0; j < nb; ++j) out[i + j] += std::fabs(a[i] * b[j]);
 }
 
 // Tables built from |R|, |g|, R_y: the magnitude of the terms of each entry.
-bg_tables_t abs_tables(const bg_tables_t &t) {
+bg_tables_t abs_tables(const bg_tables_t &t)
+{
   bg_sums_t s = tv_sums();
   for (auto &row : s.rw)
     for (double &v : row) v = std::fabs(v);
-  for (double &v : s.rwy) v = -std::fabs(v);  // the builder adds -2 g
+  for (double &v : s.rwy) v = -std::fabs(v); // the builder adds -2 g
   bg_tables_t a;
   bg_tables_scaled(&s, t.sexp, t.gexp, t.cexp, &a);
   for (int m = 0; m < 8; ++m) a.bw2[m] = std::fabs(a.bw2[m]);
@@ -46,9 +51,10 @@ bg_tables_t abs_tables(const bg_tables_t &t) {
   return a;
 }
 
-}  // namespace
+} // namespace
 
-TEST(Testvector, ScalingsAndTables) {
+TEST(Testvector, ScalingsAndTables)
+{
   const auto &j = testvector();
   const bg_sums_t s = tv_sums();
   bg_tables_t t;
@@ -86,14 +92,15 @@ TEST(Testvector, ScalingsAndTables) {
   std::printf("[tables] worst plain relative difference %.3g\n", worst);
 }
 
-TEST(Testvector, Resultant) {
+TEST(Testvector, Resultant)
+{
   const auto &j = testvector();
   const bg_sums_t s = tv_sums();
   bg_tables_t t;
   ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);
   double rw[22];
   bg_resultant(&t, rw, 0);
-  EXPECT_EQ(rw[0], 0.0);  // c = 0: r_w = kappa r
+  EXPECT_EQ(rw[0], 0.0); // c = 0: r_w = kappa r
   const double *r = rw + 1;
   const bg_tables_t a = abs_tables(t);
   double mag[21] = {0}, tmp[15], term[21];
@@ -117,10 +124,12 @@ TEST(Testvector, Resultant) {
   std::printf("[resultant] worst plain relative difference %.3g\n", worst);
 }
 
-TEST(Testvector, SolveEndToEnd) {
+TEST(Testvector, SolveEndToEnd)
+{
   const auto &j = testvector();
   const bg_sums_t s = tv_sums();
-  const bg_solve_cfg_t cfg = default_cfg(j["params"]["sigma"].get<double>(), j["params"]["L_S"].get<double>());
+  const bg_solve_cfg_t cfg =
+      default_cfg(j["params"]["sigma"].get<double>(), j["params"]["L_S"].get<double>());
   bg_solve_out_t o;
   bg_solve_stats_t st;
   ASSERT_EQ(bg_solve_ex(&s, &cfg, &o, &st), IMEST_OK);
@@ -130,7 +139,8 @@ TEST(Testvector, SolveEndToEnd) {
   for (int i = 0; i < 3; ++i) {
     EXPECT_LE(rel(o.roots_k2[i], j["positive_roots_K2"][i].get<double>()), 1e-9) << i;
     std::printf("[roots] K2[%d] = %.15g (ref %.15g, rel %.2g)\n", i, o.roots_k2[i],
-                j["positive_roots_K2"][i].get<double>(), rel(o.roots_k2[i], j["positive_roots_K2"][i].get<double>()));
+                j["positive_roots_K2"][i].get<double>(),
+                rel(o.roots_k2[i], j["positive_roots_K2"][i].get<double>()));
   }
   // candidates through the stage function
   bg_tables_t t;
@@ -147,11 +157,14 @@ TEST(Testvector, SolveEndToEnd) {
     EXPECT_LE(rel(cand[i].k1, c["K1"].get<double>()), 1e-9) << i;
     EXPECT_LE(rel(cand[i].k2, c["K2"].get<double>()), 1e-9) << i;
     EXPECT_LE(rel(cand[i].e, c["E"].get<double>()), 1e-9) << i;
-    EXPECT_EQ(cand[i].ew, cand[i].e) << i;  // c = 0: E_w = E_p^2
+    EXPECT_EQ(cand[i].ew, cand[i].e) << i; // c = 0: E_w = E_p^2
   }
-  const double ks[] = {rel(o.k1, j["K1"].get<double>()),     rel(o.k2, j["K2"].get<double>()),
-                       rel(o.tr_s, j["T_R"].get<double>()),  rel(o.rs_ohm, j["R_S"].get<double>()),
-                       rel(o.e, j["E"].get<double>()),       rel(o.e_i, j["E_I"].get<double>()),
+  const double ks[] = {rel(o.k1, j["K1"].get<double>()),
+                       rel(o.k2, j["K2"].get<double>()),
+                       rel(o.tr_s, j["T_R"].get<double>()),
+                       rel(o.rs_ohm, j["R_S"].get<double>()),
+                       rel(o.e, j["E"].get<double>()),
+                       rel(o.e_i, j["E_I"].get<double>()),
                        rel(o.pe_quad[0], j["PE_quad"][0].get<double>()),
                        rel(o.pe_quad[1], j["PE_quad"][1].get<double>())};
   const char *names[] = {"K1", "K2", "T_R", "R_S", "E", "E_I", "PEq1", "PEq2"};
@@ -183,7 +196,8 @@ TEST(Testvector, SolveEndToEnd) {
 }
 
 // The float32 chain and the float64 chain must give the same polished roots.
-TEST(Testvector, ChainPrecisionDoesNotMatterAfterPolish) {
+TEST(Testvector, ChainPrecisionDoesNotMatterAfterPolish)
+{
   const bg_sums_t s = tv_sums();
   bg_tables_t t;
   ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);

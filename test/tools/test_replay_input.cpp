@@ -12,28 +12,40 @@ using namespace tool_run;
 
 namespace {
 // 3.2 s of the paper's exp2 at 4 kHz, t printed in full.
-const std::string &base() { return sim_csv("exp2_short.csv", "--preset exp2 --duration 3.2 --supply vf"); }
+const std::string &base()
+{
+  return sim_csv("exp2_short.csv", "--preset exp2 --duration 3.2 --supply vf");
+}
 // 8 s, more valid windows (for the conventions).
-const std::string &base8() { return sim_csv("exp2_8s.csv", "--preset exp2 --duration 8 --supply vf --seed 5"); }
+const std::string &base8()
+{
+  return sim_csv("exp2_8s.csv", "--preset exp2 --duration 8 --supply vf --seed 5");
+}
 
-bool has(const Out &o, const std::string &phrase) { return o.err.find(phrase) != std::string::npos; }
+bool has(const Out &o, const std::string &phrase)
+{
+  return o.err.find(phrase) != std::string::npos;
+}
 
-std::string with_t(const std::string &name, const std::function<std::string(double t, long k)> &t_of) {
+std::string with_t(const std::string &name, const std::function<std::string(double t, long k)> &t_of)
+{
   return rewrite(base(), name, [&](std::vector<std::string> &f, long k) {
     f[0] = t_of(std::stod(f[0]), k);
     return true;
   });
 }
 
-int valid_windows(const Out &o) {
+int valid_windows(const Out &o)
+{
   int n = 0;
   for (const auto &r : rows(o.out))
     if (r.size() > 4 && r[4] == "1") n++;
   return n;
 }
-}  // namespace
+} // namespace
 
-TEST(ReplayInput, TimeInMillisecondsIsNamedWithTheRateItWouldBe) {
+TEST(ReplayInput, TimeInMillisecondsIsNamedWithTheRateItWouldBe)
+{
   const Out o = replay(with_t("ms.csv", [](double t, long) { return fmt("%.9g", t * 1e3); }));
   EXPECT_EQ(o.code, 1);
   EXPECT_TRUE(has(o, "If t is in milliseconds (4000 Hz)")) << o.err;
@@ -41,7 +53,8 @@ TEST(ReplayInput, TimeInMillisecondsIsNamedWithTheRateItWouldBe) {
   EXPECT_FALSE(has(o, "invalid setting")) << o.err;
 }
 
-TEST(ReplayInput, TimeAsSampleIndexAsksForFs) {
+TEST(ReplayInput, TimeAsSampleIndexAsksForFs)
+{
   const Out o = replay(with_t("idx.csv", [](double, long k) { return std::to_string(k); }));
   EXPECT_EQ(o.code, 1);
   EXPECT_TRUE(has(o, "t counts samples")) << o.err;
@@ -50,7 +63,8 @@ TEST(ReplayInput, TimeAsSampleIndexAsksForFs) {
 
 // With --fs, t only orders the rows: ms and a sample index give the same
 // windows as t in seconds, dated in seconds.
-TEST(ReplayInput, FsTakesMillisecondAndIndexTime) {
+TEST(ReplayInput, FsTakesMillisecondAndIndexTime)
+{
   const Out ref = replay(base());
   ASSERT_EQ(ref.code, 0) << ref.err;
   const Out ms = replay(with_t("ms.csv", [](double t, long) { return fmt("%.9g", t * 1e3); }), "--fs 4000");
@@ -63,7 +77,8 @@ TEST(ReplayInput, FsTakesMillisecondAndIndexTime) {
 
 // 1 kHz was refused by the default speed limit (3000 rad/s >= 3 fs); the
 // default now follows the rate.
-TEST(ReplayInput, OneKilohertzLogIsEstimated) {
+TEST(ReplayInput, OneKilohertzLogIsEstimated)
+{
   const Out o = replay(sim_csv("exp2_1k.csv", "--preset exp2 --duration 3.2 --supply vf --fs 1000"));
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_EQ(rows(o.out).size(), 4u);
@@ -71,14 +86,16 @@ TEST(ReplayInput, OneKilohertzLogIsEstimated) {
   EXPECT_TRUE(has(o, "at 1000 Hz")) << o.err;
 }
 
-TEST(ReplayInput, SpeedLimitBeyondPiPerSampleIsAUsageError) {
+TEST(ReplayInput, SpeedLimitBeyondPiPerSampleIsAUsageError)
+{
   const Out o = replay(sim_csv("exp2_1k.csv", "--preset exp2 --duration 3.2 --supply vf --fs 1000"),
                        "--speed-limit 5000");
   EXPECT_EQ(o.code, 2);
   EXPECT_TRUE(has(o, "below 3 x fs = 3000 rad/s")) << o.err;
 }
 
-TEST(ReplayInput, Log250HzNamesTheFilterLimitAndTheLowestRate) {
+TEST(ReplayInput, Log250HzNamesTheFilterLimitAndTheLowestRate)
+{
   const std::string &p = sim_csv("exp2_250.csv", "--preset exp2 --duration 3.2 --supply vf --fs 250");
   Out o = replay(p);
   EXPECT_EQ(o.code, 1);
@@ -95,7 +112,8 @@ TEST(ReplayInput, Log250HzNamesTheFilterLimitAndTheLowestRate) {
 
 // t printed with 4 decimals at 4 kHz steps by 0.0002 or 0.0003: rounding, not
 // irregular sampling. The windows are those of the full-precision t.
-TEST(ReplayInput, FourDecimalTimeIsReadAsRounding) {
+TEST(ReplayInput, FourDecimalTimeIsReadAsRounding)
+{
   const Out ref = replay(base());
   const std::string p = with_t("d4.csv", [](double t, long) { return fmt("%.4f", t); });
   Out o = replay(p);
@@ -108,7 +126,8 @@ TEST(ReplayInput, FourDecimalTimeIsReadAsRounding) {
 }
 
 // Rounding is tolerated, a gap is not: one missing sample is still named.
-TEST(ReplayInput, MissingSampleIsRefusedDespiteRounding) {
+TEST(ReplayInput, MissingSampleIsRefusedDespiteRounding)
+{
   const std::string p = rewrite(base(), "gap.csv", [](std::vector<std::string> &f, long k) {
     f[0] = fmt("%.4f", std::stod(f[0]));
     return k != 5000;
@@ -122,7 +141,8 @@ TEST(ReplayInput, MissingSampleIsRefusedDespiteRounding) {
 
 // t with fewer decimals than the sample period needs repeats itself: named,
 // and --fs reads the file.
-TEST(ReplayInput, TooCoarseTimeAsksForFs) {
+TEST(ReplayInput, TooCoarseTimeAsksForFs)
+{
   const std::string p = with_t("d3.csv", [](double t, long) { return fmt("%.3f", t); });
   Out o = replay(p);
   EXPECT_EQ(o.code, 1);
@@ -134,11 +154,12 @@ TEST(ReplayInput, TooCoarseTimeAsksForFs) {
 }
 
 // A recording cut off mid-write: the last line is left out with a warning.
-TEST(ReplayInput, TruncatedLastLineIsLeftOut) {
+TEST(ReplayInput, TruncatedLastLineIsLeftOut)
+{
   std::string text = slurp(base());
   const Out ref = replay(base());
   const std::string whole = text;
-  text.resize(text.size() - 30);  // cut inside the last line
+  text.resize(text.size() - 30); // cut inside the last line
   const Out o = replay(write("cut.csv", text));
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_TRUE(has(o, "the last line looks cut off")) << o.err;
@@ -150,11 +171,14 @@ TEST(ReplayInput, TruncatedLastLineIsLeftOut) {
   EXPECT_EQ(replay(write("short_mid.csv", bad)).code, 1);
 }
 
-TEST(ReplayInput, OptionEqualsValueAndStdin) {
+TEST(ReplayInput, OptionEqualsValueAndStdin)
+{
   const Out ref = replay(base(), "--window 1 --filter-hz 100");
   ASSERT_EQ(ref.code, 0) << ref.err;
-  const Out eq = run(std::string(REPLAY_BIN) + " --pole-pairs=2 --ls=0.2908 --sigma=0.096 --window=1 "
-                     "--filter-hz=100 " + base());
+  const Out eq = run(std::string(REPLAY_BIN) +
+                     " --pole-pairs=2 --ls=0.2908 --sigma=0.096 --window=1 "
+                     "--filter-hz=100 " +
+                     base());
   EXPECT_EQ(eq.code, 0) << eq.err;
   EXPECT_EQ(eq.out, ref.out);
   const Out in = replay("- < " + base());
@@ -165,7 +189,8 @@ TEST(ReplayInput, OptionEqualsValueAndStdin) {
   EXPECT_EQ(pipe.out, ref.out);
 }
 
-TEST(ReplayInput, ExitCodes) {
+TEST(ReplayInput, ExitCodes)
+{
   Out o = replay(base(), "--no-such-option");
   EXPECT_EQ(o.code, 2);
   EXPECT_TRUE(has(o, "unknown option '--no-such-option'")) << o.err;
@@ -191,19 +216,21 @@ TEST(ReplayInput, ExitCodes) {
   EXPECT_EQ(replay(base()).code, 0);
 }
 
-TEST(ReplayInput, HelpNamesEveryOption) {
+TEST(ReplayInput, HelpNamesEveryOption)
+{
   const Out o = run(std::string(REPLAY_BIN) + " --help");
   ASSERT_EQ(o.code, 0);
-  for (const char *opt : {"--pole-pairs", "--ls", "--sigma", "--fs", "--window", "--filter-hz", "--aa-hz",
-                          "--u-delay", "--dc-block-hz", "--tr-nominal", "--tr-min", "--tr-max",
-                          "--max-pe-k2", "--speed-limit", "--i-limit", "--u-limit", "--from-rest",
-                          "--candump", "--can-iface", "--can-id", "--quiet", "--help", "--opt=VALUE",
-                          "\"-\" = stdin"})
+  for (const char *opt :
+       {"--pole-pairs", "--ls",          "--sigma",       "--fs",         "--window",    "--filter-hz",
+        "--aa-hz",      "--u-delay",     "--dc-block-hz", "--tr-nominal", "--tr-min",    "--tr-max",
+        "--max-pe-k2",  "--speed-limit", "--i-limit",     "--u-limit",    "--from-rest", "--candump",
+        "--can-iface",  "--can-id",      "--quiet",       "--help",       "--opt=VALUE", "\"-\" = stdin"})
     EXPECT_NE(o.out.find(opt), std::string::npos) << opt;
 }
 
 // theta wrapped to [0, 2 pi) gives the estimates of the unwrapped angle.
-TEST(ReplayInput, WrappedThetaGivesTheSameEstimates) {
+TEST(ReplayInput, WrappedThetaGivesTheSameEstimates)
+{
   const Out ref = replay(base8());
   const std::string p = rewrite(base8(), "wrapped.csv", [](std::vector<std::string> &f, long) {
     const double th = std::stod(f[7]);
@@ -215,14 +242,15 @@ TEST(ReplayInput, WrappedThetaGivesTheSameEstimates) {
   const auto a = rows(ref.out), b = rows(o.out);
   ASSERT_EQ(a.size(), b.size());
   for (size_t k = 1; k < a.size(); ++k) {
-    EXPECT_EQ(a[k][4], b[k][4]) << "window " << k;  // same verdict
+    EXPECT_EQ(a[k][4], b[k][4]) << "window " << k; // same verdict
     EXPECT_NEAR(std::stod(a[k][1]), std::stod(b[k][1]), 1e-4 * std::stod(a[k][1])) << "window " << k;
   }
 }
 
 // theta against the field fits a motor with a tiny T_R and looks valid:
 // refused with the fix.
-TEST(ReplayInput, ThetaAgainstTheFieldIsRefused) {
+TEST(ReplayInput, ThetaAgainstTheFieldIsRefused)
+{
   const std::string p = rewrite(base8(), "neg_theta.csv", [](std::vector<std::string> &f, long) {
     f[7] = fmt("%.12g", -std::stod(f[7]));
     return true;
@@ -233,7 +261,8 @@ TEST(ReplayInput, ThetaAgainstTheFieldIsRefused) {
   EXPECT_TRUE(has(o, "Negate theta")) << o.err;
 }
 
-TEST(ReplayInput, InvertedCurrentSignIsNamed) {
+TEST(ReplayInput, InvertedCurrentSignIsNamed)
+{
   const std::string p = rewrite(base8(), "neg_i.csv", [](std::vector<std::string> &f, long) {
     for (int j = 4; j <= 6; ++j) f[j] = fmt("%.9g", -std::stod(f[j]));
     return true;
@@ -246,7 +275,8 @@ TEST(ReplayInput, InvertedCurrentSignIsNamed) {
       << o.err;
 }
 
-TEST(ReplayInput, ThetaInDegreesIsNamed) {
+TEST(ReplayInput, ThetaInDegreesIsNamed)
+{
   const std::string p = rewrite(base8(), "deg.csv", [](std::vector<std::string> &f, long) {
     const double d = std::stod(f[7]) * 180 / M_PI;
     f[7] = fmt("%.9g", d - 360 * std::floor(d / 360));
@@ -259,7 +289,8 @@ TEST(ReplayInput, ThetaInDegreesIsNamed) {
 }
 
 // As imest-monitor's --base-id: an identifier above 0x7FF is a 29-bit one.
-TEST(ReplayInput, ExtendedCanIdIsAccepted) {
+TEST(ReplayInput, ExtendedCanIdIsAccepted)
+{
   const std::string log = tmpdir() + "/ext.log";
   const Out o = replay(base(), "--can-id 0x18FF5000 --candump " + log);
   ASSERT_EQ(o.code, 0) << o.err;

@@ -22,7 +22,8 @@ struct Out {
   std::string out, err;
 };
 
-inline std::string tmpdir() {
+inline std::string tmpdir()
+{
   static std::string d;
   if (d.empty()) {
     char tmpl[] = "/tmp/imest-tool-test-XXXXXX";
@@ -32,7 +33,8 @@ inline std::string tmpdir() {
   return d;
 }
 
-inline std::string slurp(const std::string &p) {
+inline std::string slurp(const std::string &p)
+{
   std::ifstream f(p);
   std::stringstream s;
   s << f.rdbuf();
@@ -40,13 +42,15 @@ inline std::string slurp(const std::string &p) {
 }
 
 // Runs a shell command; stdout and stderr captured.
-inline Out run(const std::string &cmd) {
+inline Out run(const std::string &cmd)
+{
   const std::string o = tmpdir() + "/out.txt", e = tmpdir() + "/err.txt";
   const int rc = std::system((cmd + " >" + o + " 2>" + e).c_str());
   return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(o), slurp(e)};
 }
 
-inline std::string write(const std::string &name, const std::string &text) {
+inline std::string write(const std::string &name, const std::string &text)
+{
   const std::string p = tmpdir() + "/" + name;
   std::ofstream(p) << text;
   return p;
@@ -54,12 +58,14 @@ inline std::string write(const std::string &name, const std::string &text) {
 
 const std::string kMotor = " --pole-pairs 2 --ls 0.2908 --sigma 0.096 ";
 
-inline Out replay(const std::string &file, const std::string &extra = "") {
+inline Out replay(const std::string &file, const std::string &extra = "")
+{
   return run(std::string(REPLAY_BIN) + kMotor + extra + " " + file);
 }
 
 // A recording from the simulator, made once per test process.
-inline const std::string &sim_csv(const std::string &name, const std::string &args) {
+inline const std::string &sim_csv(const std::string &name, const std::string &args)
+{
   static std::map<std::string, std::string> made;
   auto it = made.find(name);
   if (it != made.end()) return it->second;
@@ -69,7 +75,8 @@ inline const std::string &sim_csv(const std::string &name, const std::string &ar
   return made[name] = p;
 }
 
-inline std::vector<std::string> split(const std::string &line) {
+inline std::vector<std::string> split(const std::string &line)
+{
   std::vector<std::string> f;
   std::stringstream ls(line);
   std::string x;
@@ -77,7 +84,8 @@ inline std::vector<std::string> split(const std::string &line) {
   return f;
 }
 
-inline std::vector<std::vector<std::string>> rows(const std::string &csv) {
+inline std::vector<std::vector<std::string>> rows(const std::string &csv)
+{
   std::vector<std::vector<std::string>> r;
   std::stringstream s(csv);
   std::string line;
@@ -88,7 +96,8 @@ inline std::vector<std::vector<std::string>> rows(const std::string &csv) {
 // A copy of a CSV recording with each data row (its fields, its 0-based
 // index) rewritten, or left out where fn returns false; the header is kept.
 inline std::string rewrite(const std::string &src, const std::string &name,
-                           const std::function<bool(std::vector<std::string> &, long)> &fn) {
+                           const std::function<bool(std::vector<std::string> &, long)> &fn)
+{
   std::ifstream in(src);
   std::string line, text;
   std::getline(in, line);
@@ -102,14 +111,16 @@ inline std::string rewrite(const std::string &src, const std::string &name,
   return write(name, text);
 }
 
-inline std::string fmt(const char *format, double x) {
+inline std::string fmt(const char *format, double x)
+{
   char b[64];
   std::snprintf(b, sizeof b, format, x);
   return b;
 }
 
 // The estimate columns of replay's output (everything after t_end_s).
-inline std::string estimates(const std::string &out) {
+inline std::string estimates(const std::string &out)
+{
   std::string r;
   for (const auto &row : rows(out)) {
     for (size_t j = 1; j < row.size(); ++j) r += row[j] + ",";
@@ -118,4 +129,4 @@ inline std::string estimates(const std::string &out) {
   return r;
 }
 
-}  // namespace tool_run
+} // namespace tool_run

@@ -39,7 +39,10 @@ tool_arg_kind_t tool_args_next(tool_args_t *a)
   return TOOL_ARG_OPTION;
 }
 
-int tool_args_is(const tool_args_t *a, const char *name) { return strcmp(a->opt, name) == 0; }
+int tool_args_is(const tool_args_t *a, const char *name)
+{
+  return strcmp(a->opt, name) == 0;
+}
 
 const char *tool_args_value(tool_args_t *a)
 {

@@ -6,15 +6,15 @@
 
 /* Exit codes of every imest tool. */
 enum {
-  TOOL_EXIT_OK = 0,    /* success */
-  TOOL_EXIT_DATA = 1,  /* the input or data is unusable (bad content, nothing decoded, I/O) */
-  TOOL_EXIT_USAGE = 2  /* bad option or argument */
+  TOOL_EXIT_OK = 0,   /* success */
+  TOOL_EXIT_DATA = 1, /* the input or data is unusable (bad content, nothing decoded, I/O) */
+  TOOL_EXIT_USAGE = 2 /* bad option or argument */
 };
 
 typedef enum { TOOL_ARG_END = 0, TOOL_ARG_OPTION, TOOL_ARG_OPERAND } tool_arg_kind_t;
 
 typedef struct {
-  const char *prog;         /* for messages: "prog: ..." */
+  const char *prog; /* for messages: "prog: ..." */
   int argc;
   char **argv;
   int next;                 /* index of the next argv element */

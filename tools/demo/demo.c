@@ -60,7 +60,7 @@ typedef struct {
   const char *can_iface;  /* live SocketCAN interface (exp2's frames), NULL = none */
   unsigned long seed;
   int quiet;
-  unsigned int only;      /* bit mask of experiments to run */
+  unsigned int only; /* bit mask of experiments to run */
 } options_t;
 
 enum { EXP1 = 0, EXP2 = 1, IFOC_FIXED = 2, IFOC_ADAPTIVE = 3, NEXP = 4 };
@@ -75,8 +75,7 @@ typedef struct {
 } acc_t;
 
 typedef struct {
-  double tr, rs, speed, te, te_ref, te_err_rms, psi, psi_ref, i_rms, temp_s, temp_r, ifoc_tr,
-      load;
+  double tr, rs, speed, te, te_ref, te_err_rms, psi, psi_ref, i_rms, temp_s, temp_r, ifoc_tr, load;
 } truth_t;
 
 static void acc_add(acc_t *a, const imsim_sample_t *s)
@@ -143,8 +142,10 @@ static int tee_send(void *ctx, const imest_can_frame_t *f)
   const int rc = t->log.port.send(t->log.port.ctx, f);
 #ifdef IMEST_DEMO_HAVE_SOCKETCAN
   if (t->live) {
-    if (t->sc.port.send(t->sc.port.ctx, f) == 0) t->live_sent++;
-    else t->live_failed++;
+    if (t->sc.port.send(t->sc.port.ctx, f) == 0)
+      t->live_sent++;
+    else
+      t->live_failed++;
   }
 #endif
   return rc; /* the log is the record: its failure is the port's failure */
@@ -273,9 +274,8 @@ static int exp1_wave(job_t *j, const char *dir, double tr_id, double rs_id)
     imsim_abc_to_ab(ma->u_abc, uab);
     imsim_abc_to_ab(ma->i_abc, iab);
     const double w_enc = k >= 2 * H ? (th[2 * H] - th[0]) * cm.fs_hz / (2.0 * H) : (double)NAN;
-    fprintf(f, "%.6f,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.6g,%.6g\n", ma->t, uab[0],
-            uab[1], iab[0], iab[1], w_enc, ma->speed_rad_s, mb->i_ab_true[0], mb->speed_rad_s,
-            tr_id, rs_id);
+    fprintf(f, "%.6f,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.6g,%.6g\n", ma->t, uab[0], uab[1], iab[0],
+            iab[1], w_enc, ma->speed_rad_s, mb->i_ab_true[0], mb->speed_rad_s, tr_id, rs_id);
   }
   if (fclose(f) != 0) {
     snprintf(j->err, sizeof j->err, "exp1_wave.csv: write error");
@@ -385,12 +385,11 @@ static int job_open(job_t *j, run_t *x)
 
   snprintf(fname, sizeof fname, "%s_direct.csv", x->name);
   if ((x->csv = open_out(j, x->dir, fname)) == NULL) return -1;
-  fprintf(x->csv,
-          "experiment,seq,t_end_s,T_R_s,R_S_ohm,valid,status,T_R_true_s,R_S_true_ohm,E_I,"
-          "pe_k1_rel,pe_k2_rel,slip_ratio,i_rms_a,n_roots,n_admissible,used_samples,flags,"
-          "speed_rad_s,torque_nm,load_nm,torque_ref_nm,torque_err_rms_nm,psi_r_wb,psi_ref_wb,"
-          "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s,"
-          "tr_valid,tr_reason,rs_valid,rs_reason\n");
+  fprintf(x->csv, "experiment,seq,t_end_s,T_R_s,R_S_ohm,valid,status,T_R_true_s,R_S_true_ohm,E_I,"
+                  "pe_k1_rel,pe_k2_rel,slip_ratio,i_rms_a,n_roots,n_admissible,used_samples,flags,"
+                  "speed_rad_s,torque_nm,load_nm,torque_ref_nm,torque_err_rms_nm,psi_r_wb,psi_ref_wb,"
+                  "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s,"
+                  "tr_valid,tr_reason,rs_valid,rs_reason\n");
 
   j->total = (unsigned long long)llround(j->duration_s * x->c.fs_hz);
   x->wn = (uint32_t)lround((double)cfg.window_s * (double)cfg.fs_hz);
@@ -422,11 +421,11 @@ static void on_window(void *ctx, const imest_result_t *r)
   fprintf(x->csv,
           "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
           "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s\n",
-          x->name, r->seq, r->t_end_s, r->tr_s, r->rs_ohm, r->valid, imest_reason_name(r->status),
-          t->tr, t->rs, r->e_i, r->pe_k1_rel, r->pe_k2_rel, r->slip_ratio, r->i_rms_a, r->n_roots,
-          r->n_admissible, r->used_samples, r->flags, t->speed, t->te, t->load, t->te_ref,
-          t->te_err_rms, t->psi, t->psi_ref, t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr,
-          r->tr_valid, imest_reason_name(r->tr_reason), r->rs_valid, imest_reason_name(r->rs_reason));
+          x->name, r->seq, r->t_end_s, r->tr_s, r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr,
+          t->rs, r->e_i, r->pe_k1_rel, r->pe_k2_rel, r->slip_ratio, r->i_rms_a, r->n_roots, r->n_admissible,
+          r->used_samples, r->flags, t->speed, t->te, t->load, t->te_ref, t->te_err_rms, t->psi, t->psi_ref,
+          t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr, r->tr_valid, imest_reason_name(r->tr_reason),
+          r->rs_valid, imest_reason_name(r->rs_reason));
   /* the controller takes T_R whenever T_R itself is trusted */
   if (r->tr_valid && j->id == IFOC_ADAPTIVE) imsim_set_ifoc_tr(x->sim, r->tr_s);
   if (r->valid) {
@@ -497,9 +496,8 @@ static int job_close(run_t *x)
   }
   FILE *f = open_out(j, x->dir, "exp1_identified.csv");
   if (f == NULL) return -1;
-  fprintf(f, "seq,valid,status,T_R_s,R_S_ohm,source\n%d,%d,%s,%.9g,%.9g,%s\n", j->id_seq,
-          x->have_id == 2, x->have_id ? imest_reason_name(j->id_status) : "none", j->id_tr,
-          j->id_rs,
+  fprintf(f, "seq,valid,status,T_R_s,R_S_ohm,source\n%d,%d,%s,%.9g,%.9g,%s\n", j->id_seq, x->have_id == 2,
+          x->have_id ? imest_reason_name(j->id_status) : "none", j->id_tr, j->id_rs,
           x->have_id == 2   ? "first valid window"
           : x->have_id == 1 ? "run-up window 0, NOT valid (no valid window)"
                             : "nominal parameters (no usable estimate)");
@@ -532,30 +530,29 @@ static void *job_thread(void *arg)
 
 static void usage(FILE *f)
 {
-  fprintf(f,
-          "usage: imest-demo [--out DIR] [--duration S] [--exp1-duration S] [--only LIST]\n"
-          "                  [--can-iface NAME] [--seed N] [--quiet]\n"
-          "\n"
-          "Runs the paper's experiments on the simulated motor with imest in the loop (ISR\n"
-          "call per sample, background call per window, telemetry over the CAN port) and\n"
-          "writes DIR/raw/<exp>.candump.log, DIR/raw/<exp>_direct.csv, DIR/raw/exp1_wave.csv.\n"
-          "Experiments run in parallel threads: exp1 (run-up), exp2 (30 Hz V/f heat run),\n"
-          "ifoc_fixed and ifoc_adaptive (the heat run under IFOC, controller T_R fixed at\n"
-          "the cold value / taken from the estimator).\n"
-          "Options take a value as '--opt VALUE' or '--opt=VALUE'.\n"
-          "\n"
-          "  --out DIR           output folder (default results)\n"
-          "  --duration S        motor time of exp2 and the IFOC runs (default 3600)\n"
-          "  --exp1-duration S   motor time of exp1 (default 2)\n"
-          "  --only LIST         comma-separated subset of exp1,exp2,ifoc_fixed,ifoc_adaptive\n"
-          "  --can-iface NAME    also send exp2's frames on this SocketCAN interface\n"
-          "  --seed N            sensor noise seed (default 1)\n"
-          "  --quiet             no progress on stderr (default: progress if it is a terminal)\n"
-          "  -h, --help          this text\n"
-          "\n"
-          "stdout: one line per experiment, key=value pairs.\n"
-          "exit status: 0 done; 1 an experiment failed or the output cannot be written;\n"
-          "2 bad option.\n");
+  fprintf(f, "usage: imest-demo [--out DIR] [--duration S] [--exp1-duration S] [--only LIST]\n"
+             "                  [--can-iface NAME] [--seed N] [--quiet]\n"
+             "\n"
+             "Runs the paper's experiments on the simulated motor with imest in the loop (ISR\n"
+             "call per sample, background call per window, telemetry over the CAN port) and\n"
+             "writes DIR/raw/<exp>.candump.log, DIR/raw/<exp>_direct.csv, DIR/raw/exp1_wave.csv.\n"
+             "Experiments run in parallel threads: exp1 (run-up), exp2 (30 Hz V/f heat run),\n"
+             "ifoc_fixed and ifoc_adaptive (the heat run under IFOC, controller T_R fixed at\n"
+             "the cold value / taken from the estimator).\n"
+             "Options take a value as '--opt VALUE' or '--opt=VALUE'.\n"
+             "\n"
+             "  --out DIR           output folder (default results)\n"
+             "  --duration S        motor time of exp2 and the IFOC runs (default 3600)\n"
+             "  --exp1-duration S   motor time of exp1 (default 2)\n"
+             "  --only LIST         comma-separated subset of exp1,exp2,ifoc_fixed,ifoc_adaptive\n"
+             "  --can-iface NAME    also send exp2's frames on this SocketCAN interface\n"
+             "  --seed N            sensor noise seed (default 1)\n"
+             "  --quiet             no progress on stderr (default: progress if it is a terminal)\n"
+             "  -h, --help          this text\n"
+             "\n"
+             "stdout: one line per experiment, key=value pairs.\n"
+             "exit status: 0 done; 1 an experiment failed or the output cannot be written;\n"
+             "2 bad option.\n");
 }
 
 static int mkdir_p(const char *path)
@@ -587,8 +584,10 @@ static int parse_only(const char *v, unsigned int *only)
         found = 1;
       }
     if (!found) {
-      fprintf(stderr, "imest-demo: --only: unknown experiment '%s' (exp1, exp2, ifoc_fixed, "
-              "ifoc_adaptive)\n", tok);
+      fprintf(stderr,
+              "imest-demo: --only: unknown experiment '%s' (exp1, exp2, ifoc_fixed, "
+              "ifoc_adaptive)\n",
+              tok);
       return -1;
     }
   }
@@ -670,8 +669,8 @@ static int start_jobs(const options_t *o, job_t jobs[NEXP], pthread_t th[NEXP], 
 }
 
 /* Progress on a terminal until every thread is done; then joins them. */
-static void wait_jobs(const options_t *o, job_t jobs[NEXP], pthread_t th[NEXP],
-                      const int started[NEXP], double t0)
+static void wait_jobs(const options_t *o, job_t jobs[NEXP], pthread_t th[NEXP], const int started[NEXP],
+                      double t0)
 {
   const int tty = !o->quiet && isatty(2);
   for (;;) {
@@ -716,19 +715,19 @@ static int report(const job_t jobs[NEXP], const int started[NEXP], double t0)
     }
     printf("experiment=%s motor_s=%.0f windows=%ld valid=%ld can_frames=%lu can_failed=%lu "
            "wall_s=%.2f realtime_x=%.0f",
-           k_exp_name[e], j->duration_s, j->windows, j->valid, j->can_lines, j->can_failed,
-           j->wall_s, j->duration_s / j->wall_s);
+           k_exp_name[e], j->duration_s, j->windows, j->valid, j->can_lines, j->can_failed, j->wall_s,
+           j->duration_s / j->wall_s);
     if (e == EXP1)
-      printf(" identified_T_R_s=%.6g identified_R_S_ohm=%.6g identified_window=%d", j->id_tr,
-             j->id_rs, j->id_seq);
+      printf(" identified_T_R_s=%.6g identified_R_S_ohm=%.6g identified_window=%d", j->id_tr, j->id_rs,
+             j->id_seq);
     if (j->live) printf(" live_sent=%lu live_failed=%lu", j->live_sent, j->live_failed);
     printf("\n");
   }
   struct rusage ru;
   double cpu = NAN;
   if (getrusage(RUSAGE_SELF, &ru) == 0)
-    cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-          (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+    cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
+          1e-6 * (double)ru.ru_stime.tv_usec;
   const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
   printf("simulate_wall_s=%.2f simulate_cpu_s=%.2f cpus=%ld\n", now_s() - t0, cpu, ncpu);
   return fail;

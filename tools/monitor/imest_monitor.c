@@ -25,8 +25,8 @@
 #include "imest_socketcan.h"
 #endif
 
-static const char *const k_frame_name[IMEST_CAN_NFRAMES] = {
-    "IMEST_TR", "IMEST_RS", "IMEST_QUAL", "IMEST_STAT", "IMEST_VERDICT", "IMEST_BOUNDS"};
+static const char *const k_frame_name[IMEST_CAN_NFRAMES] = {"IMEST_TR",   "IMEST_RS",      "IMEST_QUAL",
+                                                            "IMEST_STAT", "IMEST_VERDICT", "IMEST_BOUNDS"};
 #define ALL_FRAMES ((1u << IMEST_CAN_NFRAMES) - 1u)
 
 static volatile sig_atomic_t g_stop;
@@ -49,9 +49,9 @@ typedef struct {
 typedef struct {
   int csv;
   uint32_t base_id;
-  unsigned long count;      /* stop after this many windows (0: never) */
+  unsigned long count; /* stop after this many windows (0: never) */
   unsigned long windows;
-  double win_t;             /* time of the last accepted frame of the open window */
+  double win_t; /* time of the last accepted frame of the open window */
   char where[128];
   imest_can_rx_t rx;
   unsigned long lines, malformed, plain_candump;
@@ -173,8 +173,8 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
     const char *rsw = !h_v ? "" : r->rs_valid ? "ok" : rsr;
     fmt_percent(trb, sizeof trb, h_b, r->tr_bound_rel, sat, IMEST_CAN_SAT_TRB);
     fmt_percent(rsb, sizeof rsb, h_b, r->rs_bound_rel, sat, IMEST_CAN_SAT_RSB);
-    printf("%17.6f %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %2s/%-2s %6s %5s%s\n", t, seq, tr,
-           trb, trw, rs, rsb, rsw, ei, pk1, pk2, span, na, nr, flags, txf,
+    printf("%17.6f %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %2s/%-2s %6s %5s%s\n", t, seq, tr, trb,
+           trw, rs, rsb, rsw, ei, pk1, pk2, span, na, nr, flags, txf,
            w->have == ALL_FRAMES ? "" : "  (incomplete)");
   }
   if (h_st) {
@@ -192,9 +192,9 @@ static void print_header(const monitor_t *m)
          "tx_failed,counter,frames,tr_valid,tr_reason,rs_valid,rs_reason,tr_bound_rel,rs_bound_rel,"
          "span_s,windows");
   } else {
-    printf("%17s %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %5s %6s %5s\n", "t [s]", "seq",
-           "T_R [s]", "+-T_R", "T_R verdict", "R_S [ohm]", "+-R_S", "R_S verdict", "E_I", "PE_K1",
-           "PE_K2", "span [s]", "adm/r", "flags", "txf");
+    printf("%17s %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %5s %6s %5s\n", "t [s]", "seq", "T_R [s]",
+           "+-T_R", "T_R verdict", "R_S [ohm]", "+-R_S", "R_S verdict", "E_I", "PE_K1", "PE_K2", "span [s]",
+           "adm/r", "flags", "txf");
   }
   fflush(stdout);
 }
@@ -216,12 +216,16 @@ static void report_window_events(const monitor_t *m, unsigned int e, const imest
                                  const imest_can_window_t *w)
 {
   if (e & IMEST_CAN_EV_RESTART) {
-    fprintf(stderr, "imest-monitor: %s: sequence number went back to %lu: the sender restarted "
-            "(no loss counted across the restart)\n", m->where, (unsigned long)w->result.seq);
+    fprintf(stderr,
+            "imest-monitor: %s: sequence number went back to %lu: the sender restarted "
+            "(no loss counted across the restart)\n",
+            m->where, (unsigned long)w->result.seq);
   }
   if (e & IMEST_CAN_EV_LOST) {
-    fprintf(stderr, "imest-monitor: %s: lost %lu frame(s) up to the window with counter %u (previous "
-            "window: counter %u)\n", m->where, (unsigned long)ev->lost, w->counter, ev->prev_counter);
+    fprintf(stderr,
+            "imest-monitor: %s: lost %lu frame(s) up to the window with counter %u (previous "
+            "window: counter %u)\n",
+            m->where, (unsigned long)ev->lost, w->counter, ev->prev_counter);
   }
   if (e & IMEST_CAN_EV_INCOMPLETE) report_missing(m, w);
   if (e & IMEST_CAN_EV_SEQ_GAP) {
@@ -262,15 +266,16 @@ static void handle_frame(monitor_t *m, const imest_can_frame_t *f, double t)
   }
   if (e & IMEST_CAN_EV_CORRUPT) {
     if (ev.dec == IMEST_CAN_DEC_BAD_DLC) {
-      fprintf(stderr, "imest-monitor: %s: corrupted frame %s (%s): %u data bytes, expected 8\n", m->where,
-              id, name, f->dlc);
+      fprintf(stderr, "imest-monitor: %s: corrupted frame %s (%s): %u data bytes, expected 8\n", m->where, id,
+              name, f->dlc);
     } else {
       fprintf(stderr, "imest-monitor: %s: corrupted frame %s (%s): checksum mismatch\n", m->where, id, name);
     }
     return;
   }
   if (e & IMEST_CAN_EV_REPEATED) {
-    fprintf(stderr, "imest-monitor: %s: repeated frame %s (%s), counter %u\n", m->where, id, name, ev.counter);
+    fprintf(stderr, "imest-monitor: %s: repeated frame %s (%s), counter %u\n", m->where, id, name,
+            ev.counter);
     return;
   }
   if (e & IMEST_CAN_EV_LATE) {
@@ -344,7 +349,8 @@ static void explain_nothing(const monitor_t *m, int live)
 {
   const imest_can_rx_stats_t *s = &m->rx.st;
   char a[24], b[24];
-  const uint32_t last = ((m->base_id & ~IMEST_CAN_ID_EXT) + IMEST_CAN_NFRAMES - 1u) | (m->base_id & IMEST_CAN_ID_EXT);
+  const uint32_t last =
+      ((m->base_id & ~IMEST_CAN_ID_EXT) + IMEST_CAN_NFRAMES - 1u) | (m->base_id & IMEST_CAN_ID_EXT);
   imest_can_id_format(m->base_id, a, sizeof a);
   imest_can_id_format(last, b, sizeof b);
   fputs("imest-monitor: nothing decoded: ", stderr);
@@ -354,18 +360,23 @@ static void explain_nothing(const monitor_t *m, int live)
     } else if (m->lines == 0u) {
       fputs("the log is empty\n", stderr);
     } else if (m->plain_candump > 0u) {
-      fprintf(stderr, "%lu line(s) read, none in candump -L format; they look like plain candump output "
-              "('can0  6A0   [8]  00 11 ...'): record with 'candump -L' (or 'candump -l')\n", m->lines);
+      fprintf(stderr,
+              "%lu line(s) read, none in candump -L format; they look like plain candump output "
+              "('can0  6A0   [8]  00 11 ...'): record with 'candump -L' (or 'candump -l')\n",
+              m->lines);
     } else {
-      fprintf(stderr, "%lu line(s) read, none a candump -L frame line ('(1700000000.000000) can0 "
-              "6A0#0011...'; see the malformed-line messages above)\n", m->lines);
+      fprintf(stderr,
+              "%lu line(s) read, none a candump -L frame line ('(1700000000.000000) can0 "
+              "6A0#0011...'; see the malformed-line messages above)\n",
+              m->lines);
     }
   } else if (s->foreign == s->frames) {
     fprintf(stderr, "%lu frame(s) %s, none with identifiers %s..%s", (unsigned long)s->frames,
             live ? "received" : "read", a, b);
     explain_ids(m);
   } else {
-    fprintf(stderr, "%lu frame(s) at identifiers %s..%s, all corrupted (bad checksum or length): another "
+    fprintf(stderr,
+            "%lu frame(s) at identifiers %s..%s, all corrupted (bad checksum or length): another "
             "sender at these identifiers, or another telemetry layout?\n",
             (unsigned long)(s->frames - s->foreign), a, b);
   }
@@ -424,7 +435,8 @@ static int run_log(monitor_t *m, const char *path)
     return TOOL_EXIT_DATA;
   }
   if (fstat(fileno(fp), &st) == 0 && S_ISDIR(st.st_mode)) {
-    fprintf(stderr, "imest-monitor: cannot read log '%s': it is a directory (give a candump -L file)\n", path);
+    fprintf(stderr, "imest-monitor: cannot read log '%s': it is a directory (give a candump -L file)\n",
+            path);
     if (!is_stdin) fclose(fp);
     return TOOL_EXIT_DATA;
   }

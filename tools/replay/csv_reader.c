@@ -61,8 +61,7 @@ int csv_open(csv_reader_t *r, const char *path)
   path = r->name;
   r->f = from_stdin ? copy_stdin() : fopen(path, "rb");
   if (r->f == NULL) {
-    snprintf(r->err, sizeof r->err, "%s: cannot %s: %s", path, from_stdin ? "read" : "open",
-             strerror(errno));
+    snprintf(r->err, sizeof r->err, "%s: cannot %s: %s", path, from_stdin ? "read" : "open", strerror(errno));
     return -1;
   }
   for (int k = 0; k < CSV_NEED; ++k) r->col[k] = -1;
@@ -124,8 +123,7 @@ static double half_unit(const char *s)
 static int at_last_line(csv_reader_t *r)
 {
   long len;
-  while ((len = read_line(r)) == 0) {
-  }
+  while ((len = read_line(r)) == 0) {}
   return len < 0;
 }
 
@@ -135,7 +133,7 @@ int csv_next(csv_reader_t *r, double v[CSV_NEED])
   do {
     len = read_line(r);
     if (len < 0) return 0;
-  } while (len == 0); /* blank lines are ignored */
+  } while (len == 0);            /* blank lines are ignored */
   int idx = 0, got = 0, cut = 0; /* cut: the line looks cut off mid-write */
   char *tok = r->buf;
   for (;; ++idx) {
@@ -147,15 +145,15 @@ int csv_next(csv_reader_t *r, double v[CSV_NEED])
       errno = 0;
       double x = strtod(s, &end);
       if (*s == '\0' || end == s || *trim(end) != '\0') {
-        snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': '%.40s' is not a number", r->name,
-                 r->line, CSV_NAMES[k], s);
+        snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': '%.40s' is not a number", r->name, r->line,
+                 CSV_NAMES[k], s);
         /* cut off inside its last field: what is left of it is the start of a number */
         cut = comma == NULL && idx + 1 <= r->ncols && strspn(s, "0123456789+-.eE") == strlen(s);
         goto bad;
       }
       if (!isfinite(x)) {
-        snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': non-finite value '%.40s'", r->name,
-                 r->line, CSV_NAMES[k], s);
+        snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': non-finite value '%.40s'", r->name, r->line,
+                 CSV_NAMES[k], s);
         return -1;
       }
       if (k == 0) r->t_round = half_unit(s);
@@ -166,8 +164,8 @@ int csv_next(csv_reader_t *r, double v[CSV_NEED])
     tok = comma + 1;
   }
   if (idx + 1 != r->ncols || got != CSV_NEED) {
-    snprintf(r->err, sizeof r->err, "%s:%ld: %d fields, the header has %d", r->name, r->line,
-             idx + 1, r->ncols);
+    snprintf(r->err, sizeof r->err, "%s:%ld: %d fields, the header has %d", r->name, r->line, idx + 1,
+             r->ncols);
     cut = idx + 1 < r->ncols;
     goto bad;
   }

@@ -13,15 +13,15 @@
 typedef struct {
   FILE *f;
   const char *name;
-  long line;               /* line number of the last line read (1 = header) */
-  int ncols;               /* columns in the header */
-  int col[CSV_NEED];       /* column index of each needed field */
+  long line;         /* line number of the last line read (1 = header) */
+  int ncols;         /* columns in the header */
+  int col[CSV_NEED]; /* column index of each needed field */
   char *buf;
   size_t cap;
-  double t_round;          /* half a unit of the last row's t in its printed
+  double t_round;      /* half a unit of the last row's t in its printed
                               decimals: "0.0003" -> 5e-5 (its rounding bound) */
-  long truncated_line;     /* a malformed last line that was dropped (0 = none) */
-  char warn[512];          /* what was wrong with it */
+  long truncated_line; /* a malformed last line that was dropped (0 = none) */
+  char warn[512];      /* what was wrong with it */
   char err[512];
 } csv_reader_t;
 

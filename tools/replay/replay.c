@@ -30,8 +30,8 @@ static const char *const k_prog = "imest-replay";
 
 /* ADC saturation: explicit limits, or plateaus at the record's extreme. A
  * limit equal to the clipped value makes samples at it count as saturated. */
-static double adc_limit(double given, const clip_t clip[3], char sym, const char *unit,
-                        const char *opt, int quiet)
+static double adc_limit(double given, const clip_t clip[3], char sym, const char *unit, const char *opt,
+                        int quiet)
 {
   if (given >= 0) return given;
   double limit = 0;
@@ -61,12 +61,10 @@ static int configure(const replay_opts_t *o, const replay_scan_t *s, imest_confi
   /* At rest: no current and a still rotor imply a zero history for every
    * filter (no current means no flux and no voltage either). The rotor test
    * uses the first step only: a DOL start accelerates within ms. */
-  cfg->start_at_rest = o->from_rest >= 0
-                           ? o->from_rest
-                           : (s->i_first <= 0.01 * s->i_max && s->th_step1 * s->fs < 2.0);
+  cfg->start_at_rest =
+      o->from_rest >= 0 ? o->from_rest : (s->i_first <= 0.01 * s->i_max && s->th_step1 * s->fs < 2.0);
   const char *field = NULL;
-  if (imest_config_check(cfg, &field) != IMEST_OK)
-    return replay_explain_config(o, s, cfg, field);
+  if (imest_config_check(cfg, &field) != IMEST_OK) return replay_explain_config(o, s, cfg, field);
   return -1;
 }
 
@@ -140,7 +138,7 @@ static void print_header(void)
 }
 
 typedef struct {
-  double t0_s;   /* the record's first t [s] */
+  double t0_s; /* the record's first t [s] */
   can_log_t *can;
 } row_ctx_t;
 
@@ -151,10 +149,10 @@ static void print_row(void *ctx, const imest_result_t *r)
   const double t0_s = x->t0_s;
   can_log_publish(x->can, r);
   printf("%.6f,%.9g,%.9g,%.6g,%d,%s,%u,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%u,%u,%.4g,%.6g,%u,0x%x\n",
-         t0_s + r->t_end_s, r->tr_s, r->rs_ohm, r->e_i, r->valid, imest_reason_name(r->status),
-         r->seq, r->k1, r->k2, r->pe_k1_rel, r->pe_k2_rel, r->hessian[0][0], r->hessian[0][1],
-         r->hessian[1][1], (r->flags & IMEST_FLAG_HESSIAN_PD) ? 1 : 0, r->n_roots,
-         r->n_admissible, r->slip_ratio, r->i_rms_a, r->used_samples, r->flags);
+         t0_s + r->t_end_s, r->tr_s, r->rs_ohm, r->e_i, r->valid, imest_reason_name(r->status), r->seq, r->k1,
+         r->k2, r->pe_k1_rel, r->pe_k2_rel, r->hessian[0][0], r->hessian[0][1], r->hessian[1][1],
+         (r->flags & IMEST_FLAG_HESSIAN_PD) ? 1 : 0, r->n_roots, r->n_admissible, r->slip_ratio, r->i_rms_a,
+         r->used_samples, r->flags);
 }
 
 static int run(csv_reader_t *r, const replay_scan_t *s, drive_t *d, can_log_t *can)
@@ -181,8 +179,8 @@ static int run(csv_reader_t *r, const replay_scan_t *s, drive_t *d, can_log_t *c
 
 /* A last partial window of at least half the length is estimated too, and a
  * record shorter than one window is estimated as one shorter window. */
-static long run_last_window(drive_t *d, const replay_scan_t *s, const imest_config_t *cfg,
-                            can_log_t *can, int *flushed)
+static long run_last_window(drive_t *d, const replay_scan_t *s, const imest_config_t *cfg, can_log_t *can,
+                            int *flushed)
 {
   const long win_n = lround((double)cfg->window_s * s->fs), rest = s->n % win_n;
   *flushed = rest > 0 && (2 * rest >= win_n || s->n < win_n);
@@ -196,8 +194,8 @@ static long run_last_window(drive_t *d, const replay_scan_t *s, const imest_conf
 static void summary(const drive_t *d, const replay_scan_t *s, const imest_config_t *cfg, long rest,
                     int flushed)
 {
-  fprintf(stderr, "%s: %ld samples at %.6g Hz, %ld windows (%ld valid)", k_prog, s->n, s->fs,
-          d->windows, d->valid);
+  fprintf(stderr, "%s: %ld samples at %.6g Hz, %ld windows (%ld valid)", k_prog, s->n, s->fs, d->windows,
+          d->valid);
   int most = 0;
   for (int k = 1; k < DRIVE_NSTATUS; ++k) {
     if (d->by_status[k]) fprintf(stderr, ", %ld %s", d->by_status[k], imest_reason_name(k));

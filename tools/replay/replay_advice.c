@@ -9,10 +9,13 @@
 static const char *const k_prog = "imest-replay";
 
 /* Where the sample rate came from, for messages that depend on it. */
-static const char *fs_origin(const replay_opts_t *o) { return o->fs_hz > 0 ? "--fs" : "t"; }
+static const char *fs_origin(const replay_opts_t *o)
+{
+  return o->fs_hz > 0 ? "--fs" : "t";
+}
 
-int replay_explain_config(const replay_opts_t *o, const replay_scan_t *s,
-                          const imest_config_t *cfg, const char *field)
+int replay_explain_config(const replay_opts_t *o, const replay_scan_t *s, const imest_config_t *cfg,
+                          const char *field)
 {
   int given = 0;
   const char *opt = replay_option_of(o, field, &given);
@@ -23,8 +26,7 @@ int replay_explain_config(const replay_opts_t *o, const replay_scan_t *s,
     fprintf(stderr,
             "--window %g s%s holds %.0f samples at %.6g Hz (from %s); a window needs 64 to 4e8 "
             "samples: give --window between %.3g and %.3g s\n",
-            (double)cfg->window_s, dflt, (double)cfg->window_s * fs, fs, fs_origin(o), 64.0 / fs,
-            4e8 / fs);
+            (double)cfg->window_s, dflt, (double)cfg->window_s * fs, fs, fs_origin(o), 64.0 / fs, 4e8 / fs);
   } else if (strcmp(field, "filter_hz") == 0) {
     /* measured on the simulated paper motor, 12-bit sensors (docs/feeding-logs.md) */
     fprintf(stderr,
@@ -35,14 +37,12 @@ int replay_explain_config(const replay_opts_t *o, const replay_scan_t *s,
             "about 1 kHz, because the derivatives lose (2 pi f/fs)^2/6 at the supply frequency f "
             "(9 %% at 60 Hz and 500 Hz). 100 Hz is the lowest cut-off that follows a run-up; "
             "for a record at constant speed, --filter-hz %.0f works at this rate.\n",
-            fs, fs_origin(o), (double)cfg->filter_hz, dflt, 2.5 * (double)cfg->filter_hz,
-            floor(fs / 5.0));
+            fs, fs_origin(o), (double)cfg->filter_hz, dflt, 2.5 * (double)cfg->filter_hz, floor(fs / 5.0));
   } else if (strcmp(field, "aa_hz") == 0) {
     fprintf(stderr, "--aa-hz %g must be below 0.45 x the sample rate (%.6g Hz at %.6g Hz)\n",
             (double)cfg->aa_hz, 0.45 * fs, fs);
   } else if (strcmp(field, "u_delay_s") == 0) {
-    fprintf(stderr,
-            "--u-delay %g s must be between 0 and one sample period (1/fs = %.6g s at %.6g Hz)\n",
+    fprintf(stderr, "--u-delay %g s must be between 0 and one sample period (1/fs = %.6g s at %.6g Hz)\n",
             (double)cfg->u_delay_s, 1.0 / fs, fs);
   } else if (strcmp(field, "dc_block_hz") == 0) {
     fprintf(stderr,
@@ -89,8 +89,7 @@ const char *replay_remedy(int status)
   case IMEST_REASON_ZERO_SLIP:
     return "the rotor carries no current (no load at constant speed, or standstill): T_R is "
            "observable only under load or while the speed changes; record under load";
-  case IMEST_REASON_NUMERIC:
-    return "the window sums are degenerate: are the signals constant or all zero?";
+  case IMEST_REASON_NUMERIC: return "the window sums are degenerate: are the signals constant or all zero?";
   case IMEST_REASON_NO_ROOT:
   case IMEST_REASON_NOT_MINIMUM:
     return "the data contradict the motor model: check the current sign (positive into the "
@@ -106,7 +105,6 @@ const char *replay_remedy(int status)
   case IMEST_REASON_RS_OUT_OF_RANGE:
     return "R_S comes out negative or huge: the voltage scale (phase-to-phase instead of "
            "phase-to-neutral?), the current scale, or --u-delay";
-  default:
-    return NULL;
+  default: return NULL;
   }
 }

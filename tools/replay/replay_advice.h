@@ -11,8 +11,8 @@
 /* Explains why imest_config_check() refused `field` for this record. Returns
  * the exit code: TOOL_EXIT_USAGE if an option the user gave is at fault,
  * TOOL_EXIT_DATA if the record (its sample rate) is. */
-int replay_explain_config(const replay_opts_t *o, const replay_scan_t *s,
-                          const imest_config_t *cfg, const char *field);
+int replay_explain_config(const replay_opts_t *o, const replay_scan_t *s, const imest_config_t *cfg,
+                          const char *field);
 
 /* What to check when every window of a record ends with this status (NULL if
  * there is nothing to say). */

@@ -14,61 +14,60 @@ static const char *const k_prog = "imest-replay";
 
 static void usage(FILE *o)
 {
-  fprintf(o,
-          "usage: imest-replay --pole-pairs N --ls HENRY --sigma VALUE [options] FILE.csv\n"
-          "\n"
-          "Runs a recording through the estimator exactly as firmware does and prints one\n"
-          "CSV row per window: t_end_s,T_R_s,R_S_ohm,E_I,valid,status,...\n"
-          "FILE (\"-\" = stdin) needs a header with t,u_a,u_b,u_c,i_a,i_b,i_c,theta (any\n"
-          "order; other columns ignored): t in s, phase-to-neutral V, phase currents in A\n"
-          "(positive into the motor), mechanical angle in rad (wrapped or unwrapped,\n"
-          "increasing with the a-b-c field). Guide: docs/feeding-logs.md.\n"
-          "Options take a value as '--opt VALUE' or '--opt=VALUE'.\n"
-          "\n"
-          "motor (required):\n"
-          "  --pole-pairs N      pole pairs n_p\n"
-          "  --ls H              stator inductance L_S [H]\n"
-          "  --sigma X           total leakage factor (0 < sigma < 1)\n"
-          "time base:\n"
-          "  --fs HZ             sample rate; t then only orders the rows and may be in any\n"
-          "                      unit (ms, a sample index) or too coarse (default: from t,\n"
-          "                      which must then be in seconds; rounding of t to its printed\n"
-          "                      decimals is tolerated)\n"
-          "estimator:\n"
-          "  --window S          window length [s] (default 1; at least 64 samples)\n"
-          "  --filter-hz HZ      front-end Butterworth-3 cut-off (default 100; needs\n"
-          "                      fs > 2.5 x cut-off)\n"
-          "  --aa-hz HZ          cut-off of a 2nd-order analog anti-alias filter on the\n"
-          "                      electrical channels, modelled on the angle (default none)\n"
-          "  --u-delay S         the voltage samples lag the currents by S seconds, 0..1/fs\n"
-          "                      (e.g. 50e-6 for volt-seconds of the PWM period that just\n"
-          "                      ended at 10 kHz)\n"
-          "  --dc-block-hz HZ    cut-off of the offset high-pass on voltages and currents\n"
-          "                      (default 1; 0 = off)\n"
-          "  --tr-nominal S      nominal T_R for scaling (default 0.1)\n"
-          "  --tr-min S --tr-max S   admissible T_R band (default 0.001 .. 10)\n"
-          "  --max-pe-k2 X       validity threshold on the relative PE index of K2 (0.1)\n"
-          "  --speed-limit RAD_S an angle step faster than this is an encoder fault\n"
-          "                      (default min(3000, 2 x fs); below 3 x fs, i.e. less than\n"
-          "                      pi per sample)\n"
-          "  --i-limit A|auto    |phase current| at which the ADC saturates (default auto:\n"
-          "                      detected from plateaus at the record's extreme; 0 = off)\n"
-          "  --u-limit V|auto    the same for the phase voltages (default auto)\n"
-          "  --from-rest auto|yes|no  the record starts at rest (no warm-up needed);\n"
-          "                      auto = current ~0 and rotor still at the first samples\n"
-          "CAN telemetry:\n"
-          "  --candump FILE      also write the published CAN frames (candump -L format;\n"
-          "                      \"-\" = stdout)\n"
-          "  --can-iface NAME    interface name in that log (default vcan0)\n"
-          "  --can-id ID         base CAN identifier (default 0x6A0; above 0x7FF a 29-bit\n"
-          "                      extended identifier)\n"
-          "  --can-ext           the base CAN identifier is 29-bit even if it is small\n"
-          "other:\n"
-          "  --quiet             no notes or summary on stderr\n"
-          "  -h, --help          this text\n"
-          "\n"
-          "exit status: 0 windows estimated; 1 the file or its data are unusable (the\n"
-          "message says why and what to do); 2 bad option or argument.\n");
+  fprintf(o, "usage: imest-replay --pole-pairs N --ls HENRY --sigma VALUE [options] FILE.csv\n"
+             "\n"
+             "Runs a recording through the estimator exactly as firmware does and prints one\n"
+             "CSV row per window: t_end_s,T_R_s,R_S_ohm,E_I,valid,status,...\n"
+             "FILE (\"-\" = stdin) needs a header with t,u_a,u_b,u_c,i_a,i_b,i_c,theta (any\n"
+             "order; other columns ignored): t in s, phase-to-neutral V, phase currents in A\n"
+             "(positive into the motor), mechanical angle in rad (wrapped or unwrapped,\n"
+             "increasing with the a-b-c field). Guide: docs/feeding-logs.md.\n"
+             "Options take a value as '--opt VALUE' or '--opt=VALUE'.\n"
+             "\n"
+             "motor (required):\n"
+             "  --pole-pairs N      pole pairs n_p\n"
+             "  --ls H              stator inductance L_S [H]\n"
+             "  --sigma X           total leakage factor (0 < sigma < 1)\n"
+             "time base:\n"
+             "  --fs HZ             sample rate; t then only orders the rows and may be in any\n"
+             "                      unit (ms, a sample index) or too coarse (default: from t,\n"
+             "                      which must then be in seconds; rounding of t to its printed\n"
+             "                      decimals is tolerated)\n"
+             "estimator:\n"
+             "  --window S          window length [s] (default 1; at least 64 samples)\n"
+             "  --filter-hz HZ      front-end Butterworth-3 cut-off (default 100; needs\n"
+             "                      fs > 2.5 x cut-off)\n"
+             "  --aa-hz HZ          cut-off of a 2nd-order analog anti-alias filter on the\n"
+             "                      electrical channels, modelled on the angle (default none)\n"
+             "  --u-delay S         the voltage samples lag the currents by S seconds, 0..1/fs\n"
+             "                      (e.g. 50e-6 for volt-seconds of the PWM period that just\n"
+             "                      ended at 10 kHz)\n"
+             "  --dc-block-hz HZ    cut-off of the offset high-pass on voltages and currents\n"
+             "                      (default 1; 0 = off)\n"
+             "  --tr-nominal S      nominal T_R for scaling (default 0.1)\n"
+             "  --tr-min S --tr-max S   admissible T_R band (default 0.001 .. 10)\n"
+             "  --max-pe-k2 X       validity threshold on the relative PE index of K2 (0.1)\n"
+             "  --speed-limit RAD_S an angle step faster than this is an encoder fault\n"
+             "                      (default min(3000, 2 x fs); below 3 x fs, i.e. less than\n"
+             "                      pi per sample)\n"
+             "  --i-limit A|auto    |phase current| at which the ADC saturates (default auto:\n"
+             "                      detected from plateaus at the record's extreme; 0 = off)\n"
+             "  --u-limit V|auto    the same for the phase voltages (default auto)\n"
+             "  --from-rest auto|yes|no  the record starts at rest (no warm-up needed);\n"
+             "                      auto = current ~0 and rotor still at the first samples\n"
+             "CAN telemetry:\n"
+             "  --candump FILE      also write the published CAN frames (candump -L format;\n"
+             "                      \"-\" = stdout)\n"
+             "  --can-iface NAME    interface name in that log (default vcan0)\n"
+             "  --can-id ID         base CAN identifier (default 0x6A0; above 0x7FF a 29-bit\n"
+             "                      extended identifier)\n"
+             "  --can-ext           the base CAN identifier is 29-bit even if it is small\n"
+             "other:\n"
+             "  --quiet             no notes or summary on stderr\n"
+             "  -h, --help          this text\n"
+             "\n"
+             "exit status: 0 windows estimated; 1 the file or its data are unusable (the\n"
+             "message says why and what to do); 2 bad option or argument.\n");
 }
 
 /* The config fields set by a plain numeric option. */
@@ -88,8 +87,8 @@ static const struct {
     {"--ls", "ls_h", offsetof(imest_config_t, ls_h)},
     {"--sigma", "sigma", offsetof(imest_config_t, sigma)},
 };
-#define N_NUMERIC (sizeof k_numeric / sizeof k_numeric[0])
-#define GIVEN_LS (1u << 9)
+#define N_NUMERIC   (sizeof k_numeric / sizeof k_numeric[0])
+#define GIVEN_LS    (1u << 9)
 #define GIVEN_SIGMA (1u << 10)
 
 const char *replay_option_of(const replay_opts_t *o, const char *field, int *given)
@@ -190,9 +189,12 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
     } else if (tool_args_is(&a, "--from-rest")) {
       const char *v = tool_args_value(&a);
       if (v == NULL) return TOOL_EXIT_USAGE;
-      if (!strcmp(v, "auto")) o->from_rest = -1;
-      else if (!strcmp(v, "yes")) o->from_rest = 1;
-      else if (!strcmp(v, "no")) o->from_rest = 0;
+      if (!strcmp(v, "auto"))
+        o->from_rest = -1;
+      else if (!strcmp(v, "yes"))
+        o->from_rest = 1;
+      else if (!strcmp(v, "no"))
+        o->from_rest = 0;
       else {
         fprintf(stderr, "%s: --from-rest takes auto, yes or no, not '%s'\n", k_prog, v);
         return TOOL_EXIT_USAGE;

@@ -6,14 +6,17 @@
 
 #include "tool_args.h"
 
-#define PI 3.14159265358979323846
+#define PI                3.14159265358979323846
 /* Below this rate no motor log is usable (a 64-sample window, the supply
  * frequency): a lower rate from t means t is not in seconds. */
 #define FS_IMPLAUSIBLE_HZ 100.0
 
 static const char *const k_prog = "imest-replay";
 
-static double wrap_pi(double x) { return x - 2.0 * PI * floor((x + PI) / (2.0 * PI)); }
+static double wrap_pi(double x)
+{
+  return x - 2.0 * PI * floor((x + PI) / (2.0 * PI));
+}
 
 /* Clipping signature: runs of >= 5 identical samples at the record's extreme. */
 static void clip_feed(clip_t *c, double x)
@@ -25,8 +28,10 @@ static void clip_feed(clip_t *c, double x)
     c->run = 1;
   } else if (a == c->max_abs && x == c->prev) {
     c->run++;
-    if (c->run == 5) c->plateau += 5;
-    else if (c->run > 5) c->plateau++;
+    if (c->run == 5)
+      c->plateau += 5;
+    else if (c->run > 5)
+      c->plateau++;
   } else if (a == c->max_abs) {
     c->run = 1;
   } else {
@@ -37,20 +42,20 @@ static void clip_feed(clip_t *c, double x)
 
 /* What the time column and the conventions look like over the whole file. */
 typedef struct {
-  double tprev, qprev;       /* previous t and its rounding bound */
-  double dt_min, dt_max;     /* raw steps */
+  double tprev, qprev;   /* previous t and its rounding bound */
+  double dt_min, dt_max; /* raw steps */
   long line_min, line_max;
-  double lo, hi;             /* steps widened / narrowed by their rounding */
+  double lo, hi; /* steps widened / narrowed by their rounding */
   long line_lo, line_hi;
   long repeats, line_repeat; /* steps of exactly 0 */
   double t_repeat;
-  double q_repeat, q_worst;  /* rounding of t at the first repeat, at the widest step */
-  int all_unit_steps;        /* every step exactly 1 (a sample index) */
-  double p_sum, s_sum;       /* sum of u.i, sum of |u||i| */
-  double field_rad, mech_rad;/* net rotation of the current vector, of theta */
+  double q_repeat, q_worst;   /* rounding of t at the first repeat, at the widest step */
+  int all_unit_steps;         /* every step exactly 1 (a sample index) */
+  double p_sum, s_sum;        /* sum of u.i, sum of |u||i| */
+  double field_rad, mech_rad; /* net rotation of the current vector, of theta */
   double i_prev[2];
   double th_prev, th_min, th_max;
-  long th_wraps;             /* steps beyond +-pi: the angle wraps somewhere */
+  long th_wraps; /* steps beyond +-pi: the angle wraps somewhere */
 } tally_t;
 
 static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const double v[CSV_NEED])
@@ -67,10 +72,22 @@ static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const
     y->th_min = y->th_max = v[7];
   } else {
     const double dt = v[0] - y->tprev, q = r->t_round + y->qprev;
-    if (dt < y->dt_min) { y->dt_min = dt; y->line_min = r->line; }
-    if (dt > y->dt_max) { y->dt_max = dt; y->line_max = r->line; }
-    if (dt + q < y->lo) { y->lo = dt + q; y->line_lo = r->line; }
-    if (dt - q > y->hi) { y->hi = dt - q; y->line_hi = r->line; }
+    if (dt < y->dt_min) {
+      y->dt_min = dt;
+      y->line_min = r->line;
+    }
+    if (dt > y->dt_max) {
+      y->dt_max = dt;
+      y->line_max = r->line;
+    }
+    if (dt + q < y->lo) {
+      y->lo = dt + q;
+      y->line_lo = r->line;
+    }
+    if (dt - q > y->hi) {
+      y->hi = dt - q;
+      y->line_hi = r->line;
+    }
     if (dt == y->dt_max) y->q_worst = r->t_round;
     if (dt == 0.0 && y->repeats++ == 0) {
       y->line_repeat = r->line;
@@ -100,7 +117,10 @@ static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const
 }
 
 /* Decimals a rounding bound stands for (5e-5 -> 4). */
-static int decimals(double q) { return q > 0 ? (int)lround(-log10(2.0 * q)) : 0; }
+static int decimals(double q)
+{
+  return q > 0 ? (int)lround(-log10(2.0 * q)) : 0;
+}
 
 /* t is not in seconds, or not a time at all: say which, and what to do. */
 static int bad_unit(const char *name, const tally_t *y, double step)
@@ -113,15 +133,16 @@ static int bad_unit(const char *name, const tally_t *y, double step)
             k_prog, name);
     return TOOL_EXIT_DATA;
   }
-  fprintf(stderr, "%s: %s: t steps by %.6g on average: %.6g Hz if t is in seconds, too slow for "
+  fprintf(stderr,
+          "%s: %s: t steps by %.6g on average: %.6g Hz if t is in seconds, too slow for "
           "any motor log (the estimator needs at least several hundred Hz).",
           k_prog, name, step, 1.0 / step);
   if (1e3 / step >= FS_IMPLAUSIBLE_HZ && 1e3 / step <= 1e6)
-    fprintf(stderr, " If t is in milliseconds (%.6g Hz), divide it by 1000 or give --fs %.6g.",
-            1e3 / step, 1e3 / step);
+    fprintf(stderr, " If t is in milliseconds (%.6g Hz), divide it by 1000 or give --fs %.6g.", 1e3 / step,
+            1e3 / step);
   else if (1e6 / step >= FS_IMPLAUSIBLE_HZ && 1e6 / step <= 1e6)
-    fprintf(stderr, " If t is in microseconds (%.6g Hz), divide it by 1e6 or give --fs %.6g.",
-            1e6 / step, 1e6 / step);
+    fprintf(stderr, " If t is in microseconds (%.6g Hz), divide it by 1e6 or give --fs %.6g.", 1e6 / step,
+            1e6 / step);
   fprintf(stderr, " If t is a sample index or a timer count, give --fs with the drive's sample "
                   "rate.\n");
   return TOOL_EXIT_DATA;
@@ -148,8 +169,10 @@ static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s
   }
   if (1.0 / step < FS_IMPLAUSIBLE_HZ || y->all_unit_steps) return bad_unit(name, y, step);
   if (1.0 / step > 1e6) {
-    fprintf(stderr, "%s: %s: t steps by %.6g s on average, %.6g Hz: is t in seconds? Write t in "
-            "seconds or give --fs HZ.\n", k_prog, name, step, 1.0 / step);
+    fprintf(stderr,
+            "%s: %s: t steps by %.6g s on average, %.6g Hz: is t in seconds? Write t in "
+            "seconds or give --fs HZ.\n",
+            k_prog, name, step, 1.0 / step);
     return TOOL_EXIT_DATA;
   }
   if (y->hi > 1.05 * step || y->lo < 0.95 * step) {
@@ -176,16 +199,17 @@ static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s
 }
 
 /* With --fs: t only orders the rows; its unit follows from its mean step. */
-static int time_base_given(const char *name, const tally_t *y, replay_scan_t *s, double fs,
-                           int quiet)
+static int time_base_given(const char *name, const tally_t *y, replay_scan_t *s, double fs, int quiet)
 {
   const double step = (s->t_last - s->t0) / (double)(s->n - 1);
   s->fs = fs;
   if (y->dt_min < 0) {
     /* a timer that wrapped, or no time at all: the output counts from the first row */
     if (!quiet)
-      fprintf(stderr, "%s: note: %s:%ld: t decreases; with --fs it is not used, output times "
-              "count from the first row\n", k_prog, name, y->line_min);
+      fprintf(stderr,
+              "%s: note: %s:%ld: t decreases; with --fs it is not used, output times "
+              "count from the first row\n",
+              k_prog, name, y->line_min);
     s->t_unit_s = 0.0;
     return -1;
   }
@@ -195,14 +219,14 @@ static int time_base_given(const char *name, const tally_t *y, replay_scan_t *s,
   for (size_t k = 0; k < sizeof k_units / sizeof k_units[0]; ++k)
     if (fabs(unit / k_units[k] - 1.0) < 0.05) {
       if (k == 0 && fabs(unit - 1.0) > 0.01 && !quiet)
-        fprintf(stderr, "%s: note: t says %.6g Hz, --fs says %.6g Hz: using --fs\n", k_prog,
-                s->fs_t, fs);
+        fprintf(stderr, "%s: note: t says %.6g Hz, --fs says %.6g Hz: using --fs\n", k_prog, s->fs_t, fs);
       unit = k_units[k];
       break;
     }
   s->t_unit_s = unit;
   if (step > 0 && (y->hi > 1.05 * step || y->lo < 0.95 * step) && !quiet)
-    fprintf(stderr, "%s: note: t's steps vary from %.6g to %.6g (mean %.6g, line %ld); with --fs "
+    fprintf(stderr,
+            "%s: note: t's steps vary from %.6g to %.6g (mean %.6g, line %ld); with --fs "
             "they are not checked: the rows are taken as samples at %.6g Hz\n",
             k_prog, y->dt_min, y->dt_max, step, y->hi > 1.05 * step ? y->line_hi : y->line_lo, fs);
   return -1;
@@ -220,8 +244,7 @@ static int check_conventions(const tally_t *y, const char *name, int quiet)
             "motor was braking, the current sign is inverted (currents must be positive into the "
             "motor) or a voltage and a current column are of different phases\n",
             k_prog, y->p_sum / y->s_sum);
-  if (fabs(y->field_rad) > 4.0 * PI && fabs(y->mech_rad) > PI &&
-      (y->field_rad > 0) != (y->mech_rad > 0)) {
+  if (fabs(y->field_rad) > 4.0 * PI && fabs(y->mech_rad) > PI && (y->field_rad > 0) != (y->mech_rad > 0)) {
     fprintf(stderr,
             "%s: %s: theta turns %s (%.3g turns) while the a-b-c current field turns %s (%.3g "
             "turns): theta must increase with the a-b-c field, else T_R comes out far too small "
@@ -251,7 +274,8 @@ int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s)
   int rc;
   while ((rc = csv_next(r, v)) == 1) {
     if (s->n > 0 && v[0] < y.tprev && o->fs_hz <= 0) {
-      fprintf(stderr, "%s: %s:%ld: t = %.9g does not increase (previous %.9g): rows out of "
+      fprintf(stderr,
+              "%s: %s:%ld: t = %.9g does not increase (previous %.9g): rows out of "
               "order, or a timer that wrapped (then give --fs HZ)\n",
               k_prog, r->name, r->line, v[0], y.tprev);
       return TOOL_EXIT_DATA;
@@ -263,8 +287,10 @@ int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s)
     return TOOL_EXIT_DATA;
   }
   if (r->truncated_line && !o->quiet)
-    fprintf(stderr, "%s: warning: %s: the last line looks cut off; it is left out and the "
-            "%ld rows before it are used\n", k_prog, r->warn, s->n);
+    fprintf(stderr,
+            "%s: warning: %s: the last line looks cut off; it is left out and the "
+            "%ld rows before it are used\n",
+            k_prog, r->warn, s->n);
   if (s->n < 2) {
     fprintf(stderr, "%s: %s: %s\n", k_prog, r->name,
             s->n == 0 ? "no data rows after the header" : "only one data row: no sample rate");

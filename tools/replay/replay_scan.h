@@ -14,15 +14,15 @@ typedef struct {
 } clip_t;
 
 typedef struct {
-  long n;                 /* data rows */
-  double t0, t_last;      /* first and last t, in the file's unit */
-  double fs;              /* the sample rate used [Hz]: --fs, or from t */
-  double fs_t;            /* the rate t implies if it is in seconds [Hz] */
-  double t_unit_s;        /* seconds per unit of t (1 unless --fs says otherwise) */
-  int t_rounded;          /* t's steps vary only by its printed rounding */
+  long n;            /* data rows */
+  double t0, t_last; /* first and last t, in the file's unit */
+  double fs;         /* the sample rate used [Hz]: --fs, or from t */
+  double fs_t;       /* the rate t implies if it is in seconds [Hz] */
+  double t_unit_s;   /* seconds per unit of t (1 unless --fs says otherwise) */
+  int t_rounded;     /* t's steps vary only by its printed rounding */
   clip_t clip_i[3], clip_u[3];
-  double i_first, i_max;  /* for the at-rest test */
-  double th_step1;        /* |first angle step| [rad] */
+  double i_first, i_max; /* for the at-rest test */
+  double th_step1;       /* |first angle step| [rad] */
 } replay_scan_t;
 
 /* Reads the whole file once. Returns -1 to go on, or the exit code after a

@@ -10,7 +10,8 @@
 #include "imest/imest_can.h"
 #include "imest_can_callback.h"
 
-int main(void) {
+int main(void)
+{
   static CAN_HandleTypeDef hcan1;
   static example_can_tx_t tx;
   imest_can_callback_t cb;
@@ -42,8 +43,8 @@ int main(void) {
     printf("window %u: %d frame(s) refused%s\n", k, failed, hcan1.bus_off ? " (bus-off)" : "");
     while (hcan1.busy[0] || hcan1.busy[1] || hcan1.busy[2]) fake_can_complete(&hcan1);
   }
-  printf("accepted %u refused %u tx_failed %u on bus %u\n", (unsigned)cb.sent,
-         (unsigned)cb.failed, (unsigned)pub.tx_failed, hcan1.n_log);
+  printf("accepted %u refused %u tx_failed %u on bus %u\n", (unsigned)cb.sent, (unsigned)cb.failed,
+         (unsigned)pub.tx_failed, hcan1.n_log);
   for (k = 0u; k < hcan1.n_log; k++) {
     unsigned int i;
     printf("%03X#", (unsigned)(hcan1.log[k].id & 0x7FFu));

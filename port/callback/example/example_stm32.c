@@ -14,7 +14,8 @@ static example_can_tx_t *g_tx_for_isr; /* firmware glue: one CAN controller */
 
 /* Move queued frames into free mailboxes. Runs either in the TX interrupt or
  * in the background task with that interrupt masked: never both at once. */
-static void kick(example_can_tx_t *t) {
+static void kick(example_can_tx_t *t)
+{
   while (t->tail != t->head && HAL_CAN_GetTxMailboxesFreeLevel(t->hcan) > 0u) {
     example_can_txe_t *e = &t->q[t->tail % EXAMPLE_CAN_TXQ];
     CAN_TxHeaderTypeDef h;
@@ -35,7 +36,8 @@ static void kick(example_can_tx_t *t) {
   }
 }
 
-void example_can_tx_init(example_can_tx_t *t, CAN_HandleTypeDef *hcan) {
+void example_can_tx_init(example_can_tx_t *t, CAN_HandleTypeDef *hcan)
+{
   t->hcan = hcan;
   t->head = 0u;
   t->tail = 0u;
@@ -43,8 +45,8 @@ void example_can_tx_init(example_can_tx_t *t, CAN_HandleTypeDef *hcan) {
   (void)HAL_CAN_ActivateNotification(hcan, CAN_IT_TX_MAILBOX_EMPTY);
 }
 
-int example_stm32_can_tx(void *hal, uint32_t id, int extended, const unsigned char *data,
-                         unsigned int dlc) {
+int example_stm32_can_tx(void *hal, uint32_t id, int extended, const unsigned char *data, unsigned int dlc)
+{
   example_can_tx_t *t = (example_can_tx_t *)hal;
   example_can_txe_t *e;
   unsigned int i;
@@ -70,7 +72,8 @@ int example_stm32_can_tx(void *hal, uint32_t id, int extended, const unsigned ch
 
 /* The HAL calls this from the CAN TX interrupt (mailbox 1 and 2 callbacks
  * would do the same). */
-void HAL_CAN_TxMailbox0CompleteCallback(CAN_HandleTypeDef *hcan) {
+void HAL_CAN_TxMailbox0CompleteCallback(CAN_HandleTypeDef *hcan)
+{
   if (g_tx_for_isr != NULL && g_tx_for_isr->hcan == hcan) {
     kick(g_tx_for_isr);
   }

@@ -32,7 +32,6 @@ void example_can_tx_init(example_can_tx_t *t, CAN_HandleTypeDef *hcan);
 /* imest_can_hal_tx_fn_t: pass the example_can_tx_t* as `hal`. Never blocks:
  * returns -1 when the software queue is full (e.g. the controller is
  * bus-off and nothing drains it). */
-int example_stm32_can_tx(void *hal, uint32_t id, int extended, const unsigned char *data,
-                         unsigned int dlc);
+int example_stm32_can_tx(void *hal, uint32_t id, int extended, const unsigned char *data, unsigned int dlc);
 
 #endif

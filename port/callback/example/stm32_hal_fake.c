@@ -2,7 +2,8 @@
 
 #include <stddef.h>
 
-uint32_t HAL_CAN_GetTxMailboxesFreeLevel(CAN_HandleTypeDef *hcan) {
+uint32_t HAL_CAN_GetTxMailboxesFreeLevel(CAN_HandleTypeDef *hcan)
+{
   uint32_t n = 0u;
   int i;
   for (i = 0; i < FAKE_CAN_MAILBOXES; i++) {
@@ -11,8 +12,9 @@ uint32_t HAL_CAN_GetTxMailboxesFreeLevel(CAN_HandleTypeDef *hcan) {
   return n;
 }
 
-HAL_StatusTypeDef HAL_CAN_AddTxMessage(CAN_HandleTypeDef *hcan, CAN_TxHeaderTypeDef *pHeader,
-                                       uint8_t aData[], uint32_t *pTxMailbox) {
+HAL_StatusTypeDef HAL_CAN_AddTxMessage(CAN_HandleTypeDef *hcan, CAN_TxHeaderTypeDef *pHeader, uint8_t aData[],
+                                       uint32_t *pTxMailbox)
+{
   int i;
   uint32_t k;
   if (hcan == NULL || pHeader == NULL || aData == NULL || pHeader->DLC > 8u || hcan->bus_off) {
@@ -32,17 +34,20 @@ HAL_StatusTypeDef HAL_CAN_AddTxMessage(CAN_HandleTypeDef *hcan, CAN_TxHeaderType
   return HAL_ERROR; /* the vendor HAL also fails at once when no mailbox is free */
 }
 
-HAL_StatusTypeDef HAL_CAN_ActivateNotification(CAN_HandleTypeDef *hcan, uint32_t ActiveITs) {
+HAL_StatusTypeDef HAL_CAN_ActivateNotification(CAN_HandleTypeDef *hcan, uint32_t ActiveITs)
+{
   hcan->it_enabled |= ActiveITs;
   return HAL_OK;
 }
 
-HAL_StatusTypeDef HAL_CAN_DeactivateNotification(CAN_HandleTypeDef *hcan, uint32_t InactiveITs) {
+HAL_StatusTypeDef HAL_CAN_DeactivateNotification(CAN_HandleTypeDef *hcan, uint32_t InactiveITs)
+{
   hcan->it_enabled &= ~InactiveITs;
   return HAL_OK;
 }
 
-void fake_can_complete(CAN_HandleTypeDef *hcan) {
+void fake_can_complete(CAN_HandleTypeDef *hcan)
+{
   int i;
   int any = 0;
   for (i = 0; i < FAKE_CAN_MAILBOXES; i++) {

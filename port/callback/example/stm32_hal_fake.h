@@ -9,8 +9,8 @@
 
 typedef enum { HAL_OK = 0, HAL_ERROR = 1, HAL_BUSY = 2, HAL_TIMEOUT = 3 } HAL_StatusTypeDef;
 
-#define CAN_ID_STD 0x00000000u
-#define CAN_ID_EXT 0x00000004u
+#define CAN_ID_STD   0x00000000u
+#define CAN_ID_EXT   0x00000004u
 #define CAN_RTR_DATA 0x00000000u
 
 typedef struct {
@@ -23,20 +23,20 @@ typedef struct {
 } CAN_TxHeaderTypeDef;
 
 #define FAKE_CAN_MAILBOXES 3
-#define FAKE_CAN_LOG 64
+#define FAKE_CAN_LOG       64
 
 typedef struct {
-  uint32_t id;      /* with bit 31 set for extended (as IMEST_CAN_ID_EXT) */
+  uint32_t id; /* with bit 31 set for extended (as IMEST_CAN_ID_EXT) */
   uint32_t dlc;
   uint8_t data[8];
 } fake_can_msg_t;
 
 typedef struct {
-  int bus_off;                               /* set: AddTxMessage fails */
-  uint32_t it_enabled;                       /* CAN_IT_* notifications on */
+  int bus_off;         /* set: AddTxMessage fails */
+  uint32_t it_enabled; /* CAN_IT_* notifications on */
   int busy[FAKE_CAN_MAILBOXES];
   fake_can_msg_t mailbox[FAKE_CAN_MAILBOXES];
-  fake_can_msg_t log[FAKE_CAN_LOG];          /* frames "sent" on the bus */
+  fake_can_msg_t log[FAKE_CAN_LOG]; /* frames "sent" on the bus */
   unsigned int n_log;
 } CAN_HandleTypeDef;
 
@@ -47,8 +47,8 @@ HAL_StatusTypeDef HAL_CAN_ActivateNotification(CAN_HandleTypeDef *hcan, uint32_t
 HAL_StatusTypeDef HAL_CAN_DeactivateNotification(CAN_HandleTypeDef *hcan, uint32_t InactiveITs);
 /* Defined by the application (weak in the vendor HAL): a mailbox finished. */
 void HAL_CAN_TxMailbox0CompleteCallback(CAN_HandleTypeDef *hcan);
-HAL_StatusTypeDef HAL_CAN_AddTxMessage(CAN_HandleTypeDef *hcan, CAN_TxHeaderTypeDef *pHeader,
-                                       uint8_t aData[], uint32_t *pTxMailbox);
+HAL_StatusTypeDef HAL_CAN_AddTxMessage(CAN_HandleTypeDef *hcan, CAN_TxHeaderTypeDef *pHeader, uint8_t aData[],
+                                       uint32_t *pTxMailbox);
 
 /* Fake only: the controller sends every pending mailbox (in mailbox order;
  * priority by identifier is not modelled), then raises the mailbox-empty

@@ -123,12 +123,12 @@ typedef struct {
 
   /* IFOC (indirect field orientation, slip from the controller's T_R). */
   imsim_ifoc_mode_t ifoc_mode;
-  bool ifoc_ideal_stage;   /* true: ideal voltage source (ZOH per sample) instead of PWM   */
-  double ifoc_tr_s;        /* controller's T_R (<= 0: use the motor's cold tr_s)            */
-  double ifoc_flux_wb;     /* rotor flux reference (<= 0: rated flux of the preset)          */
-  double speed_ref_rpm;    /* speed mode: reference, reached by a linear ramp over speed_ramp_s */
+  bool ifoc_ideal_stage; /* true: ideal voltage source (ZOH per sample) instead of PWM   */
+  double ifoc_tr_s;      /* controller's T_R (<= 0: use the motor's cold tr_s)            */
+  double ifoc_flux_wb;   /* rotor flux reference (<= 0: rated flux of the preset)          */
+  double speed_ref_rpm;  /* speed mode: reference, reached by a linear ramp over speed_ramp_s */
   double speed_ramp_s;
-  double torque_ref_nm;    /* torque mode: reference (applied after flux build-up, see README) */
+  double torque_ref_nm; /* torque mode: reference (applied after flux build-up, see README) */
   double torque_limit_nm;
   double current_bw_hz, speed_bw_hz, speed_filter_hz;
 
@@ -165,17 +165,17 @@ typedef struct {
   double theta;    /* rad, unwrapped, encoder-quantised          */
 
   /* Truth. */
-  double tr_s, rs_ohm;         /* present (temperature-dependent) values        */
-  double speed_rad_s;          /* mechanical                                    */
-  double torque_nm, load_nm;   /* electromagnetic torque, load torque           */
-  double psi_r_wb;             /* rotor-flux magnitude |psi_R| (alpha-beta)     */
+  double tr_s, rs_ohm;       /* present (temperature-dependent) values        */
+  double speed_rad_s;        /* mechanical                                    */
+  double torque_nm, load_nm; /* electromagnetic torque, load torque           */
+  double psi_r_wb;           /* rotor-flux magnitude |psi_R| (alpha-beta)     */
   double temp_stator_c, temp_rotor_c;
   double i_abc_true[3], theta_true;
-  double u_abc_true[3];        /* ideal supplies: instantaneous; PWM: actual applied (dead
+  double u_abc_true[3];                         /* ideal supplies: instantaneous; PWM: actual applied (dead
                                   time and drops included) average over the last carrier
                                   period (firmware timing: the last sample period)       */
   double i_ab_true[2], psi_ab[2], u_ab_true[2]; /* alpha-beta state (power invariant)   */
-  double accel_rad_s2;         /* d omega / dt from the model at t               */
+  double accel_rad_s2;                          /* d omega / dt from the model at t               */
   double p_cu_stator_w, p_cu_rotor_w;
   /* IFOC (NaN when not IFOC). */
   double ifoc_torque_ref_nm, ifoc_flux_ref_wb, ifoc_tr_s, ifoc_speed_ref_rad_s;
@@ -194,7 +194,9 @@ typedef struct {
 } imsim_steady_t;
 
 /* Private state. Declared here only so that the caller can own the storage (no malloc). */
-typedef struct { double re, im; } imsim_cpx_t;
+typedef struct {
+  double re, im;
+} imsim_cpx_t;
 typedef struct {
   uint64_t s[4]; /* xoshiro256** */
   double spare;  /* second Gaussian of the polar method */
@@ -214,7 +216,8 @@ typedef struct {
   uint64_t n;
   double te, acc; /* torque and acceleration at t */
   double temp_s, temp_r;
-  double load_override; bool load_overridden;
+  double load_override;
+  bool load_overridden;
   /* supply bookkeeping */
   double u_hp_cmd[2][2], u_hp_act[2][2]; /* last two half-period averages (re, im) */
   int hp_count;
@@ -226,7 +229,8 @@ typedef struct {
   double u_zoh[2];
   /* sensors: rng for the phase channels, rng_vdc (own stream) for the bus */
   imsim_rng_t rng, rng_vdc;
-  double i_meas_ab[2]; double th_meas;
+  double i_meas_ab[2];
+  double th_meas;
   double vdc_meas;
   /* firmware timing: duties applied now and those computed at the last sample */
   double duty[3], duty_next[3];
@@ -268,10 +272,10 @@ void imsim_step(imsim_t *sim, imsim_sample_t *out);
 void imsim_get_pwm_stats(const imsim_t *sim, imsim_pwm_stats_t *out);
 
 /* Run-time controls. */
-void imsim_set_ifoc_tr(imsim_t *sim, double tr_s);   /* controller's T_R, takes effect at the next step */
-void imsim_set_speed_ref(imsim_t *sim, double rpm);  /* IFOC speed reference (no ramp)          */
-void imsim_set_torque_ref(imsim_t *sim, double nm);  /* IFOC torque-mode reference              */
-void imsim_set_load(imsim_t *sim, double load_nm);   /* overrides the load profile              */
+void imsim_set_ifoc_tr(imsim_t *sim, double tr_s);  /* controller's T_R, takes effect at the next step */
+void imsim_set_speed_ref(imsim_t *sim, double rpm); /* IFOC speed reference (no ramp)          */
+void imsim_set_torque_ref(imsim_t *sim, double nm); /* IFOC torque-mode reference              */
+void imsim_set_load(imsim_t *sim, double load_nm);  /* overrides the load profile              */
 
 /* External commands (supply IMSIM_SUPPLY_EXT), firmware timing: after imsim_init or
    imsim_step has returned the sample at t_k, the caller sets the command computed from it; it
