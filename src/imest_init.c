@@ -36,6 +36,19 @@ void imest_config_default(imest_config_t *cfg)
   cfg->i_absurd_a = 1.0e4f;
   cfg->u_absurd_v = 1.0e5f;
   cfg->speed_limit_rad_s = 3000.0f;
+  cfg->pwm_hz = 0.0f;
+  cfg->pwm_timing = IMEST_PWM_NEXT_PERIOD;
+  cfg->inverter.dead_time_s = 0.0f;
+  cfg->inverter.v_switch_v = 0.0f;
+  cfg->inverter.r_switch_ohm = 0.0f;
+  cfg->inverter.v_diode_v = 0.0f;
+  cfg->inverter.r_diode_ohm = 0.0f;
+  cfg->inverter.i_band_a = 0.0f;
+  cfg->inverter.uncertainty = -1.0f; /* unknown until the user (or commissioning) says */
+  cfg->rs_tolerance = 0.05f;
+  cfg->u_uncertainty_v = 0.0f;
+  cfg->timing_uncertainty_s = 2.0e-6f;
+  cfg->rs_nominal_ohm = 0.0f;
 }
 
 static int finite_pos(float x)
@@ -262,6 +275,10 @@ const char *imest_reason_name(int reason)
   case IMEST_REASON_POORLY_DETERMINED: return "poorly_determined";
   case IMEST_REASON_HIGH_RESIDUAL: return "high_residual";
   case IMEST_REASON_RS_OUT_OF_RANGE: return "rs_out_of_range";
+  case IMEST_REASON_WIRING_MISMATCH: return "wiring_mismatch";
+  case IMEST_REASON_CONSTANTS_MISMATCH: return "constants_mismatch";
+  case IMEST_REASON_RS_UNCERTAIN: return "rs_uncertain";
+  case IMEST_REASON_GAIN_MISMATCH: return "gain_mismatch";
   default: return "unknown";
   }
 }

@@ -119,7 +119,17 @@ typedef enum {
   IMEST_REASON_NOT_MINIMUM = 19,       /**< Hessian at the selected point not positive definite */
   IMEST_REASON_POORLY_DETERMINED = 20, /**< relative parametric error index of K2 too large */
   IMEST_REASON_HIGH_RESIDUAL = 21,     /**< E_I above max_ei: the data do not fit the model */
-  IMEST_REASON_RS_OUT_OF_RANGE = 22    /**< R_S outside [rs_min_ohm, rs_max_ohm] */
+  IMEST_REASON_RS_OUT_OF_RANGE = 22,   /**< R_S outside [rs_min_ohm, rs_max_ohm] */
+  /** the data contradict the configured conventions: encoder direction, phase order, pole pairs,
+   *  electrical instead of mechanical angle, units (README remedies) */
+  IMEST_REASON_WIRING_MISMATCH = 23,
+  /** R_S far outside what heating explains around rs_nominal_ohm: L_S, sigma or the nominal R_S
+   *  are wrong */
+  IMEST_REASON_CONSTANTS_MISMATCH = 24,
+  /* R_S only (T_R may still be valid): */
+  /** R_S's error bound (inverter voltage error, timing, noise) exceeds rs_tolerance */
+  IMEST_REASON_RS_UNCERTAIN = 25,
+  IMEST_REASON_GAIN_MISMATCH = 26 /**< the current sensors' gains differ by more than R_S tolerates */
 } imest_reason_t;
 
 /** Short lower-case name of a reason ("ok", "warmup", "zero_slip", ...). */
@@ -131,11 +141,52 @@ const char *imest_reason_name(int reason);
 #define IMEST_FLAG_ADC_SAT       0x0004u
 #define IMEST_FLAG_ENCODER_FAULT 0x0008u
 #define IMEST_FLAG_OVERRUN       0x0010u /**< one or more windows before this one were dropped */
-#define IMEST_FLAG_HESSIAN_PD    0x0100u /**< Hessian positive definite at the selected point */
+#define IMEST_FLAG_CURRENT_STEP  0x0020u /**< a current step beyond what the voltage can drive (a spike) */
+#define IMEST_FLAG_COMBINED      0x0040u /**< the estimate combines this window with earlier ones */
+#define IMEST_FLAG_GAIN_MISMATCH                                                                             \
+  0x0080u                             /**< the zero sequence of three current sensors shows a gain mismatch */
+#define IMEST_FLAG_HESSIAN_PD 0x0100u /**< Hessian positive definite at the selected point */
 
 /* ----------------------------------------------------------------------------
  * Configuration
  * ------------------------------------------------------------------------- */
+
+/** How the duty cycles passed to imest_isr_duty() relate to the sample instants t_k
+ *  (centre-aligned PWM; T = 1/fs_hz, one sample every N carrier periods). */
+typedef enum {
+  /** the duties passed with sample k are applied during [t_k, t_k + T): computed in the previous
+   *  ISR, loaded into the shadow registers at the carrier valley where sample k is taken (the usual
+   *  scheme; default) */
+  IMEST_PWM_NEXT_PERIOD = 0,
+  /** applied during [t_k - T/2, t_k + T/2): e.g. loaded at the carrier peak half a period before
+   *  sample k */
+  IMEST_PWM_CENTRED = 1,
+  IMEST_PWM_LAST_PERIOD = 2 /**< applied during [t_k - T, t_k): the period that just ended */
+} imest_pwm_timing_t;
+
+/** The inverter's voltage error per leg, for the duty-cycle input: how much less a
+ *  leg delivers than its commanded d * V_dc, for the phase current i (into the motor):
+ *
+ *      e(i, d) = s(i) * [ t_d f_pwm V_dc + V_d0 + r_d |i| + d_c ((V_sw0 - V_d0) + (r_sw - r_d) |i|) ]
+ *
+ *  with d_c the share of the period the active switch conducts (d for i > 0, 1 - d
+ *  for i < 0) and s(i) the sign of i made linear over |i| < i_band_a (the current
+ *  ripple crosses zero inside the period there, so the error fades rather than
+ *  jumping). All zero: an ideal (or fully compensated) inverter. commissioning
+ *  (imest_commission.h) measures these numbers. */
+typedef struct {
+  float dead_time_s;  /**< effective dead time, switching delays included [s] */
+  float v_switch_v;   /**< switch (IGBT, MOSFET) threshold voltage V_sw0 [V] */
+  float r_switch_ohm; /**< switch slope resistance r_sw [ohm] */
+  float v_diode_v;    /**< freewheeling diode threshold voltage V_d0 [V] */
+  float r_diode_ohm;  /**< diode slope resistance r_d [ohm] */
+  /** half-width of the zero-crossing transition [A] (0: the current ripple's peak, V_dc / (8 sigma
+   *  L_S f_pwm)) */
+  float i_band_a;
+  /** relative uncertainty of this model's error (e.g. 0.2 for 20 %); negative: the error is unknown
+   *  (default), so R_S is never valid with the duty-cycle input */
+  float uncertainty;
+} imest_inverter_t;
 
 /** Configuration. Fill with imest_config_default(), then set the motor. */
 typedef struct {
@@ -149,57 +200,72 @@ typedef struct {
   float window_s; /**< window length [s] (default 1.0) */
 
   /* Front end. */
-  float filter_hz;   /**< Butterworth-3 cut-off [Hz] (default 100: works for
-                                 run-up and steady state with 12-bit sensors) */
-  float aa_hz;       /**< if the analog current/voltage channels have a 2nd-order
-                                 anti-alias filter, its cut-off [Hz]; the angle is
-                                 then passed through a digital model of it so all
-                                 channels see the same delay (0 = none, default) */
-  float u_delay_s;   /**< how much the voltage samples lag the current samples [s],
-                                 0 .. 1/fs_hz (default 0). E.g. a phase voltage
-                                 reconstructed from the duty cycles of the PWM period that
-                                 just ended lags by half a carrier period (50 us at 10 kHz):
-                                 uncompensated, that biases R_S by about +5 % at 30 Hz. The
-                                 currents and the angle are delayed to match (linear
-                                 interpolation). */
-  float dc_block_hz; /**< cut-off [Hz] of a first-order high-pass applied alike to the
-                                 alpha/beta voltages and currents before the rotation: it
-                                 removes sensor offsets (default 1; 0 = off). Applied to
-                                 both, it leaves the motor's equations intact at constant
-                                 speed; see README "Method" (sensor offsets). The first start
-                                 (unless start_at_rest) waits 5 time constants more for it:
-                                 0.8 s at 1 Hz. */
-  float warmup_s;    /**< samples discarded after start/fault while the filters
-                                 settle [s] (default 0: derived from filter_hz) */
-  int start_at_rest; /**< nonzero: the first sample follows a zero history
-                                 (drive just enabled, motor at rest, no current),
-                                 so no warm-up is needed at start (default 0) */
+  /** Butterworth-3 cut-off [Hz] (default 100: works for run-up and steady state with 12-bit
+   *  sensors) */
+  float filter_hz;
+  /** if the analog current/voltage channels have a 2nd-order anti-alias filter, its cut-off [Hz];
+   *  the angle is then passed through a digital model of it so all channels see the same delay (0 =
+   *  none, default) */
+  float aa_hz;
+  /** how much the voltage lags the currents [s], beyond what pwm_timing already accounts for;
+   *  negative: the voltage leads (e.g. currents sampled late). |u_delay_s| <= 1/fs_hz (default 0).
+   *  E.g. a phase voltage taken from the duty cycles of the PWM period that just ended lags by half
+   *  a period (50 us at 10 kHz): uncompensated, that biases R_S by about +5 % at 30 Hz. Compensated
+   *  by linear interpolation of whichever side leads. */
+  float u_delay_s;
+  /** cut-off [Hz] of a first-order high-pass applied alike to the alpha/beta voltages and currents
+   *  before the rotation: it removes sensor offsets (default 1; 0 = off). Applied to both, it
+   *  leaves the motor's equations intact at constant speed; see README "Method" (sensor offsets).
+   *  The first start (unless start_at_rest) waits 5 time constants more for it: 0.8 s at 1 Hz. */
+  float dc_block_hz;
+  /** samples discarded after start/fault while the filters settle [s] (default 0: derived from
+   *  filter_hz) */
+  float warmup_s;
+  /** nonzero: the first sample follows a zero history (drive just enabled, motor at rest, no
+   *  current), so no warm-up is needed at start (default 0) */
+  int start_at_rest;
+
+  /* Duty-cycle input (imest_isr_duty). */
+  float pwm_hz;                  /**< carrier frequency [Hz] (default 0: fs_hz, one sample per period) */
+  imest_pwm_timing_t pwm_timing; /**< when the duties passed with a sample apply (default NEXT_PERIOD) */
+  imest_inverter_t inverter;     /**< the inverter's voltage error (default: unknown) */
 
   /* Solve and selection. */
-  float tr_nominal_s; /**< nominal T_R, used for scaling and the first centring
-                                 (default 0.1 s) */
-  float tr_min_s;     /**< admissible T_R band [s] (default 1 ms .. 10 s) */
+  /** nominal T_R, used for scaling and the first centring (default 0.1 s) */
+  float tr_nominal_s;
+  float tr_min_s; /**< admissible T_R band [s] (default 1 ms .. 10 s) */
   float tr_max_s;
   float rs_min_ohm; /**< admissible R_S band [ohm] (default 0 .. 1e3) */
   float rs_max_ohm;
 
   /* Validity (see README "When is a window valid"). */
-  float max_pe_k2_rel;  /**< largest relative parametric error index of K2 (default 0.1) */
-  float max_ei;         /**< largest residual error index E_I (default 3.0: a sanity bound; the
-                                 PE index is the evidence of trust, README) */
-  float min_current_a;  /**< least rms stator current (alpha/beta amplitude) [A] (default 0.05) */
-  float min_slip_ratio; /**< least slip excitation: mean rotation rate of the rotor-frame
-                                 current x tr_nominal_s, i.e. slip frequency x T_R in steady
-                                 state (default 0.1, i.e. rotor current >= ~10 % of the
-                                 magnetising current; rated load is about 1) */
+  float max_pe_k2_rel; /**< largest relative parametric error index of K2 (default 0.1) */
+  /** largest residual error index E_I (default 3.0: a sanity bound; the PE index is the evidence of
+   *  trust, README) */
+  float max_ei;
+  float min_current_a; /**< least rms stator current (alpha/beta amplitude) [A] (default 0.05) */
+  /** least slip excitation: mean rotation rate of the rotor-frame current x tr_nominal_s, i.e. slip
+   *  frequency x T_R in steady state (default 0.1, i.e. rotor current >= ~10 % of the magnetising
+   *  current; rated load is about 1) */
+  float min_slip_ratio;
+  float rs_tolerance; /**< R_S is valid only if its error bound is within this, relative (default 0.05) */
+  /** phase-voltage input: uncertainty of the measured voltage's fundamental [V] (default 0: measured
+   *  voltages are trusted) */
+  float u_uncertainty_v;
+  /** uncertainty of the voltage/current alignment after pwm_timing and u_delay_s [s] (default 2e-6) */
+  float timing_uncertainty_s;
+  /** R_S at ambient temperature, from the data sheet or commissioning (0: unknown, default). A window
+   *  whose R_S lies outside what heating explains (0.7 .. 1.8 x this) is constants_mismatch */
+  float rs_nominal_ohm;
 
   /* Input plausibility (per sample, ISR). */
-  float i_limit_a;         /**< |phase current| >= this counts as ADC saturation (0 = off) */
-  float u_limit_v;         /**< |phase voltage| >= this counts as ADC saturation (0 = off) */
-  float i_absurd_a;        /**< |current| beyond this (or non-finite) is an input fault (default 1e4) */
-  float u_absurd_v;        /**< |voltage| beyond this (or non-finite) is an input fault (default 1e5) */
-  float speed_limit_rad_s; /**< |mechanical angle step| * fs beyond this is an encoder fault
-                                 (default 3000 rad/s, about 28 600 rpm) */
+  float i_limit_a;  /**< |phase current| >= this counts as ADC saturation (0 = off) */
+  float u_limit_v;  /**< |phase voltage| >= this counts as ADC saturation (0 = off) */
+  float i_absurd_a; /**< |current| beyond this (or non-finite) is an input fault (default 1e4) */
+  float u_absurd_v; /**< |voltage| beyond this (or non-finite) is an input fault (default 1e5) */
+  /** |mechanical angle step| * fs beyond this is an encoder fault (default 3000 rad/s, about 28 600
+   *  rpm) */
+  float speed_limit_rad_s;
 } imest_config_t;
 
 /** Fill a config with defaults (motor constants zero: the caller must set them). */
@@ -224,21 +290,23 @@ int imest_config_check(const imest_config_t *cfg, const char **field);
  *  keeps its number when it is not valid: only the verdict says whether to
  *  use it. */
 typedef struct {
-  uint32_t seq;              /**< window sequence number (0, 1, 2, ...; gaps = dropped windows) */
-  uint32_t samples;          /**< samples in the window */
-  uint32_t used_samples;     /**< samples accumulated (not warm-up, not faulty) */
-  uint32_t overruns;         /**< windows dropped since init (background too slow) */
-  int valid;                 /**< 1: T_R and R_S can both be trusted (tr_valid && rs_valid) */
-  int status;                /**< IMEST_REASON_NONE, else the first reason (tr_reason if T_R is
-                                 not valid, else rs_reason): imest_reason_t */
-  int tr_valid;              /**< 1: T_R can be trusted (feed it to the IFOC) */
-  int tr_reason;             /**< why T_R is not valid (imest_reason_t; NONE if tr_valid) */
-  int rs_valid;              /**< 1: R_S can be trusted */
-  int rs_reason;             /**< why R_S is not valid (imest_reason_t; NONE if rs_valid) */
-  unsigned int flags;        /**< IMEST_FLAG_* bits */
-  double t_end_s;            /**< time of the window's last sample since init [s] */
-  double span_s;             /**< time the estimate is drawn from [s]: the window length,
-                                 longer when consecutive windows were combined */
+  uint32_t seq;          /**< window sequence number (0, 1, 2, ...; gaps = dropped windows) */
+  uint32_t samples;      /**< samples in the window */
+  uint32_t used_samples; /**< samples accumulated (not warm-up, not faulty) */
+  uint32_t overruns;     /**< windows dropped since init (background too slow) */
+  int valid;             /**< 1: T_R and R_S can both be trusted (tr_valid && rs_valid) */
+  /** IMEST_REASON_NONE, else the first reason (tr_reason if T_R is not valid, else rs_reason):
+   *  imest_reason_t */
+  int status;
+  int tr_valid;       /**< 1: T_R can be trusted (feed it to the IFOC) */
+  int tr_reason;      /**< why T_R is not valid (imest_reason_t; NONE if tr_valid) */
+  int rs_valid;       /**< 1: R_S can be trusted */
+  int rs_reason;      /**< why R_S is not valid (imest_reason_t; NONE if rs_valid) */
+  unsigned int flags; /**< IMEST_FLAG_* bits */
+  double t_end_s;     /**< time of the window's last sample since init [s] */
+  /** time the estimate is drawn from [s]: the window length, longer when consecutive windows were
+   *  combined */
+  double span_s;
   unsigned int windows;      /**< windows combined into this estimate (1: this one alone) */
   double tr_s;               /**< rotor time constant T_R [s] (NaN if no candidate) */
   double rs_ohm;             /**< stator resistance R_S [ohm] */
@@ -359,6 +427,21 @@ int imest_init(imest_t *s, const imest_config_t *cfg);
  * @retval 0  otherwise (no error is possible: bad samples are flagged in the window)
  */
 int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], float theta_rad);
+
+/**
+ * ISR call for drives that know the phase voltage only from their duty cycles.
+ * The library keeps the previous duties and forms the phase-to-neutral voltage
+ * centred on this sample (pwm_timing), zero sequence removed, minus its model
+ * of the inverter's voltage error (cfg.inverter). Fixed instruction count.
+ * @param duty_abc  the upper switches' duty cycles in [0, 1] that apply as
+ *                  cfg.pwm_timing says (default: during the period that starts
+ *                  at this sample, i.e. what the previous ISR computed)
+ * @param vdc_v     DC-bus voltage sampled now [V]
+ * @param i_abc_a   phase currents [A], positive into the motor
+ * @param theta_rad mechanical rotor angle [rad], as for imest_isr_abc()
+ * @retval 1, 0  as imest_isr_abc()
+ */
+int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float i_abc_a[3], float theta_rad);
 
 /** ISR call with alpha/beta quantities (power-invariant 3-2 transform, docs/METHOD.md
  *  §1: amplitude = line-to-line rms; an amplitude-invariant Clarke transform
