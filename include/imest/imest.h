@@ -172,8 +172,8 @@ typedef enum {
  *  with d_c the share of the period the active switch conducts (d for i > 0, 1 - d
  *  for i < 0) and s(i) the sign of i made linear over |i| < i_band_a (the current
  *  ripple crosses zero inside the period there, so the error fades rather than
- *  jumping). All zero: an ideal (or fully compensated) inverter. commissioning
- *  (imest_commission.h) measures these numbers. */
+ *  jumping). All zero: an ideal (or fully compensated) inverter. The library's
+ *  standstill commissioning measures these numbers. */
 typedef struct {
   float dead_time_s;  /**< effective dead time, switching delays included [s] */
   float v_switch_v;   /**< switch (IGBT, MOSFET) threshold voltage V_sw0 [V] */
