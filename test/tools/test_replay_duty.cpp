@@ -262,3 +262,13 @@ TEST(ReplayDuty, ConventionChecksWorkWithDuties)
   EXPECT_EQ(o.code, 1);
   EXPECT_NE(o.err.find("theta must increase with the a-b-c field"), std::string::npos) << o.err;
 }
+
+// A drive started from rest is recognised as such in duty mode (no warm-up),
+// though a 16384-count encoder steps by one count at the first sample.
+TEST(ReplayDuty, StartFromRestIsRecognised)
+{
+  const std::string &p = sim_csv("4kw_rest.csv", "--preset 4kw --start rest --duration 2");
+  const Out o = duty(p);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.err.find("started at rest"), std::string::npos) << o.err;
+}

@@ -26,6 +26,10 @@
 
 static const char *const k_prog = "imest-replay";
 
+/* One count of a 4096-count encoder [rad]: a first angle step this small is
+ * encoder noise on a still rotor. */
+#define ENCODER_COUNT_STILL_RAD (6.283185307179586 / 4096.0 * 1.0001)
+
 /* ------------------------------------------------------------------------- */
 /* configure: from the options and the scan to an estimator config            */
 
@@ -61,9 +65,11 @@ static int configure(const replay_opts_t *o, const replay_scan_t *s, imest_confi
   cfg->u_limit_v = (float)adc_limit(o->u_limit, s->clip_u, 'u', "V", "--u-limit", o->quiet);
   /* At rest: no current and a still rotor imply a zero history for every
    * filter (no current means no flux and no voltage either). The rotor test
-   * uses the first step only: a DOL start accelerates within ms. */
-  cfg->start_at_rest =
-      o->from_rest >= 0 ? o->from_rest : (s->i_first <= 0.01 * s->i_max && s->th_step1 * s->fs < 2.0);
+   * uses the first step only: a DOL start accelerates within ms. A still
+   * rotor may show one count of a fine encoder (at 8 kHz one count of 16384
+   * is 3 rad/s), so a step up to a 4096-count encoder's count is still. */
+  const int still = s->th_step1 * s->fs < 2.0 || s->th_step1 <= ENCODER_COUNT_STILL_RAD;
+  cfg->start_at_rest = o->from_rest >= 0 ? o->from_rest : (s->i_first <= 0.01 * s->i_max && still);
   const char *field = NULL;
   if (imest_config_check(cfg, &field) != IMEST_OK) return replay_explain_config(o, s, cfg, field);
   return -1;
