@@ -193,7 +193,7 @@ int imest_comm_isr(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float t
     if (c->stage < IMEST_COMM_STAGE_ROTATE) {
       const float moved = cm_absf(theta_rad - c->th0 + CM_2PI * (float)c->wraps);
       if (moved > c->th_dev) c->th_dev = moved;
-      if (moved > 0.2f) {
+      if (moved > 1.0f) { /* a sixth of a turn: the rotor is driven, not creeping */
         cm_fail(c, IMEST_COMM_REASON_ROTOR_MOVED);
         return 0;
       }

@@ -261,12 +261,13 @@ const char *imest_comm_state_name(int state);
 #define IMEST_COMM_FLAG_ENCODER_REVERSED 0x0040u /**< the angle decreases with the a-b-c field */
 #define IMEST_COMM_FLAG_CPR_MISMATCH     0x0080u /**< the encoder counts differ from encoder_cpr */
 #define IMEST_COMM_FLAG_AXIS_SPREAD      0x0100u /**< R_S or sigma*L_S differ by > 3 % between axes */
-#define IMEST_COMM_FLAG_ROTOR_CREPT      0x0200u /**< the rotor moved slightly at standstill (< 0.2 rad) */
-#define IMEST_COMM_FLAG_LOAD_ON_SHAFT    0x0400u /**< slip x T_R > 0.05 while rotating: not at no load */
-#define IMEST_COMM_FLAG_GAIN_MISMATCH    0x0800u /**< sensor gains differ by more than 0.5 % */
+#define IMEST_COMM_FLAG_ROTOR_CREPT                                                                          \
+  0x0200u /**< the rotor moved at standstill, by more than 0.01 rad (the stop is at 1 rad) */
+#define IMEST_COMM_FLAG_LOAD_ON_SHAFT   0x0400u /**< slip x T_R > 0.05 while rotating: not at no load */
+#define IMEST_COMM_FLAG_GAIN_MISMATCH   0x0800u /**< sensor gains differ by more than 0.5 % */
 /** dead time and threshold voltages not separable (the clamped patterns' pulses were too short):
  *  the whole error is in dead_time_s */
-#define IMEST_COMM_FLAG_INVERTER_LUMPED  0x1000u
+#define IMEST_COMM_FLAG_INVERTER_LUMPED 0x1000u
 
 /** One identified value with its quality. */
 typedef struct {

@@ -85,6 +85,7 @@ void comm_sim_comm_config(const comm_sim_opts_t *o, const imsim_config_t *sc, im
   cc->i_max_a = (float)(o->i_max_a > 0.0 ? o->i_max_a : sqrt(2.0) * sc->rated_current_a);
   cc->encoder_cpr = (float)(o->cpr_assumed > 0.0 ? o->cpr_assumed : (double)sc->encoder_counts);
   cc->r_series_ohm = (float)o->r_series_ohm;
+  cc->n_sensors = o->two_sensors ? 2u : 3u;
   cc->allow_rotation = o->allow_rotation;
   cc->rated_voltage_v = (float)sc->rated_voltage_v;
   cc->rated_freq_hz = (float)sc->rated_freq_hz;
@@ -193,6 +194,7 @@ int comm_sim_run(const comm_sim_opts_t *o, comm_sim_out_t *out)
   if (o->trace) fprintf(o->trace, "t,stage,i_a,i_b,i_c,d_a,d_b,d_c,speed_rad_s,theta\n");
   for (uint64_t n = 0; n < n_max; ++n) {
     float i[3] = {(float)s.i_abc[0], (float)s.i_abc[1], (float)s.i_abc[2]};
+    if (o->two_sensors) i[2] = -i[0] - i[1];
     if (o->swap_sensors_bc) {
       const float t = i[1];
       i[1] = i[2];

@@ -41,6 +41,7 @@ static void usage(FILE *f)
           "  --cpr-assumed N      counts the firmware assumes [the true ones]\n"
           "  --encoder-reversed   the angle counts against the a-b-c field\n"
           "  --swap-sensors       current channels b and c swapped\n"
+          "  --two-sensors        the firmware computes i_c = -i_a - i_b\n"
           "  --seed N             noise seed [1]\n"
           "  --trace FILE         per-sample CSV (t, stage, currents, duties, speed, angle)\n"
           "  --trace-decimate N   every N-th sample in the trace [1]\n"
@@ -120,6 +121,9 @@ int main(int argc, char **argv)
     } else if (tool_args_is(&a, "--swap-sensors")) {
       if (tool_args_flag(&a)) return 2;
       o.swap_sensors_bc = 1;
+    } else if (tool_args_is(&a, "--two-sensors")) {
+      if (tool_args_flag(&a)) return 2;
+      o.two_sensors = 1;
     } else if (tool_args_is(&a, "--verbose")) {
       if (tool_args_flag(&a)) return 2;
       verbose = 1;
@@ -216,9 +220,18 @@ int main(int argc, char **argv)
   row("sigma", 1.0, r->sigma.value, out.sigma, NULL);
   row("T_R [ms]", 1e3, r->tr_s.value, out.tr_s, "flux tails");
   row("R_R' [ohm]", 1.0, r->rr_ohm.value, out.rr_ohm, "(1-sigma) L_S / T_R");
-  printf("  %-26s %12u %12u %9s   %s\n", "n_p", r->pole_pairs, out.pole_pairs,
-         r->pole_pairs == out.pole_pairs ? "ok" : "WRONG",
-         (r->flags & IMEST_COMM_FLAG_NP_NAMEPLATE) ? "from the rated speed" : "from the speed ratio");
+  {
+    /* with the firmware's counts assumed right, n_p x the firmware's angle is what must match */
+    const double cpr_fw = o.cpr_assumed > 0.0 ? o.cpr_assumed : (double)sc->encoder_counts;
+    const double np_equiv = (double)r->pole_pairs * (double)sc->encoder_counts / cpr_fw;
+    const char *verdict = r->pole_pairs == out.pole_pairs                  ? "ok"
+                          : fabs(np_equiv - (double)out.pole_pairs) < 1e-9 ? "ok x angle"
+                                                                           : "WRONG";
+    printf("  %-26s %12u %12u %9s   %s\n", "n_p", r->pole_pairs, out.pole_pairs, verdict,
+           (r->flags & IMEST_COMM_FLAG_NP_NAMEPLATE)
+               ? "from the rated speed"
+               : "from the speed ratio (n_p x the firmware's angle is what counts)");
+  }
   const int dir_true = o.encoder_reversed ? -1 : 1;
   printf("  %-26s %12d %12d %9s   speed ratio %.5f\n", "encoder direction", r->encoder_dir, dir_true,
          r->encoder_dir == dir_true ? "ok" : "WRONG", (double)r->speed_ratio);
