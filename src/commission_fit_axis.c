@@ -40,6 +40,7 @@
 
 enum { COL_R = 0, COL_TD = 1, COL_VTH = 2, COL_DR = 3, COL_TAIL = 4 };
 #define NPAR (4u + CM_PLATEAUS)
+_Static_assert(IMEST_COMM_NBLK <= 64, "the skip mask has 64 bits");
 
 typedef struct {
   imest_comm_t *c;
@@ -136,7 +137,7 @@ static double axis_solve(axis_ctx_t *x, double tau)
   }
   x->npar = np;
   x->ok = np > 0u && cm_chol_solve(a, r, np, x->dinv) == 0;
-  if (!x->ok) return 1e300;
+  if (!x->ok) return 1e30;
   double sse = 0.0;
   for (unsigned int i = 0; i < np; ++i) x->beta[i] = r[i];
   for (uint32_t bi = 0; bi < x->nb; ++bi) {
@@ -269,7 +270,7 @@ void cm_fit_axis(imest_comm_t *c, uint32_t axis)
     const double td = x.lumped ? 0.0 : x.beta[COL_TD];
     uint64_t skip = x.skip;
     uint32_t clamped = 0u;
-    for (uint32_t bi = 0; bi < x.nb && bi < 64u; ++bi) {
+    for (uint32_t bi = 0; bi < x.nb; ++bi) {
       const imest_comm_block_t *b = &c->blk[bi];
       if (!dc_block(b) || CM_TAG_PATTERN(b->tag) == CM_PAT_CENTRED) continue;
       if ((double)b->s[CM_S_PULSE] / (double)b->n < 2.1 * td * (double)c->fpwm) skip |= (uint64_t)1u << bi;

@@ -153,7 +153,7 @@ int imest_comm_status(const imest_comm_t *c, imest_comm_status_t *st)
   st->state = c->state;
   st->stage = (int)c->stage;
   st->reason = c->reason;
-  st->axis = c->axis;
+  st->axis = (unsigned int)c->axis;
   st->time_s = (float)c->k * c->ts_s;
   /* rough shares of the run: the three axes take most of the standstill part; the rotating
      part, when allowed, about a third of the whole */
@@ -179,39 +179,53 @@ int imest_comm_status(const imest_comm_t *c, imest_comm_status_t *st)
 
 const char *imest_comm_reason_name(int reason)
 {
-  static const char *const names[] = {"none",
-                                      "aborted",
-                                      "input_fault",
-                                      "overcurrent",
-                                      "current_at_rest",
-                                      "open_phase",
-                                      "wiring",
-                                      "current_not_reached",
-                                      "rotor_moved",
-                                      "timeout",
-                                      "background",
-                                      "fit",
-                                      "implausible",
-                                      "encoder_still",
-                                      "rotor_blocked",
-                                      "phase_order",
-                                      "pole_pairs_ambiguous",
-                                      "current_limit_rotating"};
-  if (reason < 0 || reason >= (int)(sizeof names / sizeof names[0])) return "unknown";
-  return names[reason];
+  switch (reason) {
+  case IMEST_COMM_REASON_NONE: return "none";
+  case IMEST_COMM_REASON_ABORTED: return "aborted";
+  case IMEST_COMM_REASON_INPUT_FAULT: return "input_fault";
+  case IMEST_COMM_REASON_OVERCURRENT: return "overcurrent";
+  case IMEST_COMM_REASON_CURRENT_AT_REST: return "current_at_rest";
+  case IMEST_COMM_REASON_OPEN_PHASE: return "open_phase";
+  case IMEST_COMM_REASON_WIRING: return "wiring";
+  case IMEST_COMM_REASON_CURRENT_NOT_REACHED: return "current_not_reached";
+  case IMEST_COMM_REASON_ROTOR_MOVED: return "rotor_moved";
+  case IMEST_COMM_REASON_TIMEOUT: return "timeout";
+  case IMEST_COMM_REASON_BACKGROUND: return "background";
+  case IMEST_COMM_REASON_FIT: return "fit";
+  case IMEST_COMM_REASON_IMPLAUSIBLE: return "implausible";
+  case IMEST_COMM_REASON_ENCODER_STILL: return "encoder_still";
+  case IMEST_COMM_REASON_ROTOR_BLOCKED: return "rotor_blocked";
+  case IMEST_COMM_REASON_PHASE_ORDER: return "phase_order";
+  case IMEST_COMM_REASON_POLE_PAIRS_AMBIGUOUS: return "pole_pairs_ambiguous";
+  case IMEST_COMM_REASON_CURRENT_LIMIT_ROTATING: return "current_limit_rotating";
+  default: return "unknown";
+  }
 }
 
 const char *imest_comm_stage_name(int stage)
 {
-  static const char *const names[] = {"offsets", "wiring",      "time_constant", "staircase",
-                                      "pulses",  "demagnetise", "rotate",        "end"};
-  if (stage < 0 || stage >= (int)(sizeof names / sizeof names[0])) return "unknown";
-  return names[stage];
+  switch (stage) {
+  case IMEST_COMM_STAGE_OFFSETS: return "offsets";
+  case IMEST_COMM_STAGE_WIRING: return "wiring";
+  case IMEST_COMM_STAGE_TIME_CONSTANT: return "time_constant";
+  case IMEST_COMM_STAGE_STAIRCASE: return "staircase";
+  case IMEST_COMM_STAGE_PULSES: return "pulses";
+  case IMEST_COMM_STAGE_DEMAGNETISE: return "demagnetise";
+  case IMEST_COMM_STAGE_ROTATE: return "rotate";
+  case IMEST_COMM_STAGE_END: return "end";
+  default: return "unknown";
+  }
 }
 
 const char *imest_comm_state_name(int state)
 {
-  static const char *const names[] = {"idle", "running", "computing", "done", "failed", "aborted"};
-  if (state < 0 || state >= (int)(sizeof names / sizeof names[0])) return "unknown";
-  return names[state];
+  switch (state) {
+  case IMEST_COMM_IDLE: return "idle";
+  case IMEST_COMM_RUNNING: return "running";
+  case IMEST_COMM_COMPUTING: return "computing";
+  case IMEST_COMM_DONE: return "done";
+  case IMEST_COMM_FAILED: return "failed";
+  case IMEST_COMM_ABORTED: return "aborted";
+  default: return "unknown";
+  }
 }
