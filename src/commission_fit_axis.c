@@ -51,18 +51,20 @@ typedef struct {
   double ishift;             /* its mean minus sampled axis current [A] */
   double dyn;                /* L_m * ishift: the flux's answer to the pattern switches [V s] */
   uint32_t kp[CM_PLATEAUS];  /* plateau start samples */
+  double tau0;               /* the probe's tau: the search runs in u, tau = tau0 e^u */
   double h[IMEST_COMM_NBLK]; /* block means of F' for the present tau [1/s] */
+  double g[IMEST_COMM_NBLK]; /* block means of exp(-(t - t_p)/tau), plateau p's tail */
   double beta[CM_LSQ_MAX], dinv[CM_LSQ_MAX], sse;
   unsigned int npar;
   int ok;
 } axis_ctx_t;
 
+/* (The DC blocks hold means, not sums, once cm_fit_axis has begun.) */
 static double axis_current(const imest_comm_block_t *b, uint32_t axis)
 {
-  const double n = (double)b->n;
-  const double ma = (double)b->s[CM_S_MA + axis] / n;
-  const double mb = (double)b->s[CM_S_MA + (axis + 1u) % 3u] / n;
-  const double mc = (double)b->s[CM_S_MA + (axis + 2u) % 3u] / n;
+  const double ma = (double)b->s[CM_S_MA + axis];
+  const double mb = (double)b->s[CM_S_MA + (axis + 1u) % 3u];
+  const double mc = (double)b->s[CM_S_MA + (axis + 2u) % 3u];
   return 0.816496580927726 * (ma - 0.5 * (mb + mc));
 }
 
@@ -76,47 +78,45 @@ static int dc_used(const axis_ctx_t *x, uint32_t bi)
   return dc_block(&x->c->blk[bi]) && !((x->skip >> bi) & 1u);
 }
 
-/* h_b: the shifted pattern's indicator lagged by tau, its derivative averaged over each block's
+/* For the present tau: g_b, the block's mean of exp(-(t - t_p) / tau) (its plateau's tail), and
+   h_b, the shifted pattern's indicator lagged by tau, its derivative averaged over the block's
    summed samples. Blocks are contiguous in time (each began `discard` samples before k0). */
-static void lag_indicator(axis_ctx_t *x, double tau)
+static void block_decays(axis_ctx_t *x, double tau)
 {
   const imest_comm_t *c = x->c;
-  const double ts = (double)c->ts_s;
+  cm_decay_t dec;
+  cm_decay_init(&dec, (double)c->ts_s, tau);
   double f = 0.0;
   uint32_t k_end = 0u;
   for (uint32_t bi = 0; bi < x->nb; ++bi) {
     const imest_comm_block_t *b = &c->blk[bi];
-    x->h[bi] = 0.0;
+    x->h[bi] = x->g[bi] = 0.0;
     if (!dc_block(b)) continue;
-    const uint32_t first =
-        CM_TAG_PATTERN(b->tag) == CM_PAT_CENTRED && CM_TAG_PLATEAU(b->tag) != CM_PLATEAU_PATTERNS
-            ? b->k0 - 1u
-            : b->k0; /* start of the pattern's period (approximately) */
-    const uint32_t k_start = k_end > 0u && k_end < first ? k_end : first;
-    if (k_end > 0u && k_start > k_end) f *= exp(-(double)(k_start - k_end) * ts / tau);
+    const double mean = cm_decay_mean(&dec, b->n);
+    x->g[bi] = cm_decay_pow(&dec, b->k0 - x->kp[CM_TAG_PLATEAU(b->tag)]) * mean;
+    const uint32_t k_start = k_end > 0u && k_end < b->k0 ? k_end : b->k0;
     const double ind = CM_TAG_PATTERN(b->tag) == x->shifted ? 1.0 : 0.0;
-    const double f0 = ind + (f - ind) * exp(-(double)(b->k0 - k_start) * ts / tau); /* at k0 */
-    x->h[bi] = (ind - f0) / tau * cm_block_exp(b->k0, b->n, b->k0, ts, tau);
-    f = ind + (f0 - ind) * exp(-(double)b->n * ts / tau);
+    const double f0 = ind + (f - ind) * cm_decay_pow(&dec, b->k0 - k_start); /* at k0 */
+    x->h[bi] = (ind - f0) / tau * mean;
+    f = ind + (f0 - ind) * cm_decay_pow(&dec, b->n);
     k_end = b->k0 + b->n;
   }
 }
 
 /* One row: R, t_d (not when lumped), V_th, dr (not when lumped), the plateaus' tails. */
-static unsigned int dc_row(const axis_ctx_t *x, uint32_t bi, double tau, double row[CM_LSQ_MAX], double *y)
+static unsigned int dc_row(const axis_ctx_t *x, uint32_t bi, double row[CM_LSQ_MAX], double *y)
 {
   const imest_comm_block_t *b = &x->c->blk[bi];
-  const double n = (double)b->n;
   const uint32_t p = CM_TAG_PLATEAU(b->tag);
   const int shifted = CM_TAG_PATTERN(b->tag) == x->shifted;
   unsigned int j = 0;
   row[j++] = axis_current(b, x->axis) + (shifted ? x->ishift : 0.0);
-  if (!x->lumped) row[j++] = (double)b->s[CM_S_TD] / n;
-  row[j++] = (double)b->s[CM_S_VTH] / n;
-  if (!x->lumped) row[j++] = (double)b->s[CM_S_DR] / n;
+  if (!x->lumped) row[j++] = (double)b->s[CM_S_TD];
+  row[j++] = (double)b->s[CM_S_VTH];
+  if (!x->lumped) row[j++] = (double)b->s[CM_S_DR];
   for (uint32_t q = 0; q < CM_PLATEAUS; ++q) row[j + q] = 0.0;
-  row[j + p] = cm_block_exp(b->k0, b->n, x->kp[p], (double)x->c->ts_s, tau);
-  *y = (double)b->s[CM_S_V] / n - x->dyn * x->h[bi];
+  row[j + p] = x->g[bi];
+  *y = (double)b->s[CM_S_V] - x->dyn * x->h[bi];
   return j + CM_PLATEAUS;
 }
 
@@ -125,16 +125,19 @@ static double axis_solve(axis_ctx_t *x, double tau)
 {
   double a[CM_LSQ_MAX][CM_LSQ_MAX] = {{0}}, r[CM_LSQ_MAX] = {0}, row[CM_LSQ_MAX], y;
   unsigned int np = 0u;
-  lag_indicator(x, tau);
+  block_decays(x, tau);
   for (uint32_t bi = 0; bi < x->nb; ++bi) {
     if (!dc_used(x, bi)) continue;
-    np = dc_row(x, bi, tau, row, &y);
+    np = dc_row(x, bi, row, &y);
     const double w = (double)x->c->blk[bi].n;
     for (unsigned int i = 0; i < np; ++i) {
-      r[i] += w * row[i] * y;
-      for (unsigned int j = 0; j < np; ++j) a[i][j] += w * row[i] * row[j];
+      const double wi = w * row[i];
+      r[i] += wi * y;
+      for (unsigned int j = i; j < np; ++j) a[i][j] += wi * row[j];
     }
   }
+  for (unsigned int i = 1; i < np; ++i)
+    for (unsigned int j = 0; j < i; ++j) a[i][j] = a[j][i];
   x->npar = np;
   x->ok = np > 0u && cm_chol_solve(a, r, np, x->dinv) == 0;
   if (!x->ok) return 1e30;
@@ -142,7 +145,7 @@ static double axis_solve(axis_ctx_t *x, double tau)
   for (unsigned int i = 0; i < np; ++i) x->beta[i] = r[i];
   for (uint32_t bi = 0; bi < x->nb; ++bi) {
     if (!dc_used(x, bi)) continue;
-    (void)dc_row(x, bi, tau, row, &y);
+    (void)dc_row(x, bi, row, &y);
     double e = y;
     for (unsigned int i = 0; i < np; ++i) e -= row[i] * r[i];
     sse += (double)x->c->blk[bi].n * e * e;
@@ -153,7 +156,8 @@ static double axis_solve(axis_ctx_t *x, double tau)
 
 static double axis_cost(void *ctx, double u)
 {
-  return axis_solve((axis_ctx_t *)ctx, exp(u));
+  axis_ctx_t *x = (axis_ctx_t *)ctx;
+  return axis_solve(x, x->tau0 * exp(u));
 }
 
 /* (1 - sigma) L_S from the tails of consecutive plateaus (weighted by their current steps). */
@@ -217,6 +221,15 @@ void cm_fit_axis(imest_comm_t *c, uint32_t axis)
   x.nb = c->job_nblk < IMEST_COMM_NBLK ? c->job_nblk : IMEST_COMM_NBLK;
   double d_p[CM_PLATEAUS] = {0}, i_p[CM_PLATEAUS] = {0}, w_p[CM_PLATEAUS] = {0};
   int seen[CM_PLATEAUS] = {0};
+  /* the DC blocks' sums become means (the fits evaluate them many times); the buffer is the
+     background's until the job is done */
+  for (uint32_t bi = 0; bi < x.nb; ++bi) {
+    imest_comm_block_t *b = &c->blk[bi];
+    if (!dc_block(b)) continue;
+    const float inv = 1.0f / (float)b->n;
+    for (int j = 0; j < IMEST_COMM_NSUM; ++j)
+      if (j != CM_S_DELAY) b->s[j] *= inv;
+  }
   /* gains: zero sequence against the axis leg's current (weighted, with intercept) */
   double gw = 0, gx = 0, gy = 0, gxx = 0, gxy = 0;
   for (uint32_t bi = 0; bi < x.nb; ++bi) {
@@ -231,8 +244,8 @@ void cm_fit_axis(imest_comm_t *c, uint32_t axis)
     const double w = (double)b->n;
     i_p[p] += w * axis_current(b, axis);
     w_p[p] += w;
-    const double xm = (double)b->s[CM_S_MA + axis] / w;
-    const double z = ((double)b->s[CM_S_MA] + (double)b->s[CM_S_MA + 1] + (double)b->s[CM_S_MA + 2]) / w;
+    const double xm = (double)b->s[CM_S_MA + axis];
+    const double z = (double)b->s[CM_S_MA] + (double)b->s[CM_S_MA + 1] + (double)b->s[CM_S_MA + 2];
     gw += w;
     gx += w * xm;
     gy += w * z;
@@ -255,7 +268,8 @@ void cm_fit_axis(imest_comm_t *c, uint32_t axis)
      clamped blocks whose switching leg's pulse is shorter than 2.1 dead times left out (a
      pulse split at the sample instant, as double-update PWM units and the simulator do, is
      partly eaten below 2 dead times) and the pulse-position correction updated. */
-  const double u0 = log((double)(c->tau > 0.0f ? c->tau : 0.1f));
+  x.tau0 = (double)(c->tau > 0.0f ? c->tau : 0.1f);
+  const double u0 = 0.0;
   const double sl = f->slsig_h > 0.0 ? f->slsig_h : (double)c->sl_rough;
   x.skip = 0u;
   x.lumped = 0;
@@ -264,8 +278,10 @@ void cm_fit_axis(imest_comm_t *c, uint32_t axis)
   x.dyn = 0.0;
   double u = u0, sse = 0.0, lm = 0.0;
   for (int pass = 0; pass < 6; ++pass) {
-    u = cm_golden(axis_cost, &x, u0 - 1.0, u0 + 1.0, 36u);
-    sse = axis_solve(&x, exp(u));
+    /* the first pass searches a factor e around the probe's tau, later ones close to the last */
+    u = pass == 0 ? cm_golden(axis_cost, &x, u0 - 1.0, u0 + 1.0, 24u)
+                  : cm_golden(axis_cost, &x, u - 0.05, u + 0.05, 16u);
+    sse = axis_solve(&x, x.tau0 * exp(u));
     if (!x.ok) break;
     const double td = x.lumped ? 0.0 : x.beta[COL_TD];
     uint64_t skip = x.skip;
@@ -273,10 +289,10 @@ void cm_fit_axis(imest_comm_t *c, uint32_t axis)
     for (uint32_t bi = 0; bi < x.nb; ++bi) {
       const imest_comm_block_t *b = &c->blk[bi];
       if (!dc_block(b) || CM_TAG_PATTERN(b->tag) == CM_PAT_CENTRED) continue;
-      if ((double)b->s[CM_S_PULSE] / (double)b->n < 2.1 * td * (double)c->fpwm) skip |= (uint64_t)1u << bi;
+      if ((double)b->s[CM_S_PULSE] < 2.1 * td * (double)c->fpwm) skip |= (uint64_t)1u << bi;
       if (!((skip >> bi) & 1u)) clamped++;
     }
-    lm = tail_lm(&x, exp(u), d_p, i_p);
+    lm = tail_lm(&x, x.tau0 * exp(u), d_p, i_p);
     const double ishift =
         (!x.lumped && sl > 0.0) ? 0.816496580927726 * (double)c->vdc0 * td / (2.0 * sl) : 0.0;
     const double dyn = lm > 0.0 ? lm * ishift : 0.0;
@@ -298,9 +314,9 @@ void cm_fit_axis(imest_comm_t *c, uint32_t axis)
   }
   const double h = 0.02;
   const double d2 = (axis_cost(&x, u + h) - 2.0 * sse + axis_cost(&x, u - h)) / (h * h);
-  (void)axis_solve(&x, exp(u));                    /* beta at the minimum again */
+  (void)axis_solve(&x, x.tau0 * exp(u));           /* beta at the minimum again */
   const double s2 = sse / (double)(n_dc - x.npar); /* per-sample variance of the voltage */
-  const double tau = exp(u), ktd = (double)c->fpwm * (double)c->vdc0;
+  const double tau = x.tau0 * exp(u), ktd = (double)c->fpwm * (double)c->vdc0;
   f->separable = !x.lumped;
   f->r_ohm = x.beta[COL_R];
   f->r_std = sqrt(s2 * x.dinv[COL_R]);

@@ -1,7 +1,8 @@
 /* Background: the rotor time constant from the probe's voltage record (commission_probe.c).
  * Block means v_b over log-spaced blocks are fitted with c + A g_b(tau), g_b the block's mean
  * of exp(-(t - t_0)/tau); for each tau the two linear parameters are solved in closed form,
- * tau itself by a grid over ln tau and a golden-section refinement (fixed iteration counts).
+ * tau itself by a grid over ln tau (4 samples to 240 000) and a golden-section refinement
+ * (fixed iteration counts).
  * T_R is known when the record spans 2.5 tau and the curvature of the residual gives
  * std(ln tau) < 0.1. float64. */
 #include <math.h>
@@ -9,23 +10,17 @@
 
 #include "commission_fit.h"
 
-double cm_block_exp(uint32_t k0, uint32_t n, uint32_t k_ref, double ts, double tau)
-{
-  const double x = ts / tau;
-  const double start = exp(-(double)(k0 - k_ref) * x);
-  if (x * (double)n < 1e-9) return start;
-  return start * (1.0 - exp(-(double)n * x)) / ((double)n * (1.0 - exp(-x)));
-}
-
 /* Weighted least squares of v_b = c + A g_b: returns the residual sum (weights n_b). */
 static double probe_sse(const imest_comm_t *c, uint32_t nb, double tau, double *amp)
 {
   double sw = 0, sg = 0, sgg = 0, sv = 0, svg = 0, svv = 0;
+  cm_decay_t dec;
+  cm_decay_init(&dec, (double)c->ts_s, tau);
   for (uint32_t b = 0; b < nb; ++b) {
     const imest_comm_block_t *k = &c->blk[b];
     if (k->n == 0u) continue;
     const double w = (double)k->n, v = (double)k->s[0] / w;
-    const double g = cm_block_exp(k->k0, k->n, c->probe_k0, (double)c->ts_s, tau);
+    const double g = cm_decay_pow(&dec, k->k0 - c->probe_k0) * cm_decay_mean(&dec, k->n);
     sw += w;
     sg += w * g;
     sgg += w * g * g;
@@ -68,23 +63,25 @@ double cm_golden(double (*f)(void *, double), void *ctx, double lo, double hi, u
   return f1 < f2 ? x1 : x2;
 }
 
+/* tau = tau_lo e^u: the search runs in u (no logarithm needed) */
 typedef struct {
   const imest_comm_t *c;
   uint32_t nb;
+  double tau_lo;
 } probe_ctx_t;
 
 static double probe_cost(void *ctx, double u)
 {
   const probe_ctx_t *p = (const probe_ctx_t *)ctx;
-  return probe_sse(p->c, p->nb, exp(u), NULL);
+  return probe_sse(p->c, p->nb, p->tau_lo * exp(u), NULL);
 }
 
 void cm_fit_probe(imest_comm_t *c)
 {
   const uint32_t nb = c->job_nblk;
-  probe_ctx_t ctx = {c, nb};
   const double ts = (double)c->ts_s;
-  const double u_lo = log(4.0 * ts), u_hi = log(2.0 * (double)c->cfg.tr_max_s);
+  probe_ctx_t ctx = {c, nb, 4.0 * ts};
+  const double u_lo = 0.0, u_hi = 11.0; /* 4 samples .. 240 000 samples */
   enum { NGRID = 24 };
   double best = 0.0, fbest = 0.0;
   for (int g = 0; g < NGRID; ++g) {
@@ -101,7 +98,7 @@ void cm_fit_probe(imest_comm_t *c)
   if (hi > u_hi) hi = u_hi;
   const double u = cm_golden(probe_cost, &ctx, lo, hi, 30u);
   double amp;
-  const double sse = probe_sse(c, nb, exp(u), &amp);
+  const double sse = probe_sse(c, nb, ctx.tau_lo * exp(u), &amp);
   /* curvature of the residual in ln tau -> standard error of ln tau */
   const double h = 0.05;
   const double d2 = (probe_cost(&ctx, u + h) - 2.0 * sse + probe_cost(&ctx, u - h)) / (h * h);
@@ -109,7 +106,7 @@ void cm_fit_probe(imest_comm_t *c)
   const double var_u = d2 > 0.0 ? 2.0 * s2 / d2 : 1e9;
   const imest_comm_block_t *last = &c->blk[nb - 1u];
   const double span = (double)(last->k0 + last->n - c->probe_k0) * ts;
-  const double tau = exp(u);
+  const double tau = ctx.tau_lo * exp(u);
   c->bg_tau = (float)tau;
   c->bg_tau_ok = (span >= 2.5 * tau && var_u < 0.01 && amp != 0.0) ? 1 : 0;
 }

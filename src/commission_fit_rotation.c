@@ -27,7 +27,8 @@ void cm_fit_rotation(imest_comm_t *c)
   }
   const double id = (double)s[CM_R_ID] / n, iq = (double)s[CM_R_IQ] / n;
   const double nd = (double)s[CM_R_ND] / n, nq = (double)s[CM_R_NQ] / n;
-  const double hold = sin(0.5 * we * ts) / (0.5 * we * ts);
+  const double hx = 0.5 * we * ts; /* below 0.1 rad: sin(x)/x by its series */
+  const double hold = 1.0 - hx * hx / 6.0 * (1.0 - hx * hx / 20.0);
   const double ud = (double)s[CM_R_UD] / n * hold, uq = (double)s[CM_R_UQ] / n * hold;
   const double i2 = id * id + iq * iq;
   r->rotating_f_hz = (float)(we / (2.0 * 3.14159265358979));

@@ -65,7 +65,7 @@ void cm_stage_probe(imest_comm_t *c, const float m[3], float vdc, float i_n, flo
   }
   /* hand complete rounds to the background, one job at a time */
   if (!cm_job_done(c)) {
-    if (++c->wait > (uint32_t)(2.0f * c->cfg.fs_hz)) cm_fail(c, IMEST_COMM_REASON_BACKGROUND);
+    if (++c->wait > (uint32_t)(10.0f * c->cfg.fs_hz)) cm_fail(c, IMEST_COMM_REASON_BACKGROUND);
     return;
   }
   c->wait = 0u;

@@ -121,7 +121,7 @@ void cm_stage_demagnetise(imest_comm_t *c, float vdc, float i_n)
   c->cnt++;
   if (c->cnt < c->cnt_demag + c->n_zero) return;
   if (!cm_job_done(c)) {
-    if (c->cnt > c->cnt_demag + c->n_zero + (uint32_t)(2.0f * c->cfg.fs_hz))
+    if (c->cnt > c->cnt_demag + c->n_zero + (uint32_t)(10.0f * c->cfg.fs_hz))
       cm_fail(c, IMEST_COMM_REASON_BACKGROUND);
     return;
   }

@@ -71,7 +71,7 @@ void cm_stage_wiring(imest_comm_t *c, const float m[3], float vdc)
   case W_WAIT:
   default:
     if (!cm_job_done(c)) {
-      if (++c->wait > (uint32_t)(2.0f * c->cfg.fs_hz)) cm_fail(c, IMEST_COMM_REASON_BACKGROUND);
+      if (++c->wait > (uint32_t)(10.0f * c->cfg.fs_hz)) cm_fail(c, IMEST_COMM_REASON_BACKGROUND);
       break;
     }
     if (c->bg_fail) {

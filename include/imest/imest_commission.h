@@ -51,7 +51,7 @@
  *     (one or more periods per sample). The dead time must be the inverter's own, not compensated
  *     by the firmware: the routine measures it;
  *   - an ISR at a fixed rate cc.fs_hz, a background call at least every 10 ms (it does the
- *     fitting; the ISR waits for it at a few points, at most 2 s), and a motor at rest, free to turn
+ *     fitting; the ISR waits for it at a few points, at most 10 s), and a motor at rest, free to turn
  *     if cc.allow_rotation (no load coupled, or only a small one).
  *
  * The sequence (durations for the motors of the README's table: 0.4 kW to 37 kW):
