@@ -1,4 +1,4 @@
-/* Background: the V/f run (commission_rotate.c) -> L_S, sigma, n_p, the encoder's direction
+/* Background: the rotating run (commission_rotate.c) -> L_S, sigma, n_p, the encoder's direction
  * and counts, the phase-order check.
  *
  * The current and the commanded voltage, demodulated at the field angle, give the impedance

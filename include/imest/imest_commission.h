@@ -69,12 +69,14 @@
  *      Clamped legs do not switch, so they lose no dead time and conduct one device type only.
  *      Then, at 1/3 level, a square-wave voltage (fs/8) on top of the DC current (0.2 s): the
  *      current's slope gives sigma*L_S. Then zero current until the rotor flux has decayed.
- *   5. With cc.allow_rotation only: V/f run at speed_frac of rated frequency with IR
- *      compensation and the identified inverter model as feed-forward: ramp (ramp_s), settle
- *      (1 s + 3 T_R), measure (1 s, whole electrical periods), ramp down.
+ *   5. With cc.allow_rotation only: a current-fed rotating field at the rated magnetising
+ *      current (rated V/f flux with the standstill L_S), the identified inverter model as
+ *      feed-forward: magnetise on the a axis (1 s + 3 T_R), ramp to speed_frac of rated
+ *      frequency (ramp_s), settle (1 s + 3 T_R), measure (>= 1 s, whole electrical periods),
+ *      ramp down. (A voltage-fed V/f run oscillates at no load on a low-inertia motor.)
  *   The routine ends with zero voltage; its ISR call then returns 0 and the background call
- *   completes the result. Typical totals: 8 s at standstill for a 4 kW motor (T_R 128 ms), 35 s
- *   for 37 kW (T_R 550 ms), plus about 8 s of rotation (README, Commissioning, measured).
+ *   completes the result. Measured totals: 8.4 s at standstill for a 4 kW motor (T_R 128 ms),
+ *   30 s for 37 kW (T_R 553 ms), plus 8 to 10.5 s of rotation (README, Commissioning).
  *
  * What is measured, and how (per axis, then combined; the spread between the three axes is
  * reported as a quality figure for each quantity):
@@ -100,7 +102,7 @@
  *   - T_R: the flux tail's time constant (reported; fills tr_nominal_s). L_S at standstill:
  *     sigma*L_S plus (1-sigma)L_S from the tail amplitudes at the current steps (used only when
  *     the shaft may not turn).
- *   - L_S (rotating): reactive part of the impedance at the V/f frequency, from the commanded
+ *   - L_S (rotating): reactive part of the impedance at the field's frequency, from the commanded
  *     voltage (the inverter error compensated by its model) and the current, demodulated at the
  *     commanded angle; at no load the slip is ~1e-4, and is corrected for.
  *   - n_p, encoder direction and counts: the ratio of the commanded electrical frequency to the
@@ -116,10 +118,11 @@
  *
  * Accuracy (closed loop on the simulator: 12-bit sensors with offsets and +-1 % gain mismatch,
  * 4096-count encoder, 2 us dead time, 1 V / 0.8 V drops with slopes; README, Commissioning, for
- * the table per motor): R_S within 0.3 % of the identifiable value (winding plus the devices'
- * common slope resistance), sigma within 1 %, L_S within 0.5 % rotating, T_R within 1 %, the
- * inverter's per-leg voltage error within 0.1 V where the switch and diode thresholds differ by
- * 0.2 V (the part standstill cannot see).
+ * the table per motor, 0.4 to 37 kW): R_S within 0.15 % of the identifiable value (winding plus
+ * the devices' common slope resistance), L_S within 0.1 % rotating (0.1 % standstill), sigma
+ * within 0.25 %, T_R within 0.2 %, dead time within 2 ns, the inverter's per-leg voltage error
+ * within 0.1 V where the switch and diode thresholds differ by 0.2 V (the part standstill cannot
+ * see; the rest of the model is right to a few mV).
  *
  * Limits: the current never exceeds i_max_a in any phase (the routine stops with
  * IMEST_COMM_REASON_OVERCURRENT if it does: the firmware's own protection stays in charge); the
@@ -180,8 +183,8 @@ typedef struct {
   /** rated speed [rpm] from the nameplate (0: unknown): n_p = floor(60 f_rated / n_rated), and
    *  the encoder counts are then checked, not assumed */
   float rated_speed_rpm;
-  float speed_frac; /**< speed of the V/f run as a fraction of rated (default 0.4) */
-  float ramp_s;     /**< V/f ramp time up and down [s] (default 2) */
+  float speed_frac; /**< speed of the rotating run as a fraction of rated (default 0.4) */
+  float ramp_s;     /**< frequency ramp time up and down [s] (default 2) */
 } imest_comm_config_t;
 
 /** Fill with defaults (fs 8 kHz, level 0.8, 300 s, standstill only; i_max_a must be set). */
@@ -216,7 +219,7 @@ typedef enum {
   IMEST_COMM_STAGE_STAIRCASE = 3, /**< DC current staircase with the three modulation patterns */
   IMEST_COMM_STAGE_PULSES = 4,    /**< square-wave voltage for sigma*L_S */
   IMEST_COMM_STAGE_DEMAGNETISE = 5,
-  IMEST_COMM_STAGE_ROTATE = 6, /**< V/f run: ramp, settle, measure, ramp down */
+  IMEST_COMM_STAGE_ROTATE = 6, /**< rotating field: magnetise, ramp, settle, measure, ramp down */
   IMEST_COMM_STAGE_END = 7
 } imest_comm_stage_t;
 
@@ -242,7 +245,7 @@ typedef enum {
   IMEST_COMM_REASON_PHASE_ORDER = 15,   /**< the measured current turns against the commanded field */
   /** the speed ratio fits no integer n_p with the firmware's counts, and no rated speed was given */
   IMEST_COMM_REASON_POLE_PAIRS_AMBIGUOUS = 16,
-  IMEST_COMM_REASON_CURRENT_LIMIT_ROTATING = 17 /**< the V/f run needs more than i_max_a */
+  IMEST_COMM_REASON_CURRENT_LIMIT_ROTATING = 17 /**< the rotating run needs more than i_max_a */
 } imest_comm_reason_t;
 
 /** Short lower-case names ("none", "overcurrent", ...; "offsets", "staircase", ...). */
@@ -316,11 +319,11 @@ typedef struct {
   int encoder_dir;          /**< +1: the angle increases with the a-b-c field; -1: reversed; 0: unknown */
   float encoder_cpr;        /**< true counts per revolution (NaN if encoder_cpr not given) */
   float speed_ratio;        /**< commanded electrical / measured mechanical speed (signed) */
-  float slip;               /**< slip at the V/f point (no load: ~1e-4) */
+  float slip;               /**< slip of the rotating run (no load: ~1e-4) */
   float neg_seq_rel;        /**< |negative-sequence current| / |positive|, rotating (wiring check) */
   float rotating_r_ohm;     /**< resistive part of the impedance rotating (R_S + losses) [ohm] */
-  float rotating_i_a;       /**< magnetising current at the V/f point (alpha/beta amplitude) [A] */
-  float rotating_f_hz;      /**< electrical frequency of the V/f run [Hz] */
+  float rotating_i_a;       /**< magnetising current of the rotating run (alpha/beta amplitude) [A] */
+  float rotating_f_hz;      /**< electrical frequency of the rotating run [Hz] */
 } imest_comm_result_t;
 
 /** Progress, readable from any context. */

@@ -26,7 +26,7 @@ static void usage(FILE *f)
           "  --preset NAME        4kw, 11kw, 15kw, 37kw, 75kw, exp1 (the paper's 0.4 kW motor) [4kw]\n"
           "  --no-rotation        standstill only (L_S and sigma from the flux tails)\n"
           "  --no-nameplate       do not give the rated speed (n_p from the encoder's counts)\n"
-          "  --speed-frac X       V/f speed as a fraction of rated [0.4]\n"
+          "  --speed-frac X       speed of the rotating run, fraction of rated [0.4]\n"
           "  --i-max A            current limit, peak [sqrt(2) x rated]\n"
           "  --r-series OHM       known series resistance passed to the routine [0]\n"
           "  --dead-time S        inverter dead time [2e-6]\n"
@@ -267,10 +267,11 @@ int main(int argc, char **argv)
              f->dr_std, f->tau_s, f->tau_std, f->lm_h, f->slsig_h, f->slsig_std, f->rhf_ohm, f->gain_dev,
              f->rms_v);
     }
-  printf("\n  rotor travel at standstill %.2g rad; V/f run %.2f Hz, %.3f A, slip %.2g, negative sequence "
-         "%.3g; flags "
-         "0x%04x\n",
-         out.theta_max_standstill_rad, (double)r->rotating_f_hz, (double)r->rotating_i_a, (double)r->slip,
-         (double)r->neg_seq_rel, r->flags);
+  printf(
+      "\n  rotor travel at standstill %.2g rad; rotating run %.2f Hz, %.3f A, slip %.2g, negative sequence "
+      "%.3g; flags "
+      "0x%04x\n",
+      out.theta_max_standstill_rad, (double)r->rotating_f_hz, (double)r->rotating_i_a, (double)r->slip,
+      (double)r->neg_seq_rel, r->flags);
   return r->valid ? 0 : 1;
 }
