@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "commission_sensitivity.h"
 #include "commission_sim.h"
 #include "tool_args.h"
 
@@ -47,6 +48,10 @@ static void usage(FILE *f)
           "  --trace-decimate N   every N-th sample in the trace [1]\n"
           "  --csv                one machine-readable line instead of the table\n"
           "  --verbose            also the per-axis fits\n"
+          "  --sensitivity        instead: the online estimator's T_R and R_S error per 1 %% error of\n"
+          "                       L_S and sigma and per 0.1 V of inverter model error (preset at\n"
+          "                       --load of rated torque, phase-voltage input)\n"
+          "  --load X             load for --sensitivity, fraction of rated [1]\n"
           "  --help\n",
           k_prog);
 }
@@ -90,7 +95,8 @@ int main(int argc, char **argv)
     fprintf(stderr, "%s: unknown preset '%s' (%s)\n", k_prog, preset, imsim_preset_names());
     return 2;
   }
-  int csv = 0, verbose = 0;
+  int csv = 0, verbose = 0, sensitivity = 0;
+  double load = 1.0;
   const char *trace = NULL;
   tool_args_t a;
   tool_args_init(&a, k_prog, argc, argv);
@@ -127,6 +133,14 @@ int main(int argc, char **argv)
     } else if (tool_args_is(&a, "--verbose")) {
       if (tool_args_flag(&a)) return 2;
       verbose = 1;
+    } else if (tool_args_is(&a, "--sensitivity")) {
+      if (tool_args_flag(&a)) return 2;
+      sensitivity = 1;
+    } else if (tool_args_is(&a, "--load")) {
+      if (tool_args_number(&a, &load) || load < 0.0 || load > 2.0) {
+        fprintf(stderr, "%s: --load needs a fraction of rated torque in [0, 2]\n", k_prog);
+        return 2;
+      }
     } else if (tool_args_is(&a, "--csv")) {
       if (tool_args_flag(&a)) return 2;
       csv = 1;
@@ -164,6 +178,40 @@ int main(int argc, char **argv)
       default: o.trace_decimate = v >= 1.0 ? (unsigned int)v : 1u; break;
       }
     }
+  }
+  if (sensitivity) {
+    comm_sens_opts_t so;
+    memset(&so, 0, sizeof so);
+    snprintf(so.preset, sizeof so.preset, "%s", o.preset);
+    so.load_frac = load;
+    so.duration_s = 14.0;
+    so.settle_s = 4.0;
+    so.seed = o.seed;
+    comm_sens_t r;
+    if (comm_sensitivity(&so, &r) != 0) {
+      fprintf(stderr, "%s: the sensitivity runs failed for %s\n", k_prog, o.preset);
+      return 1;
+    }
+    if (csv) {
+      printf("preset,load,tr_base_pct,rs_base_pct,valid,windows,tr_per_ls_pct,rs_per_ls_pct,tr_per_sigma_pct,"
+             "rs_per_sigma_pct,tr_per_0p1v_pct,rs_per_0p1v_pct\n");
+      printf("%s,%.2f,%.3f,%.3f,%d,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", o.preset, load, 100.0 * r.base.tr_rel,
+             100.0 * r.base.rs_rel, r.base.valid, r.base.windows, 100.0 * r.tr_per_ls, 100.0 * r.rs_per_ls,
+             100.0 * r.tr_per_sigma, 100.0 * r.rs_per_sigma, 100.0 * r.tr_per_dv, 100.0 * r.rs_per_dv);
+    } else {
+      printf(
+          "%s: preset %s at %.0f %% of rated torque, phase-voltage input, true constants: T_R %+.3f %%, R_S "
+          "%+.3f %% (%d of %d windows valid)\n",
+          k_prog, o.preset, 100.0 * load, 100.0 * r.base.tr_rel, 100.0 * r.base.rs_rel, r.base.valid,
+          r.base.windows);
+      printf("  error per +1 %% of L_S:    T_R %+.3f %%, R_S %+.3f %%\n", 100.0 * r.tr_per_ls,
+             100.0 * r.rs_per_ls);
+      printf("  error per +1 %% of sigma:  T_R %+.3f %%, R_S %+.3f %%\n", 100.0 * r.tr_per_sigma,
+             100.0 * r.rs_per_sigma);
+      printf("  error per +0.1 V per leg: T_R %+.3f %%, R_S %+.3f %%\n", 100.0 * r.tr_per_dv,
+             100.0 * r.rs_per_dv);
+    }
+    return 0;
   }
   if (trace) {
     o.trace = strcmp(trace, "-") == 0 ? stdout : fopen(trace, "w");
