@@ -53,35 +53,45 @@ float cm_pi(imest_comm_t *c, uint32_t pat, float err, int with_p)
   return u;
 }
 
-/* Duties that put u_n (alpha/beta units, along the axis) and u_p (perpendicular) on the motor.
-   The routine commands u_p = 0: the motor is symmetric and legs b and c carry equal currents,
-   so the perpendicular current stays zero by itself, whatever the sensors' gains say (a loop
-   on the measured perpendicular current would hold a true one of gain-mismatch size, and its
-   torque turns a free rotor).
-   centred: every leg around 0.5; low: the two return legs clamped to 0 (lower switches on);
-   high: the axis leg clamped to 1. Legs in axis order (axis, axis+1, axis+2). Returns nothing
-   else: the applied axis voltage is computed from the duties when they apply. */
-float cm_axis_duties(const imest_comm_t *c, uint32_t pat, float u_n, float u_p, float vdc, float d[3])
+/* The duties that put u_n (alpha/beta units, along the axis) on the motor, into c->d_next.
+   The perpendicular voltage is zero: the motor is symmetric and legs b and c carry equal
+   currents, so the perpendicular current stays zero by itself, whatever the sensors' gains say
+   (a loop on the measured perpendicular current would hold a true one of gain-mismatch size,
+   and its torque turns a free rotor). Patterns: centred, every leg around 0.5; low, the two
+   return legs clamped to 0 (lower switches on); high, the axis leg clamped to 1. */
+void cm_command(imest_comm_t *c, uint32_t pat, float u_n, float vdc)
 {
   const uint32_t k0 = c->axis, k1 = (c->axis + 1u) % 3u, k2 = (c->axis + 2u) % 3u;
   const float inv = 1.0f / vdc;
-  float a, b, e;
+  float a, b;
   if (pat == CM_PAT_LOW) {
     a = CM_SQRT3_2 * u_n * inv;
-    b = e = 0.0f;
+    b = 0.0f;
   } else if (pat == CM_PAT_HIGH) {
     a = 1.0f;
-    b = e = 1.0f - CM_SQRT3_2 * u_n * inv;
+    b = 1.0f - CM_SQRT3_2 * u_n * inv;
   } else {
-    const float vn = CM_SQRT2_3 * u_n * inv, vp = CM_SQRT2_3 * CM_HALF_SQ3 * u_p * inv;
+    const float vn = CM_SQRT2_3 * u_n * inv;
     a = 0.5f + vn;
-    b = 0.5f - 0.5f * vn + vp;
-    e = 0.5f - 0.5f * vn - vp;
+    b = 0.5f - 0.5f * vn;
   }
-  d[k0] = a < 0.0f ? 0.0f : (a > 1.0f ? 1.0f : a);
-  d[k1] = b < 0.0f ? 0.0f : (b > 1.0f ? 1.0f : b);
-  d[k2] = e < 0.0f ? 0.0f : (e > 1.0f ? 1.0f : e);
-  return u_n;
+  a = a < 0.0f ? 0.0f : (a > 1.0f ? 1.0f : a);
+  b = b < 0.0f ? 0.0f : (b > 1.0f ? 1.0f : b);
+  c->d_next[k0] = a;
+  c->d_next[k1] = b;
+  c->d_next[k2] = b;
+}
+
+/* The axis current loop for one sample: PI, the pattern's duties. 0, or -1 after stopping the
+   run because the voltage limit held for 0.2 s (the current cannot be reached). */
+int cm_current_loop(imest_comm_t *c, uint32_t pat, float err, float vdc)
+{
+  cm_command(c, pat, cm_pi(c, pat, err, 1), vdc);
+  if (c->lim_cnt > (uint32_t)(0.2f * c->cfg.fs_hz)) {
+    cm_fail(c, IMEST_COMM_REASON_CURRENT_NOT_REACHED);
+    return -1;
+  }
+  return 0;
 }
 
 /* A block starts with the next sample (the caller sums from its next call on). */

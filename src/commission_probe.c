@@ -35,16 +35,7 @@ void cm_probe_begin(imest_comm_t *c)
 void cm_stage_probe(imest_comm_t *c, const float m[3], float vdc, float i_n, float v_n)
 {
   (void)m;
-  const float u = cm_pi(c, CM_PAT_CENTRED, c->i_ref - i_n, 1);
-  float d[3];
-  (void)cm_axis_duties(c, CM_PAT_CENTRED, u, 0.0f, vdc, d);
-  c->d_next[0] = d[0];
-  c->d_next[1] = d[1];
-  c->d_next[2] = d[2];
-  if (c->lim_cnt > (uint32_t)(0.2f * c->cfg.fs_hz)) {
-    cm_fail(c, IMEST_COMM_REASON_CURRENT_NOT_REACHED);
-    return;
-  }
+  if (cm_current_loop(c, CM_PAT_CENTRED, c->i_ref - i_n, vdc) != 0) return;
   c->cnt++;
   if (c->step == P_DISCARD) {
     if (c->cnt >= c->n_disc_level) {

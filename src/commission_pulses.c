@@ -65,9 +65,5 @@ void cm_stage_pulses(imest_comm_t *c, float vdc, float i_n, float v_ended)
       }
     }
   }
-  float d[3];
-  (void)cm_axis_duties(c, CM_PAT_CENTRED, u, 0.0f, vdc, d);
-  c->d_next[0] = d[0];
-  c->d_next[1] = d[1];
-  c->d_next[2] = d[2];
+  cm_command(c, CM_PAT_CENTRED, u, vdc);
 }

@@ -85,12 +85,7 @@ void cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
   const float ib = CM_SQRT2_3 * CM_HALF_SQ3 * (m[1] - m[2]);
   switch (c->step) {
   case CM_ROT_MAGNETISE: {
-    const float u = cm_pi(c, CM_PAT_CENTRED, c->i_ref - ia, 1);
-    float d[3];
-    (void)cm_axis_duties(c, CM_PAT_CENTRED, u, 0.0f, vdc, d);
-    c->d_next[0] = d[0];
-    c->d_next[1] = d[1];
-    c->d_next[2] = d[2];
+    if (cm_current_loop(c, CM_PAT_CENTRED, c->i_ref - ia, vdc) != 0) return;
     if (c->cnt >= c->n_settle) {
       /* the field frame starts on the a axis: the integrators continue from the DC loop */
       c->step = CM_ROT_RAMP;

@@ -2,7 +2,7 @@
  *
  * Five plateaus at 1/3, 2/3, 1, 2/3, 1/3 of the top level, each ~3 T_R long and cut into 9
  * blocks that cycle through the three modulation patterns (centred, lower-clamped,
- * upper-clamped; cm_axis_duties). The flux tail is the same for every pattern, so interleaving
+ * upper-clamped; cm_command). The flux tail is the same for every pattern, so interleaving
  * keeps the patterns' voltage differences (dead time, devices) free of it; the background fits
  * the tail itself (cm_fit_axis). The first samples of each block are not summed while the
  * current loop settles after the switch; for the first block of a plateau, their shortfall
@@ -63,16 +63,7 @@ void cm_stage_staircase(imest_comm_t *c, const float m[3], float vdc, float i_n,
   const uint32_t pat = pattern_of(c);
   const float e = c->i_ref - i_n;
   c->i_mag += (i_n - c->i_mag) * c->ts_s / c->tau;
-  const float u = cm_pi(c, pat, e, 1);
-  float d[3];
-  (void)cm_axis_duties(c, pat, u, 0.0f, vdc, d);
-  c->d_next[0] = d[0];
-  c->d_next[1] = d[1];
-  c->d_next[2] = d[2];
-  if (c->lim_cnt > (uint32_t)(0.2f * c->cfg.fs_hz)) {
-    cm_fail(c, IMEST_COMM_REASON_CURRENT_NOT_REACHED);
-    return;
-  }
+  if (cm_current_loop(c, pat, e, vdc) != 0) return;
   c->cnt++;
   const uint32_t disc = discard(c);
   if (c->cnt <= disc) {
@@ -112,12 +103,7 @@ void cm_stage_demagnetise(imest_comm_t *c, float vdc, float i_n)
     ref = -2.0f * c->i_mag;
     c->cnt_demag = c->cnt + 1u;
   }
-  const float u = cm_pi(c, CM_PAT_CENTRED, ref - i_n, 1);
-  float d[3];
-  (void)cm_axis_duties(c, CM_PAT_CENTRED, u, 0.0f, vdc, d);
-  c->d_next[0] = d[0];
-  c->d_next[1] = d[1];
-  c->d_next[2] = d[2];
+  if (cm_current_loop(c, CM_PAT_CENTRED, ref - i_n, vdc) != 0) return;
   c->cnt++;
   if (c->cnt < c->cnt_demag + c->n_zero) return;
   if (!cm_job_done(c)) {

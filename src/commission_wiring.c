@@ -82,11 +82,7 @@ void cm_stage_wiring(imest_comm_t *c, const float m[3], float vdc)
     cm_probe_begin(c);
     break;
   }
-  float d[3];
-  (void)cm_axis_duties(c, CM_PAT_CENTRED, u, 0.0f, vdc, d);
-  c->d_next[0] = d[0];
-  c->d_next[1] = d[1];
-  c->d_next[2] = d[2];
+  cm_command(c, CM_PAT_CENTRED, u, vdc);
 }
 
 /* Background: which channel reads which leg. The true response of a pulse on axis k is

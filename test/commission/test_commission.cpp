@@ -199,6 +199,20 @@ imest_comm_config_t base_config()
   return cc;
 }
 
+// Zero currents at a 560 V bus until the routine stops commanding (at most n samples); the
+// background called every sample or never. Returns the samples taken.
+int run_silent(imest_comm_t *c, int n, bool background)
+{
+  float d[3];
+  const float i0[3] = {0.0f, 0.0f, 0.0f};
+  int rc = 1, k = 0;
+  for (; k < n && rc == 1; ++k) {
+    rc = imest_comm_isr(c, i0, 560.0f, 0.0f, d);
+    if (background) (void)imest_comm_background(c);
+  }
+  return k;
+}
+
 } // namespace
 
 TEST(CommissionGuard, ConfigCheckNamesTheField)
@@ -311,13 +325,7 @@ TEST(CommissionGuard, NoCurrentAnswerIsAnOpenPhase)
   static imest_comm_t c;
   const imest_comm_config_t cc = base_config();
   ASSERT_EQ(imest_comm_init(&c, &cc), IMEST_OK);
-  float d[3];
-  const float i0[3] = {0.0f, 0.0f, 0.0f};
-  int rc = 1, n = 0;
-  for (; n < 100000 && rc == 1; ++n) {
-    rc = imest_comm_isr(&c, i0, 560.0f, 0.0f, d);
-    (void)imest_comm_background(&c);
-  }
+  const int n = run_silent(&c, 100000, true);
   imest_comm_result_t r;
   ASSERT_EQ(imest_comm_result(&c, &r), IMEST_OK);
   EXPECT_EQ(r.state, IMEST_COMM_FAILED);
@@ -330,10 +338,7 @@ TEST(CommissionGuard, BackgroundNeverCalledTimesOut)
   static imest_comm_t c;
   const imest_comm_config_t cc = base_config();
   ASSERT_EQ(imest_comm_init(&c, &cc), IMEST_OK);
-  float d[3];
-  const float i0[3] = {0.0f, 0.0f, 0.0f};
-  int rc = 1, n = 0;
-  for (; n < 100000 && rc == 1; ++n) rc = imest_comm_isr(&c, i0, 560.0f, 0.0f, d);
+  const int n = run_silent(&c, 100000, false);
   imest_comm_status_t st;
   ASSERT_EQ(imest_comm_status(&c, &st), IMEST_OK);
   EXPECT_EQ(st.state, IMEST_COMM_FAILED);
