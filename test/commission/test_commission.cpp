@@ -158,6 +158,17 @@ TEST(Commission, CountsThatFitNoPolePairNumberFail)
   EXPECT_NEAR(out.r.speed_ratio, 2.0 * 3000.0 / 4096.0, 0.01);
 }
 
+TEST(Commission, AnEncoderThatDoesNotMoveIsNamed)
+{
+  comm_sim_opts_t o = opts("4kw");
+  o.encoder_stuck = 1;
+  const comm_sim_out_t out = run(o);
+  EXPECT_EQ(out.r.state, IMEST_COMM_FAILED);
+  EXPECT_EQ(out.r.reason, IMEST_COMM_REASON_ENCODER_STILL);
+  EXPECT_TRUE(out.r.flags & IMEST_COMM_FLAG_STANDSTILL); // the standstill part stands
+  EXPECT_LT(std::fabs(rel(out.r.rs_ohm.value, out.rs_identifiable_ohm)), 0.01);
+}
+
 TEST(Commission, SwappedCurrentChannelsStopAtTheWiringCheck)
 {
   comm_sim_opts_t o = opts("4kw");

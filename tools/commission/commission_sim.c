@@ -200,7 +200,7 @@ int comm_sim_run(const comm_sim_opts_t *o, comm_sim_out_t *out)
       i[1] = i[2];
       i[2] = t;
     }
-    const double th = (o->encoder_reversed ? -s.theta : s.theta) * scale;
+    const double th = o->encoder_stuck ? 0.0 : (o->encoder_reversed ? -s.theta : s.theta) * scale;
     float d[3];
     const int run = imest_comm_isr(c, i, (float)s.vdc_v, wrap(th), d);
     const unsigned int stg = c->stage < 8u ? c->stage : 7u;

@@ -26,6 +26,7 @@ typedef struct {
   double cpr_assumed;   /* what the firmware assumes (default: the true counts) */
   int encoder_reversed; /* the angle counts against the a-b-c field */
   int swap_sensors_bc;  /* current channels b and c swapped (wiring error) */
+  int encoder_stuck;    /* the angle never changes (encoder not connected) */
   int two_sensors;      /* the firmware computes i_c = -i_a - i_b (gain mismatch not observable) */
   int allow_rotation;
   int nameplate_speed; /* give the routine the rated speed (n_p from the nameplate) */

@@ -41,6 +41,7 @@ static void usage(FILE *f)
           "  --encoder-counts N   true counts per revolution [4096]\n"
           "  --cpr-assumed N      counts the firmware assumes [the true ones]\n"
           "  --encoder-reversed   the angle counts against the a-b-c field\n"
+          "  --encoder-stuck      the angle never moves\n"
           "  --swap-sensors       current channels b and c swapped\n"
           "  --two-sensors        the firmware computes i_c = -i_a - i_b\n"
           "  --seed N             noise seed [1]\n"
@@ -127,6 +128,9 @@ int main(int argc, char **argv)
     } else if (tool_args_is(&a, "--swap-sensors")) {
       if (tool_args_flag(&a)) return 2;
       o.swap_sensors_bc = 1;
+    } else if (tool_args_is(&a, "--encoder-stuck")) {
+      if (tool_args_flag(&a)) return 2;
+      o.encoder_stuck = 1;
     } else if (tool_args_is(&a, "--two-sensors")) {
       if (tool_args_flag(&a)) return 2;
       o.two_sensors = 1;
