@@ -9,6 +9,7 @@
 #include <cstring>
 #include <string>
 
+#include "commission_online.h"
 #include "commission_sim.h"
 #include "imest/imest_commission.h"
 
@@ -93,6 +94,23 @@ INSTANTIATE_TEST_SUITE_P(Presets, CommissionMotor, ::testing::Values("exp1", "4k
                          [](const ::testing::TestParamInfo<const char *> &i) {
                            return std::string("m") + i.param;
                          });
+
+// Then the online estimator on the same drive at rated load, fed the duty cycles (no voltage
+// sensors) with the identified constants and inverter model: T_R within 1 %, and what
+// commissioning costs against the true constants within 0.1 % of T_R.
+TEST_P(CommissionMotor, ThenTheEstimatorOnTheDutyCyclesGetsTrWithinOnePercent)
+{
+  const comm_sim_opts_t o = opts(GetParam());
+  const comm_sim_out_t out = run(o);
+  ASSERT_TRUE(out.r.valid);
+  comm_online_t id, tr;
+  ASSERT_EQ(comm_online_run(&o, 1.0, 20.0, &out.r, &id), 0);
+  ASSERT_EQ(comm_online_run(&o, 1.0, 20.0, nullptr, &tr), 0);
+  ASSERT_GT(id.windows, 10);
+  EXPECT_LT(std::fabs(id.tr_all_rel), 0.01);
+  EXPECT_LT(std::fabs(id.tr_all_rel - tr.tr_all_rel), 0.001);
+  if (id.tr_valid > 0) EXPECT_LT(std::fabs(id.tr_rel), 0.01);
+}
 
 TEST(Commission, StandstillOnlyFillsLsFromTheFluxTails)
 {

@@ -6,12 +6,18 @@
 #include "imest/imest.h"
 #include "imsim/imsim.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
   char preset[16];
   double load_frac;  /* of rated torque (exp2: of the paper's 2.064 N m) */
   double duration_s; /* simulated per run */
   double settle_s;   /* windows ending before this are left out */
   unsigned long seed;
+  int duty; /* 1: the duty-cycle input with the true inverter model (the +-0.1 V go to
+                        the model's thresholds); 0: the measured phase voltages */
 } comm_sens_opts_t;
 
 typedef struct {
@@ -29,5 +35,9 @@ typedef struct {
 /* Seven runs (true, +-1 % L_S, +-1 % sigma, +-0.1 V); central differences. 0, or -1 if a run
    failed (simulator or estimator set-up, or no window). */
 int comm_sensitivity(const comm_sens_opts_t *o, comm_sens_t *out);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

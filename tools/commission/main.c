@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "commission_online.h"
 #include "commission_sensitivity.h"
 #include "commission_sim.h"
 #include "tool_args.h"
@@ -52,7 +53,12 @@ static void usage(FILE *f)
           "  --sensitivity        instead: the online estimator's T_R and R_S error per 1 %% error of\n"
           "                       L_S and sigma and per 0.1 V of inverter model error (preset at\n"
           "                       --load of rated torque, phase-voltage input)\n"
-          "  --load X             load for --sensitivity, fraction of rated [1]\n"
+          "  --duty               --sensitivity with the duty-cycle input on the commissioned drive\n"
+          "                       (the 0.1 V taken off the true inverter model's thresholds)\n"
+          "  --load X             load for --sensitivity and --online, fraction of rated [1]\n"
+          "  --online             then: the online estimator on the same drive at --load with the\n"
+          "                       identified constants and inverter model (duty-cycle input),\n"
+          "                       against the same with the true ones\n"
           "  --help\n",
           k_prog);
 }
@@ -96,7 +102,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "%s: unknown preset '%s' (%s)\n", k_prog, preset, imsim_preset_names());
     return 2;
   }
-  int csv = 0, verbose = 0, sensitivity = 0;
+  int csv = 0, verbose = 0, sensitivity = 0, online = 0, duty_input = 0;
   double load = 1.0;
   const char *trace = NULL;
   tool_args_t a;
@@ -137,6 +143,12 @@ int main(int argc, char **argv)
     } else if (tool_args_is(&a, "--verbose")) {
       if (tool_args_flag(&a)) return 2;
       verbose = 1;
+    } else if (tool_args_is(&a, "--duty")) {
+      if (tool_args_flag(&a)) return 2;
+      duty_input = 1;
+    } else if (tool_args_is(&a, "--online")) {
+      if (tool_args_flag(&a)) return 2;
+      online = 1;
     } else if (tool_args_is(&a, "--sensitivity")) {
       if (tool_args_flag(&a)) return 2;
       sensitivity = 1;
@@ -191,6 +203,7 @@ int main(int argc, char **argv)
     so.duration_s = 14.0;
     so.settle_s = 4.0;
     so.seed = o.seed;
+    so.duty = duty_input;
     comm_sens_t r;
     if (comm_sensitivity(&so, &r) != 0) {
       fprintf(stderr, "%s: the sensitivity runs failed for %s\n", k_prog, o.preset);
@@ -229,6 +242,14 @@ int main(int argc, char **argv)
   if (o.trace && o.trace != stdout) fclose(o.trace);
   const imest_comm_result_t *r = &out.r;
   const imsim_config_t *sc = &out.sim;
+  comm_online_t on_id, on_true;
+  if (online && r->valid) {
+    if (comm_online_run(&o, load, 20.0, r, &on_id) != 0 ||
+        comm_online_run(&o, load, 20.0, NULL, &on_true) != 0) {
+      fprintf(stderr, "%s: the online run failed\n", k_prog);
+      return 1;
+    }
+  }
   if (csv) {
     printf(
         "preset,state,reason,valid,time_s,i_peak_a,rs_err_pct,rs_winding_err_pct,sigma_ls_err_pct,ls_err_pct,"
@@ -319,6 +340,18 @@ int main(int argc, char **argv)
              f->dr_std, f->tau_s, f->tau_std, f->lm_h, f->slsig_h, f->slsig_std, f->rhf_ohm, f->gain_dev,
              f->rms_v);
     }
+  if (online && r->valid) {
+    const comm_online_t *v[2] = {&on_id, &on_true};
+    printf("\n  online estimator on this drive, %.0f %% load, duty-cycle input, windows after 6 s of 20 s:",
+           100.0 * load);
+    for (int k = 0; k < 2; ++k)
+      printf("\n    %-10s constants: T_R %+.3f %% (all windows), %+.3f %% (valid: %d of %d); R_S %+.3f %% "
+             "(all), %+.3f "
+             "%% (valid: %d); status %s",
+             k == 0 ? "identified" : "true", 100.0 * v[k]->tr_all_rel, 100.0 * v[k]->tr_rel, v[k]->tr_valid,
+             v[k]->windows, 100.0 * v[k]->rs_all_rel, 100.0 * v[k]->rs_rel, v[k]->rs_valid,
+             imest_reason_name(v[k]->reason));
+  }
   printf(
       "\n  rotor travel at standstill %.2g rad; rotating run %.2f Hz, %.3f A, slip %.2g, negative sequence "
       "%.3g; flags "
