@@ -218,11 +218,14 @@ void cm_fit_axis(imest_comm_t *c, uint32_t axis)
   axis_ctx_t x;
   x.c = c;
   x.axis = axis;
-  x.nb = c->job_nblk < IMEST_COMM_NBLK ? c->job_nblk : IMEST_COMM_NBLK;
+  const uint32_t nb_job = c->job_nblk;
+  x.nb = nb_job < (uint32_t)IMEST_COMM_NBLK ? nb_job : (uint32_t)IMEST_COMM_NBLK;
   double d_p[CM_PLATEAUS] = {0}, i_p[CM_PLATEAUS] = {0}, w_p[CM_PLATEAUS] = {0};
   int seen[CM_PLATEAUS] = {0};
   /* the DC blocks' sums become means (the fits evaluate them many times); the buffer is the
-     background's until the job is done */
+     background's until the job is done. (cppcheck 2.10 takes x.nb for < 1 here: it is the
+     job's block count, up to IMEST_COMM_NBLK.) */
+  // cppcheck-suppress knownConditionTrueFalse
   for (uint32_t bi = 0; bi < x.nb; ++bi) {
     imest_comm_block_t *b = &c->blk[bi];
     if (!dc_block(b)) continue;
