@@ -77,6 +77,22 @@ int comm_sim_config(const comm_sim_opts_t *o, imsim_config_t *sc)
   return 0;
 }
 
+int comm_sim_operating(const comm_sim_opts_t *o, double load_frac, imsim_config_t *sc)
+{
+  if (comm_sim_config(o, sc) != 0) return -1;
+  sc->supply = IMSIM_SUPPLY_PWM;
+  sc->timing = IMSIM_TIMING_FIRMWARE;
+  sc->start = IMSIM_START_STEADY;
+  if (sc->rated_torque_nm > 0.0) {
+    sc->load_nm = load_frac * sc->rated_torque_nm;
+  } else {
+    sc->freq_hz = 30.0;
+    sc->vll_v = 115.0;
+    sc->load_nm = load_frac * 2.064;
+  }
+  return 0;
+}
+
 void comm_sim_comm_config(const comm_sim_opts_t *o, const imsim_config_t *sc, imest_comm_config_t *cc)
 {
   imest_comm_config_default(cc);

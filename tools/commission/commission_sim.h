@@ -69,6 +69,11 @@ int comm_sim_defaults(comm_sim_opts_t *o, const char *preset);
 /* The simulator configuration for the options (drive, sensors, inverter; no load, at rest). */
 int comm_sim_config(const comm_sim_opts_t *o, imsim_config_t *sc);
 
+/* The same drive in operation (after commissioning): V/f at its rated point (the presets' 390 V,
+   50 Hz; the paper's motor at its exp. 2 point, 30 Hz 115 V), in steady state at load_frac of
+   rated torque (the paper's: 2.064 N m), firmware timing (duty columns). 0, or -1. */
+int comm_sim_operating(const comm_sim_opts_t *o, double load_frac, imsim_config_t *sc);
+
 /* The routine's configuration for that drive (fs, carrier, limits, nameplate). */
 void comm_sim_comm_config(const comm_sim_opts_t *o, const imsim_config_t *sc, imest_comm_config_t *cc);
 

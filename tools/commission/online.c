@@ -19,18 +19,7 @@ int comm_online_run(const comm_sim_opts_t *o, double load_frac, double duration_
 {
   memset(out, 0, sizeof *out);
   imsim_config_t sc;
-  if (comm_sim_config(o, &sc) != 0) return -1;
-  /* the same drive, now in operation: V/f at the rated point, steady, at the load */
-  sc.supply = IMSIM_SUPPLY_PWM;
-  sc.timing = IMSIM_TIMING_FIRMWARE;
-  sc.start = IMSIM_START_STEADY;
-  if (sc.rated_torque_nm > 0.0) {
-    sc.load_nm = load_frac * sc.rated_torque_nm; /* the preset's 390 V, 50 Hz */
-  } else {                                       /* the paper's motor: its exp. 2 point */
-    sc.freq_hz = 30.0;
-    sc.vll_v = 115.0;
-    sc.load_nm = load_frac * 2.064;
-  }
+  if (comm_sim_operating(o, load_frac, &sc) != 0) return -1; /* the same drive, now in operation */
   imsim_t *sim = (imsim_t *)calloc(1, sizeof *sim);
   imest_t *est = (imest_t *)calloc(1, sizeof *est);
   imsim_sample_t s;

@@ -35,20 +35,13 @@ static int run_one(const comm_sens_opts_t *o, double ls_k, double sig_k, double 
   imsim_config_t sc;
   if (o->duty) { /* the commissioned drive of imest-commission: 2 us, 1 V / 0.8 V devices */
     comm_sim_opts_t co;
-    if (comm_sim_defaults(&co, o->preset) != 0 || comm_sim_config(&co, &sc) != 0) return -1;
-    sc.supply = IMSIM_SUPPLY_PWM;
-    sc.timing = IMSIM_TIMING_FIRMWARE;
-    if (sc.rated_torque_nm <= 0.0) { /* the paper's motor: its exp. 2 point */
-      sc.freq_hz = 30.0;
-      sc.vll_v = 115.0;
-    }
-  } else if (imsim_config_preset(&sc, o->preset) != 0) {
-    return -1;
+    if (comm_sim_defaults(&co, o->preset) != 0 || comm_sim_operating(&co, o->load_frac, &sc) != 0) return -1;
+  } else {
+    if (imsim_config_preset(&sc, o->preset) != 0) return -1;
+    sc.start = IMSIM_START_STEADY;
+    sc.load_nm = o->load_frac * (sc.rated_torque_nm > 0.0 ? sc.rated_torque_nm : 2.064); /* the paper's */
   }
   sc.thermal = false;
-  sc.start = IMSIM_START_STEADY;
-  sc.load_nm =
-      o->load_frac * (sc.rated_torque_nm > 0.0 ? sc.rated_torque_nm : 2.064); /* 2.064: the paper's */
   sc.seed = o->seed;
   imsim_t *sim = (imsim_t *)calloc(1, sizeof *sim);
   imest_t *est = (imest_t *)calloc(1, sizeof *est);
