@@ -107,7 +107,7 @@ int imest_background(imest_t *s, imest_result_t *out)
   for (unsigned int k = 0; k < out->n_roots && k < IMEST_MAX_ROOTS; ++k) {
     out->roots_k2[k] = so.roots_k2[k];
   }
-  bg_judge(s, &st, &so, out);
+  bg_judge(s, w, &st, &sums, &so, steady, out);
 
   /* centre later windows on the latest trusted estimate */
   if (out->valid) {
