@@ -188,7 +188,11 @@ void bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, 
   }
   if (status == IMEST_REASON_NONE && so->status != IMEST_OK) status = so->status; /* NUMERIC or NO_ROOT */
   if (status == IMEST_REASON_NONE && !so->hessian_pd) status = IMEST_REASON_NOT_MINIMUM;
-  if (status == IMEST_REASON_NONE && !(r->pe_k2_rel <= (double)s->max_pe_k2_rel))
+  /* The parametric error index does not shrink with the span (the residual
+   * and the cost's curvature both grow with it); the estimate's statistical
+   * error does, as 1/sqrt(windows). n windows combined are held to the
+   * single window's statistical standard: max_pe_k2_rel sqrt(n). */
+  if (status == IMEST_REASON_NONE && !(r->pe_k2_rel <= (double)s->max_pe_k2_rel * sqrt((double)r->windows)))
     status = IMEST_REASON_POORLY_DETERMINED;
   /* the residual beyond what the sensors' white noise explains */
   if (status == IMEST_REASON_NONE) {

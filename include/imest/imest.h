@@ -417,6 +417,19 @@ typedef struct {
   uint32_t enabled;          /**< configured (angle_observer_hz >= 0) */
 } imest_angle_t;
 
+/** Consecutive windows' sums combined by the background (src/bg_combine.c). */
+typedef struct {
+  double rw[36]; /**< upper triangle of the 8x8 R_W (K form) */
+  double rwy[8], rwe[8];
+  double ry, ree;
+  double e_c0;      /**< the noise's E at the centring, summed */
+  double ry_raw;    /**< R_y before the noise compensation, summed */
+  float c0[8];      /**< the centring of the last window */
+  uint32_t n;       /**< windows combined (0: none) */
+  uint32_t samples; /**< their samples */
+  uint32_t centred; /**< every window had the same centring: rwe, ree hold */
+} imest_combo_t;
+
 /** Estimator instance. All fields are private; sizes are what the ISR needs. */
 typedef struct {
   /* constants derived at init */
@@ -469,6 +482,7 @@ typedef struct {
   float noise_g[6];    /* the front end's noise gains (bg_noise.h) */
   float w_prev_rad_s;  /* the previous window's mean speed (angle observer) */
   uint32_t w_prev_valid;
+  imest_combo_t combo;    /* windows combined where one has too little information */
   float last_k1, last_k2; /* last valid estimate: centring of later windows */
 } imest_t;
 
