@@ -19,47 +19,44 @@
 #include "bg_noise.h"
 #include "isr_accumulate.h"
 
-/* x_f[n] of the Butterworth-3 (as isr_bw3, in float64) for an input x. */
+/* x_f[n] of the Butterworth-3 (as isr_bw3) for an input x. */
 typedef struct {
-  double s1, s2a, s2b;
+  float s1, s2a, s2b;
 } bw3_state_t;
 
-static double bw3_step(const imest_bw3_t *f, bw3_state_t *c, double x)
+static float bw3_step(const imest_bw3_t *f, bw3_state_t *c, float x)
 {
-  const double t = (double)f->b0 * x, v = t + c->s1;
-  c->s1 = t - (double)f->a1 * v;
-  const double t2 = (double)f->c0 * v, y = t2 + c->s2a;
-  c->s2a = (t2 + t2) - (double)f->d1 * y + c->s2b;
-  c->s2b = t2 - (double)f->d2 * y;
+  const float t = f->b0 * x, v = t + c->s1;
+  c->s1 = t - f->a1 * v;
+  const float t2 = f->c0 * v, y = t2 + c->s2a;
+  c->s2a = (t2 + t2) - f->d1 * y + c->s2b;
+  c->s2b = t2 - f->d2 * y;
   return y;
 }
 
 void bg_noise_gains(const imest_bw3_t *bw, double fs, float g[6])
 {
-  bw3_state_t c = {0.0, 0.0, 0.0};
-  double y1 = 0.0, y2 = 0.0, peak = 0.0;
-  double gxx = 0.0, gxd = 0.0, gxdd = 0.0, gdd = 0.0, gddd = 0.0, gd2 = 0.0;
+  /* float32: gains of a correction, summed over a few hundred samples */
+  bw3_state_t c = {0.0f, 0.0f, 0.0f};
+  const float f1 = (float)(0.5 * fs), f2 = (float)(fs * fs);
+  float y1 = 0.0f, y2 = 0.0f, peak = 0.0f;
+  float acc[6] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
   for (uint32_t n = 0; n < 65536u; ++n) {
-    const double y0 = bw3_step(bw, &c, n == 0u ? 1.0 : 0.0);
-    const double x = y1, dx = (y0 - y2) * 0.5 * fs, d2x = ((y0 - y1) - (y1 - y2)) * fs * fs;
-    gxx += x * x;
-    gxd += x * dx;
-    gxdd += x * d2x;
-    gdd += dx * dx;
-    gddd += dx * d2x;
-    gd2 += d2x * d2x;
+    const float y0 = bw3_step(bw, &c, n == 0u ? 1.0f : 0.0f);
+    const float x = y1, dx = (y0 - y2) * f1, d2x = ((y0 - y1) - (y1 - y2)) * f2;
+    acc[0] += x * x;
+    acc[1] += x * dx;
+    acc[2] += x * d2x;
+    acc[3] += dx * dx;
+    acc[4] += dx * d2x;
+    acc[5] += d2x * d2x;
     y2 = y1;
     y1 = y0;
-    peak = fmax(peak, fabs(y0));
-    /* the response has decayed far below float32 resolution of the sums */
-    if (n > 16u && fabs(y0) + fabs(y2) < 1e-10 * peak && fabs(c.s1) + fabs(c.s2a) < 1e-10 * peak) break;
+    peak = fmaxf(peak, fabsf(y0));
+    /* the response has decayed far below the sums' resolution */
+    if (n > 16u && fabsf(y0) + fabsf(y2) < 1e-7f * peak && fabsf(c.s1) + fabsf(c.s2a) < 1e-7f * peak) break;
   }
-  g[0] = (float)gxx;
-  g[1] = (float)gxd;
-  g[2] = (float)gxdd;
-  g[3] = (float)gdd;
-  g[4] = (float)gddd;
-  g[5] = (float)gd2;
+  for (unsigned int k = 0; k < 6u; ++k) g[k] = acc[k];
 }
 
 /* A regressor column's noise coefficients in one row (x): on the row's own
@@ -86,7 +83,11 @@ void bg_noise_estimate(const imest_t *s, const imest_window_t *w, const bg_windo
   /* the smooth signal's share of the third differences: a sinusoid at the
    * stator frequency, half of |i|^2 on the alpha axis */
   const double we = np * st->w_mean + st->slip_rate;
-  const double h = 2.0 * sin(0.5 * we / fs), h6 = h * h * h * h * h * h;
+  /* 2 sin(x/2) by its series (|x| <= pi: error < 1e-3 of it; libm's sin
+   * would cost 5 KB of flash on a soft-double core) */
+  const double x = fmin(fabs(we / fs), 3.141592653589793), x2 = x * x;
+  const double h = x * (1.0 - x2 * (1.0 / 24.0) * (1.0 - x2 * (1.0 / 80.0) * (1.0 - x2 * (1.0 / 168.0))));
+  const double h6 = h * h * h * h * h * h;
   const double ni = ((double)w->sum[IMEST_ACC_NOISE_I] + (double)w->blk[IMEST_ACC_NOISE_I]) / n;
   const double nu = ((double)w->sum[IMEST_ACC_NOISE_U] + (double)w->blk[IMEST_ACC_NOISE_U]) / n;
   const double i2 = 0.5 * sums->rw[3][3] / n;

@@ -21,35 +21,42 @@ static int first_flag_reason(unsigned int flags, uint32_t used, uint32_t samples
 }
 
 /* The window's operating point, from its sums: stator frequency, slip,
- * power and impedance (power-invariant alpha/beta: the power is the motor's). */
+ * power and impedance (power-invariant alpha/beta: the power is the motor's).
+ * float32 throughout this file: every evidence is a ratio, and the FPU's
+ * arithmetic keeps the verdict small and fast on a single-precision core. */
 typedef struct {
-  double we;    /* stator (field) frequency [rad/s]: the current's rotation in the stator frame */
-  double slip;  /* slip fraction: the rotor-frame current's rotation / we */
-  double p_w;   /* mean electrical power u.i [W] */
-  double s_va;  /* mean |u| |i| [VA] */
-  double z_ohm; /* |u| / |i| [ohm] */
-  double i_pk;  /* peak phase current of the fundamental [A] */
+  float we;    /* stator (field) frequency [rad/s]: the current's rotation in the stator frame */
+  float slip;  /* slip fraction: the rotor-frame current's rotation / we */
+  float p_w;   /* mean electrical power u.i [W] */
+  float s_va;  /* mean |u| |i| [VA] */
+  float z_ohm; /* |u| / |i| [ohm] */
+  float i2;    /* mean |i|^2 [A^2] */
+  float i_pk;  /* peak phase current of the fundamental [A] */
 } op_point_t;
+
+#define TWO_PI_F 6.2831853f
 
 static void operating_point(const imest_t *s, const bg_window_stats_t *st, const bg_sums_t *sm, uint32_t nreg,
                             op_point_t *op)
 {
-  const double n = nreg > 0u ? (double)nreg : 1.0;
-  op->we = st->slip_rate + (double)s->n * st->w_mean;
-  op->slip = fabs(op->we) > 0.0 ? st->slip_rate / op->we : 0.0;
+  const float n = nreg > 0u ? (float)nreg : 1.0f;
+  const float slip_rate = (float)st->slip_rate;
+  op->we = slip_rate + s->n * (float)st->w_mean;
+  op->slip = fabsf(op->we) > 0.0f ? slip_rate / op->we : 0.0f;
   /* W1.W4 - W2.W4 = u.i / (sigma L_S) exactly (i_perp.i = 0) */
-  op->p_w = (sm->rw[0][3] - sm->rw[1][3]) / (double)s->inv_s / n;
-  const double i2 = sm->rw[3][3] / n, u2 = 2.0 * st->u_ms; /* balanced: |u|^2 = 2 u_alpha^2 */
-  op->s_va = sqrt(fmax(i2, 0.0) * fmax(u2, 0.0));
-  op->z_ohm = i2 > 0.0 ? sqrt(fmax(u2, 0.0) / i2) : 0.0;
-  op->i_pk = sqrt(fmax(i2, 0.0) * (2.0 / 3.0)); /* |i_alphabeta| = sqrt(3/2) phase peak */
+  op->p_w = (float)(sm->rw[0][3] - sm->rw[1][3]) / s->inv_s / n;
+  const float i2 = fmaxf((float)sm->rw[3][3] / n, 0.0f), u2 = fmaxf(2.0f * (float)st->u_ms, 0.0f);
+  op->i2 = i2;
+  op->s_va = sqrtf(i2 * u2); /* balanced: |u|^2 = 2 u_alpha^2 */
+  op->z_ohm = i2 > 0.0f ? sqrtf(u2 / i2) : 0.0f;
+  op->i_pk = sqrtf(i2 * (2.0f / 3.0f)); /* |i_alphabeta| = sqrt(3/2) phase peak */
 }
 
 /* The data contradict the conventions the config says (README remedies):
  * - the rotor-frame current turns faster than the field (slip > 1.25): the
  *   rotor would turn against its field at steady speed. An encoder counting
  *   backwards gives 2.
-* - negative slip while the motor takes power: generating gives power back.
+ * - negative slip while the motor takes power: generating gives power back.
  *   Phases b and c swapped, or the electrical angle given for the
  *   mechanical, give -1 (with 2 pole pairs). And motoring slip while power
  *   flows back: the currents' sign.
@@ -62,17 +69,16 @@ static void operating_point(const imest_t *s, const bg_window_stats_t *st, const
  * Judged only with a stator frequency above 2 Hz and real power flowing. */
 static int wiring_mismatch(const imest_t *s, const op_point_t *op)
 {
-  const double we = fabs(op->we), two_pi = 6.283185307179586;
-  if (!(we > two_pi * 2.0) || !(op->s_va > 0.0)) return 0;
-  const double ls = (double)s->ls_h, sl = (double)s->sigma * ls;
-  if (op->slip > 1.25) return 1;
-  if (op->slip < -0.25 && op->p_w > 0.1 * op->s_va) return 1;
-  if (op->slip > 0.02 && op->p_w < -0.1 * op->s_va) return 1;
-  if (op->slip > 0.45 && fabs(op->slip) * we > two_pi * 5.0) return 1;
-  if (op->z_ohm < we * sl / 3.0) return 1;
-  const double rs_max = (s->rs_nominal_ohm > 0.0f) ? 3.0 * (double)s->rs_nominal_ohm : 10.0 * we * ls;
-  if (op->z_ohm > 3.0 * we * ls + rs_max) return 1;
-  return 0;
+  const float we = fabsf(op->we);
+  if (!(we > TWO_PI_F * 2.0f) || !(op->s_va > 0.0f)) return 0;
+  const float ls = s->ls_h, sl = s->sigma * ls;
+  if (op->slip > 1.25f) return 1;
+  if (op->slip < -0.25f && op->p_w > 0.1f * op->s_va) return 1;
+  if (op->slip > 0.02f && op->p_w < -0.1f * op->s_va) return 1;
+  if (op->slip > 0.45f && fabsf(op->slip) * we > TWO_PI_F * 5.0f) return 1;
+  if (op->z_ohm < we * sl / 3.0f) return 1;
+  const float rs_max = (s->rs_nominal_ohm > 0.0f) ? 3.0f * s->rs_nominal_ohm : 10.0f * we * ls;
+  return op->z_ohm > 3.0f * we * ls + rs_max;
 }
 
 /* Error bounds of T_R and R_S from the systematic errors the config states,
@@ -84,54 +90,49 @@ static int wiring_mismatch(const imest_t *s, const op_point_t *op)
  *   the first-order sensitivity, which the simulator shows to be about half
  *   the measured effect (the delay also moves the currents against the angle).
  * dv_v: the voltage uncertainty [V] (negative: unknown). */
-static void systematic_bounds(const imest_t *s, const op_point_t *op, double slip_rate, double tr, double rs,
-                              double dv_v, double *tr_rel, double *rs_rel)
+static void systematic_bounds(const imest_t *s, const op_point_t *op, float slip_rate, float tr, float rs,
+                              float dv_v, float *tr_rel, float *rs_rel)
 {
-  const double we = op->we, ws = slip_rate, ls = (double)s->ls_h, sg = (double)s->sigma;
-  const double a = ws * tr;
+  const float we = op->we, ls = s->ls_h, sg = s->sigma;
+  const float a = slip_rate * tr, den = 1.0f + a * a;
   /* Z and dZ/dT_R = we L_S ws (1 - sigma) / (1 + j a)^2 */
-  const double den = 1.0 + a * a;
-  const double zr = rs + we * ls * (a * (1.0 - sg)) / den;
-  const double zi = we * ls * (1.0 + sg * a * a) / den;
-  const double k = we * ls * ws * (1.0 - sg) / (den * den);
-  const double dr = k * (1.0 - a * a), di = k * (-2.0 * a);
-  const double tau = 2.0 * (double)s->timing_uncertainty_s;
-  const double dzr = fabs(we) * tau * fabs(zi), dzi = fabs(we) * tau * fabs(zr);
-  const double dt = fabs(di) > 0.0 ? dzi / fabs(di) : (double)INFINITY;
+  const float zr = rs + we * ls * (a * (1.0f - sg)) / den;
+  const float zi = we * ls * (1.0f + sg * a * a) / den;
+  const float k = we * ls * slip_rate * (1.0f - sg) / (den * den);
+  const float dr = k * (1.0f - a * a), di = k * (-2.0f * a);
+  const float tau = 2.0f * s->timing_uncertainty_s;
+  const float dzr = fabsf(we) * tau * fabsf(zi), dzi = fabsf(we) * tau * fabsf(zr);
+  const float dt = fabsf(di) > 0.0f ? dzi / fabsf(di) : INFINITY;
   *tr_rel = dt / tr;
-  const double dr_timing = dzr + fabs(dr) * dt;
-  const double dr_volt = dv_v < 0.0 ? (double)INFINITY : (4.0 / 3.141592653589793) * dv_v / op->i_pk;
-  *rs_rel = (dr_timing + dr_volt) / rs;
+  const float dr_volt = dv_v < 0.0f ? INFINITY : (4.0f / 3.14159265f) * dv_v / op->i_pk;
+  *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs;
 }
 
 /* The uncertainty of the voltage's fundamental per phase [V]: the inverter
  * model's error at this current times its relative uncertainty (duty input),
  * or u_uncertainty_v (measured voltages); negative: unknown. */
-static double voltage_uncertainty(const imest_t *s, const op_point_t *op)
+static float voltage_uncertainty(const imest_t *s, const op_point_t *op)
 {
-  if (!s->duty_input) return (double)s->u_uncertainty_v;
+  if (!s->duty_input) return s->u_uncertainty_v;
   const imest_inverter_t *v = &s->inverter;
-  if (v->uncertainty < 0.0f) return -1.0;
-  const double vdc = (double)s->vdc_prev, a = op->i_pk;
-  const double e = (double)v->dead_time_s * (double)s->pwm_hz * vdc + (double)v->v_diode_v +
-                   (double)v->r_diode_ohm * a +
-                   0.5 * (((double)v->v_switch_v - (double)v->v_diode_v) +
-                          ((double)v->r_switch_ohm - (double)v->r_diode_ohm) * a);
-  return (double)v->uncertainty * fabs(e);
+  if (v->uncertainty < 0.0f) return -1.0f;
+  const float a = op->i_pk;
+  const float e = v->dead_time_s * s->pwm_hz * s->vdc_prev + v->v_diode_v + v->r_diode_ohm * a +
+                  0.5f * ((v->v_switch_v - v->v_diode_v) + (v->r_switch_ohm - v->r_diode_ohm) * a);
+  return v->uncertainty * fabsf(e);
 }
 
 /* The current sensors' gain mismatch from the zero sequence (three sensors:
  * i_a + i_b + i_c is the sensors' error), as the complex pattern E = sum_x
  * eps_x e^(-j 2 pi x / 3) of the per-phase gain errors: |E| (0 with two
  * sensors, where the third is computed and the zero sequence is exactly 0). */
-static double gain_mismatch(const imest_window_t *w, const bg_sums_t *sm)
+static float gain_mismatch(const imest_window_t *w, const bg_sums_t *sm)
 {
-  const double c = 1.2247448713915890; /* 2 / sqrt(2/3) */
-  const double s2 = sm->rw[3][3];
-  if (!(s2 > 0.0)) return 0.0;
-  const double ca = (double)w->sum[IMEST_ACC_I0A] + (double)w->blk[IMEST_ACC_I0A];
-  const double cb = (double)w->sum[IMEST_ACC_I0B] + (double)w->blk[IMEST_ACC_I0B];
-  return c * sqrt(ca * ca + cb * cb) / s2;
+  const float s2 = (float)sm->rw[3][3];
+  if (!(s2 > 0.0f)) return 0.0f;
+  const float ca = w->sum[IMEST_ACC_I0A] + w->blk[IMEST_ACC_I0A];
+  const float cb = w->sum[IMEST_ACC_I0B] + w->blk[IMEST_ACC_I0B];
+  return 1.2247449f * sqrtf(ca * ca + cb * cb) / s2; /* 2 / sqrt(2/3) */
 }
 
 /* L_S at no load: the reactance the motor shows with (nearly) no rotor
@@ -140,16 +141,15 @@ static double gain_mismatch(const imest_window_t *w, const bg_sums_t *sm)
  * at one operating point the estimator absorbs it in T_R and R_S (L_S 10 %
  * high: T_R +11 %, R_S -42 %, residual unchanged), so this is the only place
  * it shows. Latched: every later window is constants_mismatch. */
-static void noload_ls_check(imest_t *s, const op_point_t *op, double i2, double slip_ratio, int steady,
-                            imest_result_t *r)
+static void noload_ls_check(imest_t *s, const op_point_t *op, float slip_ratio, int steady, imest_result_t *r)
 {
-  const double we = fabs(op->we), two_pi = 6.283185307179586;
-  if (!(steady && slip_ratio < 0.1 && we > two_pi * 5.0 && i2 > 0.0 && op->s_va > 0.0)) return;
-  const double q = sqrt(fmax(0.0, op->s_va * op->s_va - op->p_w * op->p_w));
-  const double ls_meas = q / i2 / we;
-  r->ls_noload_h = ls_meas;
-  const double dev = ls_meas / (double)s->ls_h - 1.0;
-  s->ls_check = (fabs(dev) > 0.06) ? 2u : (s->ls_check == 2u ? 2u : 1u);
+  const float we = fabsf(op->we);
+  if (!(steady && slip_ratio < 0.1f && we > TWO_PI_F * 5.0f && op->i2 > 0.0f && op->s_va > 0.0f)) return;
+  const float q = sqrtf(fmaxf(0.0f, op->s_va * op->s_va - op->p_w * op->p_w));
+  const float ls_meas = q / op->i2 / we;
+  r->ls_noload_h = (double)ls_meas;
+  const float dev = ls_meas / s->ls_h - 1.0f;
+  s->ls_check = (fabsf(dev) > 0.06f) ? 2u : (s->ls_check == 2u ? 2u : 1u);
 }
 
 void bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, const bg_sums_t *sm,
@@ -167,7 +167,7 @@ void bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, 
    * averages out of it: 0.004..0.008 at no load with 12-bit sensors, 1.1 at
    * rated load). Below 0.1 T_R is weakly observable. With the estimate's
    * T_R (the motor's, for any size; the nominal T_R where there is none). */
-  r->slip_ratio = fabs(st->slip_rate) * (have ? r->tr_s : (double)s->tr_nominal_s);
+  r->slip_ratio = (double)(fabsf((float)st->slip_rate) * (have ? (float)r->tr_s : s->tr_nominal_s));
 
   if (status == IMEST_REASON_NONE && !(st->i_rms_a >= (double)s->min_current_a)) {
     /* i_rms_a is what passed the offset high-pass. A DC current it removed
@@ -179,8 +179,7 @@ void bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, 
   }
   if (status == IMEST_REASON_NONE && wiring_mismatch(s, &op)) status = IMEST_REASON_WIRING_MISMATCH;
   r->ls_noload_h = NAN;
-  if (status == IMEST_REASON_NONE)
-    noload_ls_check(s, &op, sm->rw[3][3] / (w->nreg ? (double)w->nreg : 1.0), r->slip_ratio, steady, r);
+  if (status == IMEST_REASON_NONE) noload_ls_check(s, &op, (float)r->slip_ratio, steady, r);
   if (status == IMEST_REASON_NONE && s->ls_check == 2u) status = IMEST_REASON_CONSTANTS_MISMATCH;
   if (status == IMEST_REASON_NONE && !(r->slip_ratio >= (double)s->min_slip_ratio)) {
     /* about 10 rpm: an encoder toggling by a count averages to zero here */
@@ -220,14 +219,16 @@ void bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, 
    * sensors' gain mismatch (|E| |Z| / R_S, measured: the paper motor, 1 %
    * between two sensors, R_S -3.5 %). */
   int rs_status = status;
-  const double mism = gain_mismatch(w, sm);
-  if (mism > 0.002) r->flags |= IMEST_FLAG_GAIN_MISMATCH;
+  const float mism = gain_mismatch(w, sm);
+  if (mism > 0.002f) r->flags |= IMEST_FLAG_GAIN_MISMATCH;
   if (have && isfinite(r->rs_ohm) && r->rs_ohm > 0.0) {
-    double tr_b, rs_b;
-    systematic_bounds(s, &op, st->slip_rate, r->tr_s, r->rs_ohm, voltage_uncertainty(s, &op), &tr_b, &rs_b);
-    const double g_b = mism * op.z_ohm / r->rs_ohm;
-    r->tr_bound_rel = tr_b;
-    r->rs_bound_rel = rs_b + g_b;
+    const float rs = (float)r->rs_ohm;
+    float tr_b, rs_b;
+    systematic_bounds(s, &op, (float)st->slip_rate, (float)r->tr_s, rs, voltage_uncertainty(s, &op), &tr_b,
+                      &rs_b);
+    const float g_b = mism * op.z_ohm / rs;
+    r->tr_bound_rel = (double)tr_b;
+    r->rs_bound_rel = (double)(rs_b + g_b);
     if (rs_status == IMEST_REASON_NONE && !(r->rs_bound_rel <= (double)s->rs_tolerance))
       rs_status = (g_b > rs_b) ? IMEST_REASON_GAIN_MISMATCH : IMEST_REASON_RS_UNCERTAIN;
   }
