@@ -10,9 +10,16 @@
  * the other checks is recomputed as R_ee - 2 R_We'd + d'R_W d, d = K - c0,
  * which is small near the centring and has no such floor.
  * Admissible: everything finite, a1(kappa) > 0, K1 > 0, T_R in
- * [tr_min, tr_max], and E_p^2 >= -1e-4 R_y (a clearly negative E is garbage).
+* [tr_min, tr_max], and E_p^2 >= -1e-4 R_y (a clearly negative E is garbage),
+ * or, where the noise's bias was subtracted from the sums, E_p^2 no further
+ * below zero than that bias at the candidate's own K (with the centring far
+ * from the solution, e.g. on the nominal T_R, the bias at the centring says
+ * nothing about it: 11 kW at 80 % speed, every window refused).
  * The admissible candidate with the least E_w is selected (first one on a tie). */
 #include "bg_select.h"
+#include "bg_noise.h"
+
+#include <math.h>
 
 static int centred_ok(const bg_sums_t *in)
 {
@@ -71,7 +78,19 @@ int bg_select(const bg_tables_t *t, const double *kappa, int n, const bg_solve_c
                     c->tr_s <= cfg->tr_max_s;
     if (c->admissible && centred) c->e = bg_e_centred(in, c->k1, c->k2);
     c->ew = c->e * w;
-    c->admissible = c->admissible && bg_finite(c->e) && bg_finite(c->ew) && c->e >= floor_e;
+    double floor_c = floor_e;
+    if (c->admissible && c->e < floor_e && in->noise && in->noise_f > 0.0) {
+      const double K[8] = {c->k1,
+                           c->k2,
+                           c->k2 * c->k2,
+                           c->k1 * c->k2,
+                           c->tr_s,
+                           c->k1 * c->tr_s,
+                           c->k1 * c->tr_s * c->tr_s,
+                           c->tr_s * c->tr_s};
+      floor_c = -1e-4 * in->ry - in->noise_f * fmax(0.0, bg_noise_e(in->noise, K, in->noise_m));
+    }
+    c->admissible = c->admissible && bg_finite(c->e) && bg_finite(c->ew) && c->e >= floor_c;
     if (c->admissible) {
       ++nad;
       if (ib < 0 || c->ew < best->ew) {

@@ -30,6 +30,12 @@ typedef struct {
    * sums leaves E_p^2 ~ 0 at the solution, plus or minus its fluctuation
    * (bg_noise.c). 0: none. */
   double e_slack;
+  /* Optional (NULL: none): the noise's bias, of which noise_f was taken out
+   * of the sums; a candidate far from c0 may then come out as far below zero
+   * as the bias at its own K (bg_noise_e), which e_slack (the bias at c0) does
+   * not bound. */
+  const struct bg_noise *noise;
+  double noise_f, noise_m;
   double c0[8];
   double rwe[8];
   double ree;

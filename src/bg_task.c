@@ -51,6 +51,9 @@ int imest_background(imest_t *s, imest_result_t *out)
   bg_noise_estimate(s, w, &st, &sums, steady, &nz);
   const double ry_raw = sums.ry;
   bg_noise_subtract(&sums, &nz, m);
+  sums.noise = &nz;
+  sums.noise_f = nz.scale;
+  sums.noise_m = m;
   out->noise_i_a = sqrt(nz.var_i);
   out->noise_u_v = sqrt(nz.var_u);
   /* Too little information in the window before (poorly determined, nothing
@@ -69,6 +72,7 @@ int imest_background(imest_t *s, imest_result_t *out)
     bg_combine_sums(&s->combo, m, &sums);
     e_c0 = s->combo.e_c0;
     noise_share = (double)s->combo.samples / (double)(w->samples ? w->samples : 1u);
+    sums.noise_f = nz.scale * noise_share;
     out->span_s = (double)s->combo.samples / (double)s->fs;
     out->windows = (unsigned int)s->combo.n;
     out->flags |= IMEST_FLAG_COMBINED;

@@ -64,7 +64,7 @@ void check(const bg_sums_t &s, const bg_solve_cfg_t &cfg, const char *what, int 
 
 bg_sums_t fill(double v)
 {
-  bg_sums_t s;
+  bg_sums_t s{};
   for (auto &r : s.rw)
     for (double &x : r) x = v;
   for (double &x : s.rwy) x = v;
