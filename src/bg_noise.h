@@ -42,4 +42,7 @@ void bg_noise_subtract(bg_sums_t *sums, bg_noise_t *nz, double m);
  * the units of E_p^2. */
 double bg_noise_e(const bg_noise_t *nz, const double k[8], double m);
 
+/* The same at (K1, K2), the rest of K formed from them. */
+double bg_noise_e_at(const bg_noise_t *nz, double k1, double k2, double m);
+
 #endif /* IMEST_BG_NOISE_H */

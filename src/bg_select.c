@@ -80,15 +80,7 @@ int bg_select(const bg_tables_t *t, const double *kappa, int n, const bg_solve_c
     c->ew = c->e * w;
     double floor_c = floor_e;
     if (c->admissible && c->e < floor_e && in->noise && in->noise_f > 0.0) {
-      const double K[8] = {c->k1,
-                           c->k2,
-                           c->k2 * c->k2,
-                           c->k1 * c->k2,
-                           c->tr_s,
-                           c->k1 * c->tr_s,
-                           c->k1 * c->tr_s * c->tr_s,
-                           c->tr_s * c->tr_s};
-      floor_c = -1e-4 * in->ry - in->noise_f * fmax(0.0, bg_noise_e(in->noise, K, in->noise_m));
+      floor_c = -1e-4 * in->ry - in->noise_f * fmax(0.0, bg_noise_e_at(in->noise, c->k1, c->k2, in->noise_m));
     }
     c->admissible = c->admissible && bg_finite(c->e) && bg_finite(c->ew) && c->e >= floor_c;
     if (c->admissible) {

@@ -16,6 +16,7 @@
  * mutable data, no allocation. */
 #include <math.h>
 
+#include "bg_noise.h"
 #include "bg_quality.h"
 #include "bg_resultant.h"
 
@@ -90,7 +91,14 @@ int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *
   out->e = (c->e > 0.0) ? c->e : 0.0;
   out->e_w = (c->ew > 0.0) ? c->ew : 0.0;
   out->e_i = sqrt(out->e / in->ry);
-  stats->quality_evals = bg_quality(&t, cfg, c, out);
+  /* The error indices take the residual as measured: the noise's share at
+   * the selected K, not at the centring (far from the solution the latter
+   * can be much smaller, and a negative compensated E then reads as an
+   * exact fit: pe 0). */
+  bg_solve_cfg_t qcfg = *cfg;
+  if (in->noise && in->noise_f > 0.0)
+    qcfg.e_noise = fmax(cfg->e_noise, in->noise_f * bg_noise_e_at(in->noise, c->k1, c->k2, in->noise_m));
+  stats->quality_evals = bg_quality(&t, &qcfg, c, out);
   out->work += stats->quality_evals;
 
   const int finite = bg_finite(out->e_i) && bg_finite(out->hessian[0][0]) && bg_finite(out->hessian[0][1]) &&

@@ -103,8 +103,7 @@ int imest_background(imest_t *s, imest_result_t *out)
     /* E and E_I of the data as measured (the noise's part added back), and the
      * part the noise explains */
     const double k1 = so.k1, k2 = so.k2;
-    const double kv[8] = {k1, k2, k2 * k2, k1 * k2, 1.0 / k2, k1 / k2, k1 / (k2 * k2), 1.0 / (k2 * k2)};
-    const double e_noise = fmax(0.0, bg_noise_e(&nz, kv, m)) * noise_share;
+    const double e_noise = fmax(0.0, bg_noise_e_at(&nz, k1, k2, m)) * noise_share;
     out->e = so.e + nz.scale * e_noise;
     out->e_i = sqrt(out->e / ry_all);
     out->e_i_noise = sqrt(e_noise / ry_all);
@@ -144,8 +143,9 @@ int imest_background(imest_t *s, imest_result_t *out)
   else if (!combined)
     bg_combine_add(&s->combo, &sums, nz.e_c0, ry_raw, w->samples);
 
-  /* centre later windows on the latest trusted estimate */
-  if (out->valid) {
+  /* Centre later windows on the latest trusted K (T_R valid: R_S may be
+   * refused for its own bound while K1, K2 are well determined). */
+  if (out->tr_valid) {
     s->last_k1 = (float)out->k1;
     s->last_k2 = (float)out->k2;
   }

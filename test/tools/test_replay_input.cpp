@@ -44,6 +44,15 @@ int valid_windows(const Out &o)
     if (r.size() > 4 && r[4] == "1") n++;
   return n;
 }
+
+// windows whose T_R is valid (column tr_valid, the 22nd)
+int tr_valid_windows(const Out &o)
+{
+  int n = 0;
+  for (const auto &r : rows(o.out))
+    if (r.size() > 21 && r[21] == "1") n++;
+  return n;
+}
 } // namespace
 
 TEST(ReplayInput, TimeInMillisecondsIsNamedWithTheRateItWouldBe)
@@ -84,7 +93,9 @@ TEST(ReplayInput, OneKilohertzLogIsEstimated)
   const Out o = replay(sim_csv("exp2_1k.csv", "--preset exp2 --duration 3.2 --supply vf --fs 1000"));
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_EQ(rows(o.out).size(), 4u);
-  EXPECT_GE(valid_windows(o), 1) << o.out;
+  // T_R; R_S is refused (rs_uncertain): a 1 kHz PWM staircase could move it
+  // by about 20 % (docs/METHOD.md §18)
+  EXPECT_GE(tr_valid_windows(o), 1) << o.out;
   EXPECT_TRUE(has(o, "at 1000 Hz")) << o.err;
 }
 
@@ -107,7 +118,7 @@ TEST(ReplayInput, Log250HzNamesTheFilterLimitAndTheLowestRate)
   // the cut-off the message suggests does work at constant speed
   o = replay(p, "--filter-hz 50");
   ASSERT_EQ(o.code, 0) << o.err;
-  EXPECT_GE(valid_windows(o), 1) << o.out;
+  EXPECT_GE(tr_valid_windows(o), 1) << o.out;
   // the user's own cut-off that the rate cannot carry is a usage error
   EXPECT_EQ(replay(p, "--filter-hz 100").code, 2);
 }
