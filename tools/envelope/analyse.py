@@ -27,10 +27,11 @@ def _f(x):
         return math.nan
 
 
-def load_point(p, work, skip):
-    """The windows of one point (list of dicts), steady-state ones only (seq >= skip)."""
+def load_point(p, work, skip, replay_name=None):
+    """The windows of one point (list of dicts), steady-state ones only (seq >= skip). The
+    replay output is work/<replay_name or name>.replay.csv, the truth work/<name>.truth.csv."""
     name = p["name"]
-    rep = os.path.join(work, name + ".replay.csv")
+    rep = os.path.join(work, (replay_name or name) + ".replay.csv")
     tru = os.path.join(work, name + ".truth.csv")
     with open(tru) as f:
         truth = {int(r["seq"]): r for r in csv.DictReader(f)}

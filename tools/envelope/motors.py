@@ -67,7 +67,7 @@ def constants(m):
                 b=0.01 * p_w / (wn * wn))
 
 
-def _point(c, psi, f_hz, load_nm):
+def _point(c, psi, f_hz, load_nm, phasors=False):
     """Stator voltage (alpha-beta amplitude = V_ll rms), current and speed of the steady state
     with rotor flux psi, electrical frequency f_hz and load torque load_nm (friction added)."""
     we = 2.0 * math.pi * f_hz
@@ -87,7 +87,7 @@ def _point(c, psi, f_hz, load_nm):
     gamma = c["rs"] / sls + (1.0 - c["sigma"]) / (c["sigma"] * c["tr"])
     beta = m_h / (sls * c["lr"])
     u = sls * (1j * we * i + gamma * i - beta * (1.0 / c["tr"] - 1j * c["np"] * wm) * psi)
-    return abs(u), abs(i), wm
+    return (u, i, wm) if phasors else (abs(u), abs(i), wm)
 
 
 def rated_flux(m):
@@ -101,15 +101,26 @@ def rated_flux(m):
     return 0.5 * (lo + hi)
 
 
-def operating_point(m, f_pct, load_pct):
-    """(f_hz, V_ll, load_nm, i_rms, speed_rad_s) at f_pct % of rated frequency and load_pct % of
-    rated torque, with the rotor flux at its rated value."""
+def operating_point(m, f_pct, load_pct, inv=None, vdc=560.0, f_carrier=8000.0):
+    """(f_hz, V_ll, load_nm, i_ab, speed_rad_s) at f_pct % of rated frequency and load_pct % of
+    rated torque, with the rotor flux at its rated value; i_ab is the alpha-beta current
+    amplitude (sqrt 3 x the phase rms).
+
+    With inv (dead_time, v_switch, r_switch, v_diode, r_diode) the commanded voltage also makes
+    up the inverter's mean voltage error, as a drive that holds its flux does: per leg a
+    square wave of t_d f_c V_dc + the drop, in phase with the current, whose fundamental is
+    4/pi of it (sqrt(3/2) x that in alpha-beta), plus the slope times the current. Without
+    it a 3 us dead time stalls the small motors at 10 Hz under full load."""
     c = constants(m)
     psi = rated_flux(m)
     f_hz = m["f"] * f_pct / 100.0
     load = m["t_nm"] * load_pct / 100.0
-    v, i, wm = _point(c, psi, f_hz, load)
-    return f_hz, v, load, i, wm
+    u, i, wm = _point(c, psi, f_hz, load, phasors=True)
+    if inv:
+        e = inv["dead_time"] * f_carrier * vdc + 0.5 * (inv["v_switch"] + inv["v_diode"])
+        r = 0.5 * (inv["r_switch"] + inv["r_diode"])
+        u = u + (math.sqrt(1.5) * 4.0 / math.pi * e / abs(i) + r) * i
+    return f_hz, abs(u), load, abs(i), wm
 
 
 def rated_current(m):

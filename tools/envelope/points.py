@@ -76,7 +76,8 @@ def design(full=True):
     out = []
     for k, p in enumerate(pts):
         m = next(x for x in motors.MOTORS if x["name"] == p["motor"])
-        f_hz, vll, load, i_ab, wm = motors.operating_point(m, p["f_pct"], p["load_pct"])
+        inv = INVERTER if p["input"] == "duty_inv" else None  # the drive makes up its error
+        f_hz, vll, load, i_ab, wm = motors.operating_point(m, p["f_pct"], p["load_pct"], inv, m["vdc"])
         if wm <= 0.0:
             continue
         p.update(f_hz=f_hz, vll=vll, load_nm=load, speed_rad_s=wm, goal=in_goal(p))

@@ -19,6 +19,81 @@ def _names(rows, key):
     return [m["name"] for m in motors.MOTORS if any(r[key] == m["name"] for r in rows)]
 
 
+def _q(xs, p):
+    xs = sorted(x for x in xs if math.isfinite(x))
+    return xs[int(round(p * (len(xs) - 1)))] if xs else math.nan
+
+
+def _sel(rows, **kw):
+    return [w for w in rows if all(w[k] == v for k, v in kw.items())]
+
+
+def evidence(rows):
+    """Tables behind the diagnosis: the validity evidence against motor size, sensors and
+    encoders, and the systematic errors the verdicts do not see."""
+    L = ["## Evidence\n"]
+    names = _names(rows, "motor")
+    goal = [w for w in rows if w["goal"]]
+    L.append("**E_I of accurate windows** (goal region, |e_TR| <= 1 % and |e_RS| <= 3 %, valid or "
+             "not): median / 90th percentile, and the share above 3 (`max_ei`, `high_residual`).\n")
+    L.append("| " + " | ".join(["motor"] + names) + " |")
+    L.append("|---" * (len(names) + 1) + "|")
+    cells = []
+    for n in names:
+        ei = [w["E_I"] for w in goal if w["motor"] == n and abs(w["e_tr"]) <= 0.01 and abs(w["e_rs"]) <= 0.03]
+        cells.append(f"{_q(ei, .5):.2g} / {_q(ei, .9):.2g}, {_pct(sum(e > 3 for e in ei), len(ei))} % (n {len(ei)})"
+                     if ei else "–")
+    L.append("| E_I | " + " | ".join(cells) + " |\n")
+
+    L.append("**slip_ratio as reported** (median, goal sensors, frequency >= 15 %) by load; the "
+             "zero-slip test refuses below `min_slip_ratio` (0.1).\n")
+    loads = sorted({w["load_pct"] for w in rows if w["family"] == "grid"})
+    L.append("| load % | " + " | ".join(names) + " |")
+    L.append("|---" * (len(names) + 1) + "|")
+    for ld in loads:
+        L.append(f"| {ld} | " + " | ".join(
+            f"{analyse.median([w['slip_ratio'] for w in _sel(rows, family='grid', motor=n, load_pct=ld) if w['f_pct'] >= 15]):.3g}"
+            for n in names) + " |")
+    L.append("")
+
+    fams = ["sensors_ideal", "sensors_16bit", "grid", "encoder_65536", "encoder_4096", "encoder_1024"]
+    fams = [f for f in fams if any(w["family"] == f for w in rows)]
+    for title, f_pct, ld, key, fmt in (
+            ("**pe_k2_rel** (median) at 40 % frequency, 25 % load: noise and encoder against the "
+             "threshold `max_pe_k2_rel` 0.1", 40, 25, "pe_k2_rel", "{:.3g}"),
+            ("**R_S error** (median of all windows, %) at 40 % frequency, 100 % load: the encoder",
+             40, 100, "e_rs", "{:+.1f}"),
+            ("**R_S error** (median of all windows, %) at rated frequency, 25 % load", 100, 25, "e_rs",
+             "{:+.1f}")):
+        if not fams:
+            break
+        L.append(title + ".\n")
+        L.append("| variant | " + " | ".join(names) + " |")
+        L.append("|---" * (len(names) + 1) + "|")
+        for fam in fams:
+            cells = []
+            for n in names:
+                v = analyse.median([w[key] for w in _sel(rows, family=fam, motor=n, f_pct=f_pct, load_pct=ld)])
+                cells.append(fmt.format(100 * v if key == "e_rs" else v) if math.isfinite(v) else "–")
+            L.append(f"| {fam} | " + " | ".join(cells) + " |")
+        L.append("")
+
+    ideal = [w for w in rows if w["family"] == "sensors_ideal"]
+    if ideal:
+        L.append("**Systematic R_S error with ideal sensors** (median %, phase-voltage input: exact "
+                 "volt-seconds of each sample period, exact currents and angle) by frequency and "
+                 "load: what no noise explains.\n")
+        fl = sorted({(w["f_pct"], w["load_pct"]) for w in ideal})
+        L.append("| motor | " + " | ".join(f"f {f} %, load {ld} %" for f, ld in fl) + " |")
+        L.append("|---" * (len(fl) + 1) + "|")
+        for n in names:
+            L.append(f"| {n} | " + " | ".join(
+                _e(100 * analyse.median([w["e_rs"] for w in _sel(ideal, motor=n, f_pct=f, load_pct=ld)]), 1)
+                for f, ld in fl) + " |")
+        L.append("")
+    return L
+
+
 def render(summary, rows, table, meta):
     L = []
     add = L.append
@@ -140,6 +215,7 @@ def render(summary, rows, table, meta):
                 f"{t['fv_marginal']} | {_e(t['e_tr_med_pct'])} | {_e(t['e_rs_med_pct'])} | "
                 f"{t['pe_k2_med']:.3g} | {t['ei_med']:.3g} |")
         add("")
+    L += evidence(rows)
     add("## Motors\n")
     add("| motor | n_p | L_S [H] | sigma | R_S [ohm] | T_R [s] | rated | source |")
     add("|---|---|---|---|---|---|---|---|")

@@ -44,11 +44,16 @@ def sim_args(p, duration_s):
     elif p["sensors"] == "16bit":
         a += ["--adc-bits", "16"]
     if p["input"] == "duty_inv":
-        inv = points.INVERTER
-        a += ["--dead-time", f"{inv['dead_time']:g}", "--v-switch", f"{inv['v_switch']:g}",
-              "--r-switch", f"{inv['r_switch']:g}", "--v-diode", f"{inv['v_diode']:g}",
-              "--r-diode", f"{inv['r_diode']:g}"]
+        a += inverter_flags(points.INVERTER)
     return a
+
+
+def inverter_flags(inv):
+    """--dead-time ... --r-diode: the same flags for imest-sim (the inverter) and imest-replay
+    (its model)."""
+    return ["--dead-time", f"{inv['dead_time']:.6g}", "--v-switch", f"{inv['v_switch']:.6g}",
+            "--r-switch", f"{inv['r_switch']:.6g}", "--v-diode", f"{inv['v_diode']:.6g}",
+            "--r-diode", f"{inv['r_diode']:.6g}"]
 
 
 def replay_args(p, extra=()):
@@ -61,10 +66,29 @@ def replay_args(p, extra=()):
         a += ["--u-delay", f"{0.5 / FS_HZ:.9g}"]
     else:
         inv = points.INVERTER if p["input"] == "duty_inv" else dict.fromkeys(points.INVERTER, 0.0)
-        a += ["--voltage", "duty", "--dead-time", f"{inv['dead_time']:g}",
-              "--v-switch", f"{inv['v_switch']:g}", "--r-switch", f"{inv['r_switch']:g}",
-              "--v-diode", f"{inv['v_diode']:g}", "--r-diode", f"{inv['r_diode']:g}"]
+        a += ["--voltage", "duty"] + inverter_flags(inv)
     return a + list(extra)
+
+
+def simulate(sim, args, csv_path, lf):
+    """imest-sim ARGS --out CSV; returns an error message or None."""
+    r = subprocess.run([sim] + args + ["--out", csv_path], stdout=lf, stderr=lf)
+    return None if r.returncode == 0 else f"imest-sim failed ({r.returncode})"
+
+
+def replay_to(replay, args, csv_path, out_path, lf):
+    """imest-replay ARGS CSV > OUT; returns an error message or None."""
+    with open(out_path, "w") as out:
+        r = subprocess.run([replay] + args + [csv_path], stdout=out, stderr=lf)
+    return None if r.returncode == 0 else f"imest-replay failed ({r.returncode})"
+
+
+def truth_to(csv_path, out_path, lf):
+    """The simulator's truth averaged over each 1-s window of CSV, into OUT."""
+    with open(out_path, "w") as out:
+        r = subprocess.run(["awk", "-F,", "-v", f"N={int(round(FS_HZ))}", TRUTH_AWK, csv_path],
+                           stdout=out, stderr=lf)
+    return None if r.returncode == 0 else "truth averaging failed"
 
 
 def run_point(p, sim, replay, work, duration_s, extra_replay=(), keep=False):
@@ -72,24 +96,14 @@ def run_point(p, sim, replay, work, duration_s, extra_replay=(), keep=False):
     message or None."""
     name = p["name"]
     csv_path = os.path.join(work, name + ".sim.csv")
-    rep = os.path.join(work, name + ".replay.csv")
-    truth = os.path.join(work, name + ".truth.csv")
     log = os.path.join(work, name + ".log")
     with open(log, "w") as lf:
-        r = subprocess.run([sim] + sim_args(p, duration_s) + ["--out", csv_path],
-                           stdout=lf, stderr=lf)
-        if r.returncode != 0:
-            return f"imest-sim failed ({r.returncode}), see {log}"
-        with open(rep, "w") as out:
-            r = subprocess.run([replay] + replay_args(p, extra_replay) + [csv_path],
-                               stdout=out, stderr=lf)
-        if r.returncode != 0:
-            return f"imest-replay failed ({r.returncode}), see {log}"
-        with open(truth, "w") as out:
-            r = subprocess.run(["awk", "-F,", "-v", f"N={int(round(FS_HZ))}", TRUTH_AWK, csv_path],
-                               stdout=out, stderr=lf)
-        if r.returncode != 0:
-            return f"truth averaging failed, see {log}"
+        err = (simulate(sim, sim_args(p, duration_s), csv_path, lf) or
+               replay_to(replay, replay_args(p, extra_replay), csv_path,
+                         os.path.join(work, name + ".replay.csv"), lf) or
+               truth_to(csv_path, os.path.join(work, name + ".truth.csv"), lf))
+    if err:
+        return f"{err}, see {log}"
     if not keep:
         os.remove(csv_path)
     return None
