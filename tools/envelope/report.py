@@ -94,6 +94,46 @@ def evidence(rows):
     return L
 
 
+def comparison(summary, table, base_dir):
+    """Before/after against an earlier run's summary.json and points.csv (e.g. the committed
+    baseline): the summary lines and, per motor, the goal region's coverage."""
+    import csv
+    import json
+    import os
+    sj, pc = os.path.join(base_dir, "summary.json"), os.path.join(base_dir, "points.csv")
+    if not (os.path.exists(sj) and os.path.exists(pc)):
+        return []
+    old = json.load(open(sj))
+    olds = old["summary"]
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    shown = os.path.relpath(os.path.abspath(base_dir), root)
+    L = [f"## Against `{shown}`\n",
+         f"Earlier run: {old['meta']['form']} form, {old['meta']['points']} recordings, "
+         f"{olds['windows']} windows.\n", "| line | earlier | now |", "|---|---|---|"]
+    for k, v in summary.items():
+        o = olds.get(k)
+        if o is None:
+            continue
+        fmt = "{:.4f}" if isinstance(v, float) else "{}"
+        L.append(f"| `{k}` | {fmt.format(o)} | {fmt.format(v)} |")
+    L.append("")
+    with open(pc) as f:
+        prev = list(csv.DictReader(f))
+    L.append("Goal region per motor, T_R good % / R_S good % (earlier -> now):\n")
+    L.append("| motor | earlier | now |")
+    L.append("|---|---|---|")
+    for name in [m["name"] for m in motors.MOTORS]:
+        cells = []
+        for rows_, get in ((prev, lambda r, k: int(r[k])), (table, lambda r, k: int(r[k]))):
+            g = [r for r in rows_ if r["motor"] == name and str(r["goal"]) in ("1", "True")]
+            n = sum(get(r, "windows") for r in g)
+            cells.append(f"{_pct(sum(get(r, 'tr_good') for r in g), n)} / {_pct(sum(get(r, 'rs_good') for r in g), n)}"
+                         if n else "–")
+        L.append(f"| {name} | {cells[0]} | {cells[1]} |")
+    L.append("")
+    return L
+
+
 def render(summary, rows, table, meta):
     L = []
     add = L.append
@@ -111,6 +151,8 @@ def render(summary, rows, table, meta):
     for k, v in summary.items():
         add(f"{k} {v:.4f}" if isinstance(v, float) else f"{k} {v}")
     add("```\n")
+    if meta.get("compare"):
+        L += comparison(summary, table, meta["compare"])
     add("Goal region: 12-bit ADCs (1 LSB noise), 16384-count encoder, phase-voltage input, load "
         ">= 25 %, frequency >= 15 % of rated. `coverage_tr`: share of its windows with T_R valid "
         "and within 1 %; `coverage_rs`: R_S valid and within 3 %. `false_valid_gross`: windows of "
