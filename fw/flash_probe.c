@@ -2,7 +2,8 @@
  * and the CAN publisher (the telemetry a drive sends; the reader is host
  * code). Built twice, with and without the library calls (FW_FLASH_BASELINE);
  * the size difference is the flash a firmware pays for the core, including
- * what it pulls from libm, libgcc and libc, with --gc-sections. */
+ * what it pulls from libm, libgcc and libc, with --gc-sections. With
+ * FW_FLASH_DUTY it also links the duty-cycle input, reported on its own line. */
 #include <stdint.h>
 #ifndef FW_FLASH_BASELINE
 #include "imest/imest.h"
@@ -31,6 +32,9 @@ int main(void)
   const float u[3] = {0.0f, 0.0f, 0.0f}, i[3] = {0.0f, 0.0f, 0.0f};
   (void)imest_isr_abc(&est, u, i, 0.0f);
   (void)imest_isr_ab(&est, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+#ifdef FW_FLASH_DUTY
+  (void)imest_isr_duty(&est, u, 0.0f, i, 0.0f);
+#endif
   (void)imest_background(&est, &res);
   (void)imest_reason_name(res.status);
   if (imest_can_pub_init(&pub, &probe_port, IMEST_CAN_DEFAULT_BASE_ID) != IMEST_OK) return 1;

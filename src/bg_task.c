@@ -92,6 +92,17 @@ int imest_background(imest_t *s, imest_result_t *out)
     s->last_k2 = (float)out->k2;
   }
   if (s->last_k2 > 0.0f) bg_centre_from_k(w->c0, (double)s->last_k1, (double)s->last_k2, m);
+  /* The angle observer smooths only at a steady speed (src/isr_angle.h): it
+   * is engaged after a window whose mean speed is within 2 % (and 1 rad/s) of
+   * the previous window's, and disengaged otherwise. */
+  {
+    const double w_now = st.w_mean, w_before = (double)s->w_prev_rad_s;
+    const int steady = w->used > 0u && s->w_prev_valid &&
+                       fabs(w_now - w_before) <= 0.02 * fmax(fabs(w_now), fabs(w_before)) + 1.0;
+    s->obs.engaged = (s->obs.enabled && steady) ? 1u : 0u;
+    s->w_prev_rad_s = (float)w_now;
+    s->w_prev_valid = w->used > 0u;
+  }
   for (unsigned int p = 0; p < IMEST_NACC; ++p) {
     w->sum[p] = 0;
     w->blk[p] = 0;

@@ -37,7 +37,7 @@ void bg_judge(const imest_t *s, const bg_window_stats_t *st, const bg_solve_out_
     /* i_rms_a is what passed the offset high-pass. A DC current it removed
      * (magnetising at rest) is in the tracked means: that rotor is at rest
      * with excitation, not without current. */
-    const double ia = (double)s->dcb[2], ib = (double)s->dcb[3];
+    const double ia = (double)s->off_ia, ib = (double)s->off_ib;
     const int dc = sqrt(ia * ia + ib * ib) >= (double)s->min_current_a;
     status = (dc && fabs(st->w_mean) < 1.0) ? IMEST_REASON_STANDSTILL : IMEST_REASON_NO_CURRENT;
   }

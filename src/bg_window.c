@@ -57,11 +57,14 @@ void bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out
   out->c0[2] = 0.0;
   out->rwe[2] = -m * out->rwe[3];
 
-  const double n = w->used > 0u ? (double)w->used : 1.0;
+  /* the sums hold every second used sample (isr_accumulate.h); the angle
+   * steps all of them */
+  const double n = w->nreg > 0u ? (double)w->nreg : 1.0;
+  const double n_used = w->used > 0u ? (double)w->used : 1.0;
   const double r44 = out->rw[3][3];
   st->i_rms_a = sqrt(fmax(r44, 0.0) / n);
-  st->w_mean = (double)w->rot * fs / n;
-  const double cross = (double)w->sum[36] + (double)w->blk[36];
+  st->w_mean = (double)w->rot * fs / n_used;
+  const double cross = (double)w->sum[IMEST_ACC_ROT] + (double)w->blk[IMEST_ACC_ROT];
   st->slip_rate = (r44 > 0.0) ? cross / r44 : 0.0;
 }
 

@@ -46,10 +46,33 @@ static inline imest_real_t isr_abs(imest_real_t x)
 }
 #endif
 
+/* Square root as one instruction (VSQRT.F32): the ISR file is compiled with
+ * -fno-math-errno (src/CMakeLists.txt), so GCC and Clang expand the builtin
+ * inline instead of calling sqrtf for a negative argument. */
+#if defined(__GNUC__) || defined(__clang__)
+#ifdef IMEST_REF64_REAL_DOUBLE
+static inline imest_real_t isr_sqrt(imest_real_t x)
+{
+  return __builtin_sqrt(x);
+}
+#else
+static inline imest_real_t isr_sqrt(imest_real_t x)
+{
+  return __builtin_sqrtf(x);
+}
+#endif
+#else
+#include <math.h>
+static inline imest_real_t isr_sqrt(imest_real_t x)
+{
+  return (imest_real_t)sqrtf((float)x);
+}
+#endif
+
 /* 1 if |x| <= lim (false for NaN and +-Inf). */
 static inline int isr_within(imest_real_t x, imest_real_t lim)
 {
-  return (x <= lim) & (x >= -lim);
+  return isr_abs(x) <= lim; /* NaN compares false */
 }
 
 #endif

@@ -217,6 +217,11 @@ typedef struct {
    *  before the rotation: it removes sensor offsets (default 1; 0 = off). Applied to both, it
    *  leaves the motor's equations intact at constant speed; see README "Method" (sensor offsets).
    *  The first start (unless start_at_rest) waits 5 time constants more for it: 0.8 s at 1 Hz. */
+  /** natural frequency [Hz] of the tracking observer between the encoder and the rotation
+   *  (src/isr_angle.h), engaged while the speed is steady: it attenuates an encoder's
+   *  quantisation steps above this (1024 counts, paper motor at 30 Hz: R_S +6.6 % -> -0.02 %)
+   *  (default 0: filter_hz / 4; negative: off, the encoder angle as it is; at most fs_hz / 4) */
+  float angle_observer_hz;
   float dc_block_hz;
   /** samples discarded after start/fault while the filters settle [s] (default 0: derived from
    *  filter_hz) */
@@ -336,8 +341,17 @@ typedef struct {
 typedef float imest_real_t;
 
 /** Number of accumulated entries: 28 of R_W (7 columns), 7 of R_Wy, 1 of R_y,
- *  and the rotation of the rotor-frame current (sum of i x di/dt: slip excitation). */
-#define IMEST_NACC 37
+ *  the rotation of the rotor-frame current (sum of i x di/dt: slip excitation),
+ *  the white-noise evidence of the currents and voltages (sums of squared third
+ *  differences), and the zero sequence of the phase currents (its correlation
+ *  with i_alpha and i_beta, and its square: current-sensor gain mismatch). */
+#define IMEST_NACC        41
+/** Indices of the entries after the 36 of [W e]'[W e]. */
+#define IMEST_ACC_ROT     36u
+#define IMEST_ACC_NOISE_I 37u
+#define IMEST_ACC_NOISE_U 38u
+#define IMEST_ACC_I0A     39u
+#define IMEST_ACC_I0B     40u
 
 /** One window's sums, as handed from the ISR to the background. */
 typedef struct {
@@ -347,7 +361,8 @@ typedef struct {
   imest_real_t rot;             /**< sum of the angle steps of the used samples [rad] */
   uint32_t seq;
   uint32_t samples;
-  uint32_t used;
+  uint32_t used; /**< samples that passed (not warm-up, not faulty) */
+  uint32_t nreg; /**< regressor samples in the sums (every second used sample) */
   uint32_t flags;
 } imest_window_t;
 
@@ -371,6 +386,27 @@ typedef struct {
   imest_real_t c0, d1, d2;
 } imest_sos_t;
 
+/** Constants of the duty-cycle input (imest_isr_duty): how the two periods
+ *  around a sample are weighted, and the inverter model per leg. */
+typedef struct {
+  imest_real_t w_prev, w_now; /**< weights of the previous and this call's leg voltages */
+  imest_real_t td_f;          /**< dead time x carrier frequency */
+  imest_real_t v_d, r_d;      /**< diode threshold [V] and slope [ohm] */
+  imest_real_t dv, dr;        /**< switch minus diode: threshold [V] and slope [ohm] */
+  imest_real_t band2;         /**< i_band^2 of a fixed zero-crossing band [A^2] (0: from the ripple) */
+  imest_real_t band_per_v;    /**< i_band / V_dc from the current ripple [A/V] (0: fixed band) */
+} imest_duty_model_t;
+
+/** Angle tracking observer between the encoder and the rotation (src/isr_angle.h). */
+typedef struct {
+  imest_real_t k1, k2, k3;   /**< gains per sample */
+  imest_real_t d;            /**< estimated angle minus encoder angle [rad] */
+  imest_real_t dth;          /**< estimated angle step per sample [rad] */
+  imest_real_t ddth;         /**< estimated change of the step per sample [rad] */
+  volatile uint32_t engaged; /**< set by the background at a steady speed (0: the encoder as it is) */
+  uint32_t enabled;          /**< configured (angle_observer_hz >= 0) */
+} imest_angle_t;
+
 /** Estimator instance. All fields are private; sizes are what the ISR needs. */
 typedef struct {
   /* constants derived at init */
@@ -378,29 +414,48 @@ typedef struct {
   imest_real_t n, m, inv_s;                         /* n_p, M*beta, 1/(sigma L_S) */
   imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max; /* dth_max: largest angle step [rad] */
   uint32_t window_n, warmup_n;
-  uint32_t aa_on; /* anti-alias model in use */
+  uint32_t warmup_fault_n; /* samples the filters settle after a fault */
+  uint32_t aa_on;          /* anti-alias model in use */
   imest_bw3_t bw;
   imest_sos_t aa;
-  /* ISR state */
-  imest_chan_t ch[5];                     /* u_x, u_y, i_x, i_y, omega */
-  imest_real_t aa_s1, aa_s2;              /* anti-alias model state (speed) */
-  imest_real_t dly;                       /* u_delay_s * fs: currents/angle delay (fraction) */
-  imest_real_t ia_prev, ib_prev, wr_prev; /* previous alpha/beta current, raw speed */
-  imest_real_t th_prev;                   /* previous mechanical angle (as given) */
-  imest_real_t dcb_a;                     /* offset high-pass: mean-tracking gain per sample */
-  imest_real_t dcb[4];                    /* tracked means of u_alpha, u_beta, i_alpha, i_beta */
-  uint32_t k;                             /* sample index in the current window */
-  uint32_t warm;                          /* warm-up samples still to discard */
-  uint32_t seq;                           /* sequence number of the window being filled */
-  uint32_t started;                       /* first sample seen */
-  volatile uint32_t published;            /* ISR -> background: count of buffers handed over; the
-                                    ISR fills win[published & 1] */
-  volatile uint32_t released;             /* background -> ISR: count of buffers released */
-  volatile uint32_t overruns;             /* windows dropped */
+  imest_real_t dly_i;      /* voltage lags: currents and angle delayed by this fraction of a sample */
+  imest_real_t dly_u;      /* voltage leads: voltage delayed by this fraction of a sample */
+  imest_real_t dcb_a;      /* offset high-pass: mean-tracking gain per sample */
+  imest_duty_model_t duty; /* duty-cycle input */
+  /* ISR state: the filter of each channel */
+  imest_chan_t f_ux, f_uy, f_ix, f_iy, f_w;
+  imest_real_t aa_s1, aa_s2;     /* anti-alias model state (speed) */
+  imest_real_t off_ua, off_ub;   /* tracked offsets of u_alpha, u_beta [V] */
+  imest_real_t off_ia, off_ib;   /* tracked offsets of i_alpha, i_beta [A] */
+  imest_real_t ia1, dia1, d2ia1; /* last i_alpha and its last two differences (noise, delay) */
+  imest_real_t ua1, dua1, d2ua1; /* the same for u_alpha */
+  imest_real_t ib1, ub1;         /* last i_beta, u_beta (delays) */
+
+  imest_real_t wr_prev;        /* previous raw speed (delay) */
+  imest_real_t th_prev;        /* previous mechanical angle (as given) */
+  imest_angle_t obs;           /* angle observer */
+  imest_real_t zx[8], zy[8];   /* the regressor of an even sample, summed in two calls */
+  uint32_t zpend;              /* zx, zy wait for the second half of their sums */
+  imest_real_t dleg[3];        /* duty input: previous call's duties */
+  imest_real_t vdc_prev;       /* duty input: previous call's bus voltage [V] */
+  uint32_t k;                  /* sample index in the current window */
+  uint32_t warm;               /* warm-up samples still to discard */
+  uint32_t seq;                /* sequence number of the window being filled */
+  uint32_t started;            /* first sample seen */
+  volatile uint32_t published; /* ISR -> background: count of buffers handed over; the
+                                            ISR fills win[published & 1] */
+  volatile uint32_t released;  /* background -> ISR: count of buffers released */
+  volatile uint32_t overruns;  /* windows dropped */
   imest_window_t win[2];
   /* background-only state */
   float sigma, ls_h, tr_nominal_s, tr_min_s, tr_max_s, rs_min_ohm, rs_max_ohm;
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
+  float rs_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
+  imest_inverter_t inverter; /* as configured: the R_S verdict weighs its uncertainty */
+  float pwm_hz;
+  uint32_t duty_input; /* the last window was fed by imest_isr_duty */
+  float w_prev_rad_s;  /* the previous window's mean speed (angle observer) */
+  uint32_t w_prev_valid;
   float last_k1, last_k2; /* last valid estimate: centring of later windows */
 } imest_t;
 

@@ -258,3 +258,10 @@ done:
   csv_close(&r);
   return rc;
 }
+#include <stdlib.h>
+double getenv_h(void);
+double getenv_h(void)
+{
+  const char *e = getenv("IMEST_H");
+  return e ? atof(e) : 0.0;
+}

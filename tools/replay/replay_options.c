@@ -44,6 +44,9 @@ static void usage(FILE *o)
              "                      ended at 10 kHz)\n"
              "  --dc-block-hz HZ    cut-off of the offset high-pass on voltages and currents\n"
              "                      (default 1; 0 = off)\n"
+             "  --angle-observer-hz HZ  natural frequency of the angle observer between the\n"
+             "                      encoder and the rotation (default 0: filter-hz / 2;\n"
+             "                      negative: off)\n"
              "  --tr-nominal S      nominal T_R for scaling (default 0.1)\n"
              "  --tr-min S --tr-max S   admissible T_R band (default 0.001 .. 10)\n"
              "  --max-pe-k2 X       validity threshold on the relative PE index of K2 (0.1)\n"
@@ -86,6 +89,7 @@ static const struct {
     {"--max-pe-k2", "max_pe_k2_rel", offsetof(imest_config_t, max_pe_k2_rel)},
     {"--ls", "ls_h", offsetof(imest_config_t, ls_h)},
     {"--sigma", "sigma", offsetof(imest_config_t, sigma)},
+    {"--angle-observer-hz", "angle_observer_hz", offsetof(imest_config_t, angle_observer_hz)},
 };
 #define N_NUMERIC   (sizeof k_numeric / sizeof k_numeric[0])
 #define GIVEN_LS    (1u << 9)
