@@ -138,7 +138,8 @@ def render(summary, rows, table, meta):
     L = []
     add = L.append
     add("# Operating envelope of imest: results\n")
-    add(f"Run: {meta['form']} form, {meta['points']} recordings of {meta['duration']:g} s, "
+    add(f"Run: {meta['form']} form on `{meta.get('source', '?')}`, {meta['points']} recordings of "
+        f"{meta['duration']:g} s, "
         f"{len(rows)} steady-state windows (the first {meta['skip']} window(s) of each recording "
         f"dropped), {meta['wall_s']:.0f} s wall on {meta['jobs']} jobs. imest-replay "
         f"{'writes' if meta['per_param'] else 'does not write'} `tr_valid`/`rs_valid`"
