@@ -3,9 +3,11 @@
  * code). Built twice, with and without the library calls (FW_FLASH_BASELINE);
  * the size difference is the flash a firmware pays for the core, including
  * what it pulls from libm, libgcc and libc, with --gc-sections. With
- * FW_FLASH_DUTY it also links the duty-cycle input, reported on its own line. */
+ * FW_FLASH_DUTY it also links the duty-cycle input, reported on its own line.
+ * FW_FLASH_COMM adds the self-commissioning API (imest_commission.h); with
+ * FW_FLASH_COMM_ONLY it is linked alone. */
 #include <stdint.h>
-#ifndef FW_FLASH_BASELINE
+#if !defined(FW_FLASH_BASELINE) && !defined(FW_FLASH_COMM_ONLY)
 #include "imest/imest.h"
 #include "imest/imest_can.h"
 static imest_t est;
@@ -18,12 +20,45 @@ static int probe_send(void *ctx, const imest_can_frame_t *f)
 }
 static const imest_can_port_t probe_port = {probe_send, 0};
 #endif
+#if defined(FW_FLASH_COMM) || defined(FW_FLASH_COMM_ONLY)
+#include "imest/imest_commission.h"
+static imest_comm_t comm;
+static int probe_comm(void)
+{
+  imest_comm_config_t cc;
+  const char *field = 0;
+  imest_comm_config_default(&cc);
+  if (imest_comm_config_check(&cc, &field) != IMEST_OK) return 1;
+  if (imest_comm_init(&comm, &cc) != IMEST_OK) return 1;
+  const float i[3] = {0.0f, 0.0f, 0.0f};
+  float d[3];
+  int n = imest_comm_isr(&comm, i, 1.0f, 0.0f, d);
+  n += imest_comm_background(&comm);
+  (void)imest_comm_abort(&comm);
+  imest_comm_status_t st;
+  (void)imest_comm_status(&comm, &st);
+  imest_comm_result_t r;
+  (void)imest_comm_result(&comm, &r);
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  n += imest_comm_apply(&r, &cfg);
+  (void)imest_comm_reason_name(r.reason);
+  (void)imest_comm_stage_name(st.stage);
+  (void)imest_comm_state_name(st.state);
+  return n + (int)d[0];
+}
+#endif
 int main(void);
 void fw_mark_b0(void);
 
 int main(void)
 {
-#ifndef FW_FLASH_BASELINE
+#ifdef FW_FLASH_COMM_ONLY
+  return probe_comm();
+#elif !defined(FW_FLASH_BASELINE)
+#ifdef FW_FLASH_COMM
+  if (probe_comm() != 0) return 1;
+#endif
   imest_config_t cfg;
   const char *field = 0;
   imest_config_default(&cfg);

@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "harness_measure.h"
 #include "harness_semihost.h"
 #include "fw_samples.h"
 
@@ -25,90 +26,6 @@
 #define FW_WINDOW_S 0.4f
 #endif
 
-void fw_mark_b0(void);
-void fw_mark_e0(void);
-void fw_mark_b1(void);
-void fw_mark_e1(void);
-void fw_mark_b2(void);
-void fw_mark_e2(void);
-void fw_mark_b3(void);
-void fw_mark_e3(void);
-void fw_mark_b4(void);
-void fw_mark_e4(void);
-void fw_mark_b5(void);
-void fw_mark_e5(void);
-uint32_t fw_standin(uint32_t n);
-uint32_t harness_stack_used(void);
-
-#define SYST_CSR    (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR    (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR    (*(volatile uint32_t *)0xE000E018u)
-#define STACK_PAINT 0xC5C5C5C5u
-extern uint32_t __stack_bottom;
-
-typedef struct {
-  uint32_t n, min, max;
-  uint64_t sum;
-} stat_t;
-
-static void stat_add(stat_t *s, uint32_t v)
-{
-  if (s->n == 0u || v < s->min) s->min = v;
-  if (v > s->max) s->max = v;
-  s->sum += v;
-  s->n++;
-}
-
-static void stat_print(const char *name, const stat_t *s)
-{
-  sh_puts(name);
-  sh_puts(" calls ");
-  sh_putu(s->n);
-  sh_puts(" min ");
-  sh_putu(s->min);
-  sh_puts(" mean ");
-  sh_putu(s->n ? (s->sum + s->n / 2u) / s->n : 0u);
-  sh_puts(" max ");
-  sh_putu(s->max);
-  sh_puts("\n");
-}
-
-/* SysTick ticks elapsed between two CVR reads (down-counter, 24 bit). */
-static uint32_t ticks(uint32_t before, uint32_t after)
-{
-  return (before - after) & 0xFFFFFFu;
-}
-
-#if FW_WITH_IMEST
-static uint32_t *paint_lo;
-
-/* Paint `bytes` of unused stack below the caller's frame, to measure one call's stack. */
-static __attribute__((noinline)) void paint_stack(uint32_t bytes)
-{
-  uint32_t here;
-  __asm__ volatile("mov %0, sp" : "=r"(here));
-  uint32_t lo = here - 64u - bytes;
-  if (lo < (uint32_t)(uintptr_t)&__stack_bottom) lo = (uint32_t)(uintptr_t)&__stack_bottom;
-  paint_lo = (uint32_t *)(uintptr_t)(lo & ~3u);
-  for (volatile uint32_t *p = paint_lo; (uintptr_t)p < here - 64u; p++) *p = STACK_PAINT;
-}
-
-static uint32_t sp_now(void)
-{
-  uint32_t sp;
-  __asm__ volatile("mov %0, sp" : "=r"(sp));
-  return sp;
-}
-
-/* Bytes of stack used below `sp` since the last paint_stack(). */
-static uint32_t stack_below(uint32_t sp)
-{
-  const uint32_t *p = paint_lo;
-  while ((uintptr_t)p < sp && *p == STACK_PAINT) p++;
-  return sp - (uint32_t)(uintptr_t)p;
-}
-#endif
-
 #if FW_WITH_IMEST
 static imest_t est;
 static imest_result_t res;
@@ -117,26 +34,7 @@ static imest_result_t res;
 int main(void)
 {
   int fails = 0;
-  SYST_RVR = 0xFFFFFFu;
-  SYST_CVR = 0u;
-  SYST_CSR = 5u; /* enable, processor clock, no interrupt */
-
-  /* Validation of the counting: an empty bracket and a stand-in of known count. */
-  fw_mark_b2();
-  fw_mark_e2();
-  volatile uint32_t sink = 0u;
-  stat_t st_standin = {0, 0, 0, 0};
-  for (uint32_t k = 1u; k <= 200u; k++) {
-    uint32_t t0 = SYST_CVR;
-    fw_mark_b3();
-    sink += fw_standin(k * 50u);
-    fw_mark_e3();
-    uint32_t t1 = SYST_CVR;
-    stat_add(&st_standin, ticks(t0, t1));
-  }
-  (void)sink;
-  sh_puts("standin_expected calls 200 min 153 mean 15078 max 30003\n");
-  stat_print("standin_systick_ticks", &st_standin);
+  harness_validate_counting();
 
 #if FW_WITH_IMEST
   sh_kv("sizeof_imest_t", sizeof(imest_t));

@@ -234,7 +234,9 @@ unsigned int bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, const b
   out->pe_flags = 0;
 
   const double es = p * f; /* E_w~* */
-  if (!(es > 0.0)) {
+  /* the residual as measured: the compensated one plus what the noise explains */
+  const double er = es + (cfg->e_noise / t->c) * (x * x * x * x) * f;
+  if (!(er > 0.0)) {
     out->pe_k1 = out->pe_k2 = 0.0;
     out->pe_quad[0] = out->pe_quad[1] = 0.0;
     out->pe_flags |= BG_PE_FLAG_DEGENERATE;
@@ -243,7 +245,7 @@ unsigned int bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, const b
 
   double dk_q = BG_PE_UNBOUNDED, dx_q = BG_PE_UNBOUNDED;
   if (out->hessian_pd) {
-    const double hh = 0.5 * es / det;
+    const double hh = 0.5 * er / det;
     dk_q = sqrt(hh * h22);
     dx_q = sqrt(hh * h11);
     out->pe_quad[0] = finite_or_unbounded(dk_q * t->g);
@@ -255,7 +257,7 @@ unsigned int bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, const b
 
   pe_ctx_t c;
   c.t = t;
-  c.lt = 1.25 * es;
+  c.lt = es + 0.25 * er;
   c.kprof = k;
   c.nev = 0;
   /* g at kappa*: 4 e2 D^2 (E_w* - L) < 0 */

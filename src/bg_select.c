@@ -44,7 +44,7 @@ int bg_select(const bg_tables_t *t, const double *kappa, int n, const bg_solve_c
   int ib = -1;
   unsigned int nad = 0;
   const int centred = centred_ok(in);
-  const double floor_e = -1e-4 * in->ry;
+  const double floor_e = -1e-4 * in->ry - in->e_slack;
   for (int i = 0; i < n; ++i) {
     bg_cand_t cv;
     bg_cand_t *c = &cv;

@@ -25,6 +25,11 @@ typedef struct {
    * float32-accumulated sums). 8-column form: c0[2] = 0, rwe[2] = -m rwe[3].
    * centred = 0 (e.g. a zero-initialised struct): E from the tables. */
   int centred;
+  /* How far below zero E_p^2 of a candidate may come out before it counts as
+   * garbage, beyond the cancellation floor: the noise's share taken out of the
+   * sums leaves E_p^2 ~ 0 at the solution, plus or minus its fluctuation
+   * (bg_noise.c). 0: none. */
+  double e_slack;
   double c0[8];
   double rwe[8];
   double ree;
@@ -45,6 +50,11 @@ typedef struct {
    * n_p^2 w^2 of the window). 0 = the paper's cost (exactly); negative or
    * non-finite: IMEST_ERR_CONFIG. */
   double weight_c;
+  /* E_p^2 the sensors' noise explains (bg_noise.c), taken out of the sums:
+   * the parametric error indices are those of the residual as measured
+   * (L = E* + 0.25 (E* + e_noise)), not of the compensated one, which is ~0.
+   * 0: none. */
+  double e_noise;
 } bg_solve_cfg_t;
 
 typedef struct {

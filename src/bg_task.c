@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "bg_noise.h"
 #include "bg_validity.h"
 
 static void result_clear(imest_result_t *r)
@@ -36,7 +37,21 @@ int imest_background(imest_t *s, imest_result_t *out)
   bg_sums_t sums;
   bg_window_stats_t st;
   bg_window_sums(w, m, (double)s->fs, &sums, &st);
-
+  /* the white noise's bias out of the sums (bg_noise.c) */
+  /* Is the speed steady? The window's mean speed within 2 % (and 1 rad/s)
+   * of the previous window's. The noise compensation and the angle observer
+   * are models of steady operation. */
+  const double w_before = (double)s->w_prev_rad_s;
+  const int steady = w->used > 0u && s->w_prev_valid &&
+                     fabs(st.w_mean - w_before) <= 0.02 * fmax(fabs(st.w_mean), fabs(w_before)) + 1.0;
+  s->w_prev_rad_s = (float)st.w_mean;
+  s->w_prev_valid = w->used > 0u;
+  bg_noise_t nz;
+  bg_noise_estimate(s, w, &st, &sums, steady, &nz);
+  const double ry_raw = sums.ry;
+  bg_noise_subtract(&sums, &nz, m);
+  out->noise_i_a = sqrt(nz.var_i);
+  out->noise_u_v = sqrt(nz.var_u);
   bg_solve_out_t so = {0};
   so.status = IMEST_REASON_NUMERIC;
   so.tr_s = NAN;
@@ -48,6 +63,7 @@ int imest_background(imest_t *s, imest_result_t *out)
     cfg.tr_min_s = (double)s->tr_min_s;
     cfg.tr_max_s = (double)s->tr_max_s;
     cfg.weight_c = bg_solve_weight_c(&sums); /* speed-normalised cost (bg_solve.h) */
+    cfg.e_noise = nz.e_c0;
     (void)bg_solve(&sums, &cfg, &so);
   }
 
@@ -56,8 +72,14 @@ int imest_background(imest_t *s, imest_result_t *out)
     out->rs_ohm = so.rs_ohm;
     out->k1 = so.k1;
     out->k2 = so.k2;
-    out->e = so.e;
-    out->e_i = so.e_i;
+    /* E and E_I of the data as measured (the noise's part added back), and the
+     * part the noise explains */
+    const double k1 = so.k1, k2 = so.k2;
+    const double kv[8] = {k1, k2, k2 * k2, k1 * k2, 1.0 / k2, k1 / k2, k1 / (k2 * k2), 1.0 / (k2 * k2)};
+    const double e_noise = fmax(0.0, bg_noise_e(&nz, kv, m));
+    out->e = so.e + nz.scale * e_noise;
+    out->e_i = sqrt(out->e / ry_raw);
+    out->e_i_noise = sqrt(e_noise / ry_raw);
     out->hessian[0][0] = so.hessian[0][0];
     out->hessian[0][1] = so.hessian[0][1];
     out->hessian[1][0] = so.hessian[1][0];
@@ -74,6 +96,7 @@ int imest_background(imest_t *s, imest_result_t *out)
     out->k2 = NAN;
     out->e = NAN;
     out->e_i = NAN;
+    out->e_i_noise = NAN;
     out->pe_k1 = NAN;
     out->pe_k2 = NAN;
     out->pe_k1_rel = NAN;
@@ -92,17 +115,8 @@ int imest_background(imest_t *s, imest_result_t *out)
     s->last_k2 = (float)out->k2;
   }
   if (s->last_k2 > 0.0f) bg_centre_from_k(w->c0, (double)s->last_k1, (double)s->last_k2, m);
-  /* The angle observer smooths only at a steady speed (src/isr_angle.h): it
-   * is engaged after a window whose mean speed is within 2 % (and 1 rad/s) of
-   * the previous window's, and disengaged otherwise. */
-  {
-    const double w_now = st.w_mean, w_before = (double)s->w_prev_rad_s;
-    const int steady = w->used > 0u && s->w_prev_valid &&
-                       fabs(w_now - w_before) <= 0.02 * fmax(fabs(w_now), fabs(w_before)) + 1.0;
-    s->obs.engaged = (s->obs.enabled && steady) ? 1u : 0u;
-    s->w_prev_rad_s = (float)w_now;
-    s->w_prev_valid = w->used > 0u;
-  }
+  /* The angle observer smooths only at a steady speed (src/isr_angle.h). */
+  s->obs.engaged = (s->obs.enabled && steady) ? 1u : 0u;
   for (unsigned int p = 0; p < IMEST_NACC; ++p) {
     w->sum[p] = 0;
     w->blk[p] = 0;

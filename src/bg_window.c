@@ -49,6 +49,7 @@ void bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out
   /* centred form (bg_solve.h): E of a candidate without the cancellation of
    * the un-centred R_y, R_Wy (floor ~1e-5 R_y with float32 sums) */
   out->centred = 1;
+  out->e_slack = 0.0;
   out->ree = z[7][7];
   for (unsigned int i = 0; i < 7u; ++i) {
     out->c0[k_of_col[i]] = c0[i];
@@ -66,6 +67,7 @@ void bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out
   st->w_mean = (double)w->rot * fs / n_used;
   const double cross = (double)w->sum[IMEST_ACC_ROT] + (double)w->blk[IMEST_ACC_ROT];
   st->slip_rate = (r44 > 0.0) ? cross / r44 : 0.0;
+  st->u_ms = ((double)w->sum[IMEST_ACC_UU] + (double)w->blk[IMEST_ACC_UU]) / n;
 }
 
 /* Centring vector c0 (7-column form) for a given K1, K2 (docs/METHOD.md §2, §10). */

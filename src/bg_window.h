@@ -13,7 +13,8 @@ typedef struct {
   double i_rms_a;   /* rms |i| (alpha/beta amplitude) */
   double w_mean;    /* mean mechanical speed [rad/s] */
   double slip_rate; /* mean rotation rate of the rotor-frame current [rad/s]:
-                         the slip frequency in steady state */
+                       the slip frequency in steady state */
+  double u_ms;      /* mean square of u_alpha [V^2] */
 } bg_window_stats_t;
 
 /* One window's ISR sums -> full 8x8 float64 sums (undoes the centring and

@@ -3,7 +3,7 @@
 #include <math.h>
 #include <stddef.h>
 
-#include "bg_window.h"
+#include "bg_noise.h"
 
 #define IMEST_PI_D    3.14159265358979323846
 #define IMEST_SQRT2_D 1.41421356237309504880
@@ -234,6 +234,9 @@ static void design_duty(imest_duty_model_t *d, const imest_config_t *cfg)
    * carrier period: where the sign of the error is decided inside the period */
   d->band2 = v->i_band_a * v->i_band_a;
   d->band_per_v = v->i_band_a > 0.0f ? 0.0f : 1.0f / (8.0f * cfg->sigma * cfg->ls_h * fpwm);
+  /* the staircase's images alias into the samples when the steps' edges are
+   * the sample instants (NEXT_PERIOD; docs/METHOD.md §17) */
+  d->zoh = next ? 1.0f / (12.0f * cfg->fs_hz * cfg->sigma * cfg->ls_h) : 0.0f;
 }
 
 /* 2nd-order Butterworth (Q = 1/sqrt 2) anti-alias model; fc = 0: identity. */
@@ -296,6 +299,7 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
     s->dcb_a = wd / (1.0f + wd); /* backward Euler: stable for any wd */
   }
   design_bw3(&s->bw, (double)cfg->filter_hz, (double)fs);
+  bg_noise_gains(&s->bw, (double)fs, s->noise_g);
   design_aa(&s->aa, (double)cfg->aa_hz, (double)fs);
   s->aa_on = cfg->aa_hz > 0.0f;
   design_angle(&s->obs, cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz, fs);

@@ -17,6 +17,7 @@ typedef struct {
   imest_real_t cross;            /* i x di/dt of the rotor-frame current */
   imest_real_t noise_i, noise_u; /* squared third differences of i_alpha, u_alpha */
   imest_real_t i0, ia, ib;       /* zero sequence of the phase currents, alpha/beta current */
+  imest_real_t ua;               /* u_alpha */
 } isr_extra_t;
 
 /* The accumulation of one regressor sample is split over two ISR calls (the
@@ -40,6 +41,7 @@ static inline void isr_accumulate_a(imest_window_t *w, const imest_real_t zx[8],
   b[IMEST_ACC_NOISE_U] += x->noise_u;
   b[IMEST_ACC_I0A] += x->i0 * x->ia;
   b[IMEST_ACC_I0B] += x->i0 * x->ib;
+  b[IMEST_ACC_UU] += x->ua * x->ua;
 }
 
 static inline void isr_accumulate_b(imest_window_t *w, const imest_real_t zx[8], const imest_real_t zy[8])

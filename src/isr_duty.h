@@ -13,8 +13,9 @@
 /* Per-sample constants shared by the three legs. */
 typedef struct {
   imest_real_t kp, kn; /* w_prev V_dc,prev and w_now V_dc: a leg's voltage is kp dp + kn d */
-  imest_real_t e0;     /* t_d f V_dc + V_d0 at the weighted bus voltage */
-  imest_real_t band2;  /* i_band^2 */
+  imest_real_t vdc, vdc_prev;
+  imest_real_t e0;    /* t_d f V_dc + V_d0 at the weighted bus voltage */
+  imest_real_t band2; /* i_band^2 */
 } isr_duty_k_t;
 
 /* Voltage delivered by one leg [V], relative to the negative rail, from the
@@ -25,10 +26,12 @@ typedef struct {
  * sign s(i) = i / sqrt(i^2 + i_band^2): the current ripple crosses zero inside
  * the period near a zero crossing, so the error fades instead of jumping. */
 static inline imest_real_t isr_duty_leg(const imest_duty_model_t *m, const isr_duty_k_t *k,
-                                        imest_real_t *dprev, imest_real_t d, imest_real_t i)
+                                        imest_real_t *dprev, imest_real_t d, imest_real_t i,
+                                        imest_real_t *step)
 {
   const imest_real_t dp = *dprev;
   *dprev = d;
+  *step = k->vdc * d - k->vdc_prev * dp; /* the leg voltage's step at the sample */
   const imest_real_t v = k->kp * dp + k->kn * d;
   const imest_real_t dbar = m->w_prev * dp + m->w_now * d;
   const imest_real_t a = isr_abs(i);

@@ -321,6 +321,9 @@ typedef struct {
   double k2;                 /**< K2 = 1/T_R [1/s] */
   double e;                  /**< E_p^2 at the minimum (units of y^2 * samples) */
   double e_i;                /**< residual error index sqrt(E/R_y) */
+  double e_i_noise;          /**< the part of E_I that the sensors' white noise explains */
+  double noise_i_a;          /**< white noise of the current per alpha/beta axis, rms [A] */
+  double noise_u_v;          /**< white noise of the measured voltage per axis, rms [V] (0: duty input) */
   double hessian[2][2];      /**< d2E/dK^2 at the minimum, K = (K1, K2) */
   double pe_k1;              /**< parametric error index of K1 (absolute, 1/s) */
   double pe_k2;              /**< parametric error index of K2 (absolute, 1/s) */
@@ -345,13 +348,14 @@ typedef float imest_real_t;
  *  the white-noise evidence of the currents and voltages (sums of squared third
  *  differences), and the zero sequence of the phase currents (its correlation
  *  with i_alpha and i_beta, and its square: current-sensor gain mismatch). */
-#define IMEST_NACC        41
+#define IMEST_NACC        42
 /** Indices of the entries after the 36 of [W e]'[W e]. */
 #define IMEST_ACC_ROT     36u
 #define IMEST_ACC_NOISE_I 37u
 #define IMEST_ACC_NOISE_U 38u
 #define IMEST_ACC_I0A     39u
 #define IMEST_ACC_I0B     40u
+#define IMEST_ACC_UU      41u
 
 /** One window's sums, as handed from the ISR to the background. */
 typedef struct {
@@ -395,6 +399,7 @@ typedef struct {
   imest_real_t dv, dr;        /**< switch minus diode: threshold [V] and slope [ohm] */
   imest_real_t band2;         /**< i_band^2 of a fixed zero-crossing band [A^2] (0: from the ripple) */
   imest_real_t band_per_v;    /**< i_band / V_dc from the current ripple [A/V] (0: fixed band) */
+  imest_real_t zoh; /**< T / (12 sigma L_S): the staircase's aliased share of a sampled current [A/V] */
 } imest_duty_model_t;
 
 /** Angle tracking observer between the encoder and the rotation (src/isr_angle.h). */
@@ -454,6 +459,7 @@ typedef struct {
   imest_inverter_t inverter; /* as configured: the R_S verdict weighs its uncertainty */
   float pwm_hz;
   uint32_t duty_input; /* the last window was fed by imest_isr_duty */
+  float noise_g[6];    /* the front end's noise gains (bg_noise.h) */
   float w_prev_rad_s;  /* the previous window's mean speed (angle observer) */
   uint32_t w_prev_valid;
   float last_k1, last_k2; /* last valid estimate: centring of later windows */

@@ -87,7 +87,8 @@ TEST(Replay, ColumnsInAnyOrderGiveIdenticalOutput)
   ASSERT_EQ(a.code, 0) << a.err;
   EXPECT_EQ(a.out.substr(0, a.out.find('\n')),
             "t_end_s,T_R_s,R_S_ohm,E_I,valid,status,seq,K1,K2,pe_k1_rel,pe_k2_rel,H11,H12,H22,"
-            "hessian_pd,n_roots,n_admissible,slip_ratio,i_rms_a,used_samples,flags");
+            "hessian_pd,n_roots,n_admissible,slip_ratio,i_rms_a,used_samples,flags,"
+            "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel");
   // reverse the column order with awk
   const std::string q = tmpdir() + "/reversed.csv";
   ASSERT_EQ(std::system(("awk -F, 'BEGIN{OFS=\",\"} {s=$NF; for(i=NF-1;i>=1;i--) s=s \",\" $i; print s}' " +

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <regex>
+#include <set>
 #include <string>
 
 #include "tool_run.hpp"
@@ -216,16 +218,29 @@ TEST(ReplayInput, ExitCodes)
   EXPECT_EQ(replay(base()).code, 0);
 }
 
-TEST(ReplayInput, HelpNamesEveryOption)
+// Every option the parser knows (each "--name" literal of
+// tools/replay/replay_options.c) is in --help and in the README's entry.
+TEST(ReplayInput, HelpAndReadmeNameEveryOption)
 {
   const Out o = run(std::string(REPLAY_BIN) + " --help");
   ASSERT_EQ(o.code, 0);
-  for (const char *opt :
-       {"--pole-pairs", "--ls",          "--sigma",       "--fs",         "--window",    "--filter-hz",
-        "--aa-hz",      "--u-delay",     "--dc-block-hz", "--tr-nominal", "--tr-min",    "--tr-max",
-        "--max-pe-k2",  "--speed-limit", "--i-limit",     "--u-limit",    "--from-rest", "--candump",
-        "--can-iface",  "--can-id",      "--quiet",       "--help",       "--opt=VALUE", "\"-\" = stdin"})
-    EXPECT_NE(o.out.find(opt), std::string::npos) << opt;
+  const std::string src = slurp(std::string(SOURCE_DIR) + "/tools/replay/replay_options.c");
+  const std::string readme = slurp(std::string(SOURCE_DIR) + "/README.md");
+  const size_t a = readme.find("* `imest-replay`"), b = readme.find("* `imest-sim`");
+  ASSERT_NE(a, std::string::npos);
+  ASSERT_NE(b, std::string::npos);
+  const std::string entry = readme.substr(a, b - a);
+  const std::regex lit("\"(--[a-z0-9-]+)\"");
+  std::set<std::string> opts;
+  for (auto it = std::sregex_iterator(src.begin(), src.end(), lit); it != std::sregex_iterator(); ++it)
+    opts.insert((*it)[1]);
+  EXPECT_GE(opts.size(), 35u); // the parser's options were found
+  for (const std::string &opt : opts) {
+    EXPECT_NE(o.out.find(opt), std::string::npos) << opt << " not in --help";
+    if (opt != "--help") EXPECT_NE(entry.find("`" + opt), std::string::npos) << opt << " not in README.md";
+  }
+  for (const char *s : {"--opt=VALUE", "\"-\" = stdin", "-h, --help"})
+    EXPECT_NE(o.out.find(s), std::string::npos) << s;
 }
 
 // theta wrapped to [0, 2 pi) gives the estimates of the unwrapped angle.

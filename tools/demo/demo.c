@@ -11,6 +11,14 @@
  * asked). Alongside, the simulator's truth is averaged
  * over the same window's samples so every estimate can be compared with it.
  *
+ * First, commissioning: the library's self-commissioning routine (imest_commission.h) runs
+ * closed loop on the same motor behind a firmware-timed 8 kHz inverter with 2 us dead time and
+ * device drops (tools/commission/commission_sim.c); every experiment's estimator is then set up
+ * with the constants it identified (n_p, L_S, sigma, nominal R_S and T_R), not the simulator's.
+ * A second estimator with the true constants runs alongside on the same samples
+ * (<exp>_true_constants.csv), so the summary shows what commissioning costs. --no-commission
+ * uses the true constants instead.
+ *
  * Experiments (run in parallel threads):
  *   exp1           60 Hz, 230 V applied at standstill, no load, run-up (2 s);
  *                  then the motor is simulated again with the identified T_R
@@ -44,6 +52,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "commission_sim.h"
 #include "drive_loop.h"
 #include "imest/imest.h"
 #include "imest/imest_can.h"
@@ -65,7 +74,14 @@ typedef struct {
   unsigned long seed;
   int quiet;
   unsigned int only; /* bit mask of experiments to run */
+  int no_commission; /* the estimators get the true constants, nothing is commissioned */
 } options_t;
+
+/* The constants the experiments' estimators get: commissioning's, or the truth. */
+typedef struct {
+  int commissioned; /* 1: identified by the routine */
+  imest_comm_result_t r;
+} demo_constants_t;
 
 enum { EXP1 = 0, EXP2 = 1, IFOC_FIXED = 2, IFOC_ADAPTIVE = 3, IFOC11_FIXED = 4, IFOC11_ADAPTIVE = 5, NEXP = 6 };
 static const char *const k_exp_name[NEXP] = {"exp1",          "exp2",         "ifoc_fixed",
@@ -169,6 +185,7 @@ static int tee_send(void *ctx, const imest_can_frame_t *f)
 typedef struct {
   int id;
   const options_t *opt;
+  const demo_constants_t *k;
   double duration_s;
   double fs_hz;
   /* exp1 hands its estimate to the identified-parameter simulation */
@@ -225,13 +242,25 @@ static void sim_config(int id, unsigned long seed, imsim_config_t *c)
   c->seed = seed + (unsigned long)id;
 }
 
-static void est_config(const imsim_config_t *c, imest_config_t *cfg)
+/* k: the commissioned constants, or NULL for the simulator's true ones. */
+static void est_config(const imsim_config_t *c, const demo_constants_t *k, imest_config_t *cfg)
 {
   imest_config_default(cfg);
   cfg->pole_pairs = (unsigned int)c->pole_pairs; /* the paper's motor: 2, 0.2908 H, 0.096, 4 kHz */
   cfg->ls_h = (float)c->ls_h;
   cfg->sigma = (float)c->sigma;
   cfg->fs_hz = (float)c->fs_hz;
+  if (k != NULL && k->commissioned) {
+    /* n_p, L_S, sigma, the nominal R_S and T_R as identified; its inverter model is for the
+       duty-cycle input, which these runs (measured phase voltages) do not use */
+    const float fs = cfg->fs_hz;
+    (void)imest_comm_apply(&k->r, cfg);
+    cfg->fs_hz = fs;
+    imest_inverter_t none;
+    memset(&none, 0, sizeof none);
+    none.uncertainty = -1.0f;
+    cfg->inverter = none;
+  }
   /* What the drive knows about its own hardware: it is enabled with the
    * motor at rest, and where its ADCs clip (top code = range - 1 LSB). */
   cfg->start_at_rest = 1;
@@ -322,8 +351,9 @@ typedef struct {
   imsim_t *sim;
   imsim_sample_t s;
   imest_t *est;
+  imest_t *est_true; /* the same samples with the true constants (commissioned runs only) */
   tee_port_t *tee;
-  FILE *log, *csv;
+  FILE *log, *csv, *csv_true;
   truth_t *truth;
   uint32_t wn; /* samples per window */
   size_t nwin; /* truth slots */
@@ -335,8 +365,9 @@ static void run_release(run_t *x)
 {
   if (x->log) fclose(x->log);
   if (x->csv) fclose(x->csv);
+  if (x->csv_true) fclose(x->csv_true);
   free(x->truth);
-  x->log = x->csv = NULL;
+  x->log = x->csv = x->csv_true = NULL;
   x->truth = NULL;
 }
 
@@ -366,7 +397,7 @@ static void open_live(job_t *j, tee_port_t *tee)
 static int job_open(job_t *j, run_t *x)
 {
   static _Thread_local imsim_t sim;
-  static _Thread_local imest_t est;
+  static _Thread_local imest_t est, est_true;
   static _Thread_local tee_port_t tee;
   memset(x, 0, sizeof *x);
   x->j = j;
@@ -381,16 +412,27 @@ static int job_open(job_t *j, run_t *x)
     snprintf(j->err, sizeof j->err, "%s: simulator: %s", x->name, imsim_error(&sim));
     return -1;
   }
-  imest_config_t cfg;
-  est_config(&x->c, &cfg);
+  imest_config_t cfg, cfg_true;
+  /* the commissioned constants are the paper motor's: the 11 kW pair gets its true ones */
+  const demo_constants_t *k = IS_IFOC11(j->id) ? NULL : j->k;
+  est_config(&x->c, k, &cfg);
+  est_config(&x->c, NULL, &cfg_true);
   const char *field = NULL;
   if (imest_config_check(&cfg, &field) != IMEST_OK) {
     snprintf(j->err, sizeof j->err, "%s: estimator config: bad %s", x->name, field);
     return -1;
   }
-  if (imest_init(&est, &cfg) != IMEST_OK) {
+  if (imest_init(&est, &cfg) != IMEST_OK || imest_init(&est_true, &cfg_true) != IMEST_OK) {
     snprintf(j->err, sizeof j->err, "%s: imest_init failed", x->name);
     return -1;
+  }
+  if (k != NULL && k->commissioned) {
+    x->est_true = &est_true;
+    char tname[256];
+    snprintf(tname, sizeof tname, "%s_true_constants.csv", x->name);
+    if ((x->csv_true = open_out(j, x->dir, tname)) == NULL) return -1;
+    fprintf(x->csv_true, "experiment,seq,t_end_s,T_R_s,R_S_ohm,valid,status,T_R_true_s,R_S_true_ohm,"
+                         "tr_valid,rs_valid\n");
   }
 
   char fname[256];
@@ -467,6 +509,16 @@ static void on_window(void *ctx, const imest_result_t *r)
   }
 }
 
+/* drive_window_fn of the estimator with the true constants: its results beside the truth. */
+static void on_window_true(void *ctx, const imest_result_t *r)
+{
+  run_t *x = (run_t *)ctx;
+  static const truth_t nan_t = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+  const truth_t *t = (r->seq < x->nwin && r->seq < x->win) ? &x->truth[r->seq] : &nan_t;
+  fprintf(x->csv_true, "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%d,%d\n", x->name, r->seq, r->t_end_s, r->tr_s,
+          r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr, t->rs, r->tr_valid, r->rs_valid);
+}
+
 /* The samples: each one's truth into its window, then the drive loop (ISR
  * call with float32 values and the wrapped encoder angle, background drained
  * when a window is done, publishing over CAN). */
@@ -474,8 +526,9 @@ static void job_loop(run_t *x)
 {
   job_t *j = x->j;
   const unsigned long long total = j->total;
-  drive_t d;
+  drive_t d, d_true;
   drive_init(&d, x->est, on_window, x);
+  drive_init(&d_true, x->est_true, on_window_true, x);
   acc_t acc;
   memset(&acc, 0, sizeof acc);
   uint32_t in_win = 0;
@@ -490,6 +543,7 @@ static void job_loop(run_t *x)
     }
     imest_candump_port_set_time(&x->tee->log, x->s.t); /* frames carry their window's end */
     drive_sample(&d, x->s.u_abc, x->s.i_abc, x->s.theta);
+    if (x->est_true) drive_sample(&d_true, x->s.u_abc, x->s.i_abc, x->s.theta);
     if ((k & 1023u) == 0) atomic_store(&j->done, k);
   }
   atomic_store(&j->done, total);
@@ -508,8 +562,8 @@ static int job_close(run_t *x)
 #ifdef IMEST_DEMO_HAVE_SOCKETCAN
   if (x->tee->live) imest_socketcan_close(&x->tee->sc);
 #endif
-  const int bad = (fclose(x->log) != 0) | (fclose(x->csv) != 0);
-  x->log = x->csv = NULL;
+  const int bad = (fclose(x->log) != 0) | (fclose(x->csv) != 0) | (x->csv_true && fclose(x->csv_true) != 0);
+  x->log = x->csv = x->csv_true = NULL;
   run_release(x);
   if (bad) {
     snprintf(j->err, sizeof j->err, "%s: write error in %s", x->name, x->dir);
@@ -554,16 +608,70 @@ static void *job_thread(void *arg)
 }
 
 /* ------------------------------------------------------------------------- */
+/* Commissioning, before the experiments                                      */
+
+/* The routine closed loop on the paper's motor (its drive: 325 V bus, 8 kHz, firmware timing,
+   2 us dead time, 1 V / 0.8 V drops, 12-bit sensors, the 4096-count encoder; no nameplate
+   speed), allowed to turn the shaft. Writes raw/commission.csv (identified vs true) and one
+   stdout line. Returns 0, or -1 if the file cannot be written; a routine that fails leaves
+   k->commissioned = 0 (the runs then get the true constants, and the summary says so). */
+static int commission(const options_t *o, const char *raw, demo_constants_t *k)
+{
+  memset(k, 0, sizeof *k);
+  comm_sim_opts_t co;
+  if (comm_sim_defaults(&co, "exp1") != 0) return -1;
+  co.seed = o->seed;
+  static comm_sim_out_t out;
+  if (comm_sim_run(&co, &out) != 0) return -1;
+  const imest_comm_result_t *r = &out.r;
+  k->r = *r;
+  k->commissioned = r->valid;
+  char path[1100];
+  snprintf(path, sizeof path, "%s/commission.csv", raw);
+  FILE *f = fopen(path, "w");
+  if (f == NULL) {
+    fprintf(stderr, "imest-demo: %s: %s\n", path, strerror(errno));
+    return -1;
+  }
+  fprintf(f, "quantity,identified,true,unit\n");
+  fprintf(f, "state,%s,,\nreason,%s,,\nvalid,%d,,\n", imest_comm_state_name(r->state),
+          imest_comm_reason_name(r->reason), r->valid);
+  fprintf(f, "time_s,%.3f,,s\ni_peak_a,%.4f,%.4f,A\n", (double)r->time_s, out.i_peak_true_a,
+          (double)out.cc.i_max_a);
+  fprintf(f, "R_S,%.6g,%.6g,ohm\nR_S_winding,%.6g,%.6g,ohm\n", (double)r->rs_ohm.value,
+          out.rs_identifiable_ohm, (double)r->rs_ohm.value, out.rs_ohm);
+  fprintf(f, "L_S,%.6g,%.6g,H\nsigma,%.6g,%.6g,\nsigma_L_S,%.6g,%.6g,H\nT_R,%.6g,%.6g,s\n",
+          (double)r->ls_h.value, out.ls_h, (double)r->sigma.value, out.sigma, (double)r->sigma_ls_h.value,
+          out.sigma_ls_h, (double)r->tr_s.value, out.tr_s);
+  fprintf(f, "pole_pairs,%u,%u,\nencoder_dir,%d,1,\n", r->pole_pairs, out.pole_pairs, r->encoder_dir);
+  fprintf(f, "dead_time,%.6g,%.6g,s\nv_threshold,%.6g,%.6g,V\ninverter_err_max,%.4f,,V\n",
+          (double)r->inverter.dead_time_s, out.sim.dead_time_s, (double)r->v_threshold_v.value,
+          0.5 * (out.sim.v_switch_v + out.sim.v_diode_v), out.inv_err_model_v);
+  if (fclose(f) != 0) return -1;
+  printf("commission state=%s reason=%s time_s=%.2f i_peak_a=%.3f R_S_ohm=%.5g L_S_h=%.5g sigma=%.5g "
+         "T_R_s=%.5g pole_pairs=%u\n",
+         imest_comm_state_name(r->state), imest_comm_reason_name(r->reason), (double)r->time_s,
+         out.i_peak_true_a, (double)r->rs_ohm.value, (double)r->ls_h.value, (double)r->sigma.value,
+         (double)r->tr_s.value, r->pole_pairs);
+  if (!k->commissioned)
+    fprintf(stderr, "imest-demo: commissioning failed (%s): the runs use the true constants\n",
+            imest_comm_reason_name(r->reason));
+  return 0;
+}
+
+/* ------------------------------------------------------------------------- */
 /* Main                                                                       */
 
 static void usage(FILE *f)
 {
   fprintf(f, "usage: imest-demo [--out DIR] [--duration S] [--exp1-duration S] [--only LIST]\n"
-             "                  [--can-iface NAME] [--seed N] [--quiet]\n"
+             "                  [--can-iface NAME] [--seed N] [--no-commission] [--quiet]\n"
              "\n"
-             "Runs the paper's experiments on the simulated motor with imest in the loop (ISR\n"
+             "Commissions the simulated motor with the library's routine first, then runs the\n"
+             "paper's experiments with the identified constants and imest in the loop (ISR\n"
              "call per sample, background call per window, telemetry over the CAN port) and\n"
-             "writes DIR/raw/<exp>.candump.log, DIR/raw/<exp>_direct.csv, DIR/raw/exp1_wave.csv.\n"
+             "writes DIR/raw/commission.csv, DIR/raw/<exp>.candump.log, DIR/raw/<exp>_direct.csv,\n"
+             "DIR/raw/<exp>_true_constants.csv, DIR/raw/exp1_wave.csv.\n"
              "Experiments run in parallel threads: exp1 (run-up), exp2 (30 Hz V/f heat run),\n"
              "ifoc_fixed and ifoc_adaptive (the heat run under IFOC, controller T_R fixed at\n"
              "the cold value / taken from the estimator), ifoc11_fixed and ifoc11_adaptive\n"
@@ -577,6 +685,7 @@ static void usage(FILE *f)
              "                      ifoc11_fixed,ifoc11_adaptive\n"
              "  --can-iface NAME    also send exp2's frames on this SocketCAN interface\n"
              "  --seed N            sensor noise seed (default 1)\n"
+             "  --no-commission     the estimators get the true constants (no commissioning)\n"
              "  --quiet             no progress on stderr (default: progress if it is a terminal)\n"
              "  -h, --help          this text\n"
              "\n"
@@ -669,6 +778,9 @@ static int parse_options(int argc, char **argv, options_t *o)
     } else if (tool_args_is(&a, "--quiet")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       o->quiet = 1;
+    } else if (tool_args_is(&a, "--no-commission")) {
+      if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
+      o->no_commission = 1;
     } else {
       return tool_args_unknown(&a);
     }
@@ -677,11 +789,13 @@ static int parse_options(int argc, char **argv, options_t *o)
 }
 
 /* One thread per experiment asked for. */
-static int start_jobs(const options_t *o, job_t jobs[NEXP], pthread_t th[NEXP], int started[NEXP])
+static int start_jobs(const options_t *o, const demo_constants_t *k, job_t jobs[NEXP], pthread_t th[NEXP],
+                      int started[NEXP])
 {
   for (int e = 0; e < NEXP; ++e) {
     jobs[e].id = e;
     jobs[e].opt = o;
+    jobs[e].k = k;
     jobs[e].duration_s = e == EXP1        ? o->exp1_duration_s
                          : IS_IFOC11(e) ? fmax(o->duration_s / IFOC11_THERMAL_X, 10.0)
                                         : o->duration_s;
@@ -779,11 +893,16 @@ int main(int argc, char **argv)
     fprintf(stderr, "imest-demo: cannot create %s: %s\n", raw, strerror(errno));
     return TOOL_EXIT_DATA;
   }
+  static demo_constants_t k;
+  if (!o.no_commission && commission(&o, raw, &k) != 0) {
+    fprintf(stderr, "imest-demo: commissioning: cannot run or write its results\n");
+    return TOOL_EXIT_DATA;
+  }
   static job_t jobs[NEXP];
   pthread_t th[NEXP];
   int started[NEXP];
   const double t0 = now_s();
-  const int bad_start = start_jobs(&o, jobs, th, started);
+  const int bad_start = start_jobs(&o, &k, jobs, th, started);
   wait_jobs(&o, jobs, th, started, t0);
   if (bad_start) return TOOL_EXIT_DATA;
   return report(jobs, started, t0) ? TOOL_EXIT_DATA : TOOL_EXIT_OK;

@@ -701,6 +701,65 @@ def ifoc_section(fx, ad):
 # --------------------------------------------------------------------------------------
 
 
+def commission_section(raw, res):
+    """The commissioning run (raw/commission.csv) and, per experiment, the estimation error with
+    the identified constants (the runs) against a second estimator with the true constants on
+    the same samples (raw/<exp>_true_constants.csv)."""
+    path = os.path.join(raw, "commission.csv")
+    if not os.path.exists(path):
+        return ["## Constants\n", "The estimators got the simulator's true constants (`--no-commission`).\n"]
+    rows = {r["quantity"]: r for r in read_csv(path)}
+
+    def val(k):
+        return rows[k]["identified"] if k in rows else "?"
+    md = ["## Commissioning (before the runs)\n"]
+    ok = val("valid") == "1"
+    md.append(f"`imest_commission.h` run closed loop on the motor behind an 8 kHz inverter with firmware "
+              f"timing, 2 us dead time and 1.0 V / 0.8 V device drops (12-bit sensors, the 4096-count encoder, "
+              f"the shaft free to turn): state **{val('state')}**"
+              + (f" ({val('reason')})" if val("reason") not in ("none", "?") else "")
+              + f", {float(val('time_s')):.1f} s, peak phase current {float(val('i_peak_a')):.2f} A "
+              f"(limit {float(rows['i_peak_a']['true']):.2f} A).\n")
+    if not ok:
+        md.append("**The routine did not complete: the runs below use the true constants.**\n")
+        return md
+    md.append("| constant | identified | true | error |")
+    md.append("|---|---:|---:|---:|")
+    for key, label, scale, unit in (("R_S", "R_S (winding + min(r_sw, r_d))", 1.0, "Ω"),
+                                    ("R_S_winding", "R_S vs the winding alone", 1.0, "Ω"),
+                                    ("L_S", "L_S", 1e3, "mH"), ("sigma", "σ", 1.0, ""),
+                                    ("sigma_L_S", "σL_S", 1e3, "mH"), ("T_R", "T_R (nominal)", 1e3, "ms"),
+                                    ("dead_time", "dead time", 1e6, "µs"), ("v_threshold", "device threshold", 1.0, "V")):
+        if key not in rows:
+            continue
+        i, t = fnum(rows[key]["identified"]), fnum(rows[key]["true"])
+        md.append(f"| {label} | {i * scale:.5g} {unit} | {t * scale:.5g} {unit} | {100 * (i / t - 1):+.3f} % |")
+    md.append(f"| n_p, encoder direction | {val('pole_pairs')}, {val('encoder_dir')} | "
+              f"{rows['pole_pairs']['true']}, {rows['encoder_dir']['true']} | |")
+    md.append("")
+    md.append("Every run's estimator got the identified n_p, L_S, σ, nominal R_S and T_R (its voltage input "
+              "is the measured phase voltage, so the inverter model is not used). A second estimator with the "
+              "true constants ran alongside on the same samples:\n")
+    md.append("| experiment | constants | n T_R valid | T_R mean err % | T_R bias % | n R_S valid | R_S mean err % "
+              "| R_S bias % |")
+    md.append("|---|---|---:|---:|---:|---:|---:|---:|")
+    for exp in EXPS:
+        tpath = os.path.join(raw, f"{exp}_true_constants.csv")
+        if exp not in res or not os.path.exists(tpath):
+            continue
+        a = res[exp]["a"]
+        tr_rows = read_csv(tpath)
+        b = {k: np.array([fnum(r[k]) for r in tr_rows]) for k in ("T_R_s", "T_R_true_s", "R_S_ohm", "R_S_true_ohm")}
+        for k in ("tr_valid", "rs_valid"):
+            b[k] = np.array([r[k] == "1" for r in tr_rows])
+        for name, x in (("identified", a), ("true", b)):
+            s1 = err_stats(x["T_R_s"][x["tr_valid"]], x["T_R_true_s"][x["tr_valid"]])
+            s2 = err_stats(x["R_S_ohm"][x["rs_valid"]], x["R_S_true_ohm"][x["rs_valid"]])
+            md.append(f"| {exp} | {name} | {s1[0]} | {s1[1]:.2f} | {s1[4]:+.2f} | {s2[0]} | {s2[1]:.2f} | {s2[4]:+.2f} |")
+    md.append("")
+    return md
+
+
 def main(argv):
     if len(argv) < 2:
         print(__doc__)
@@ -788,6 +847,7 @@ def main(argv):
               "samples (over the same windows for the 30-s / 120-s averages). Only valid estimates "
               "count: T_R statistics use the windows whose T_R is valid (`tr_valid`), R_S statistics "
               "those whose R_S is valid (`rs_valid`); the windows left out and why are counted below.\n")
+    md += commission_section(raw, res)
     md.append("## Estimation error\n")
     md.append("n = valid 1-s windows, or 30-s / 120-s blocks with at least one valid window.\n")
     md.append("| experiment | estimate | n T_R | T_R mean err % | T_R max err % | T_R bias % "

@@ -8,6 +8,10 @@
 #include <string.h>
 
 const char *const CSV_NAMES[CSV_NEED] = {"t", "u_a", "u_b", "u_c", "i_a", "i_b", "i_c", "theta"};
+static const char *const k_duty_names[] = {"t", "d_a", "d_b", "d_c", "v_dc", "i_a", "i_b", "i_c", "theta"};
+const csv_layout_t CSV_PHASE = {CSV_NAMES, CSV_NEED};
+const csv_layout_t CSV_DUTY = {k_duty_names, (int)(sizeof k_duty_names / sizeof k_duty_names[0])};
+_Static_assert(sizeof k_duty_names / sizeof k_duty_names[0] <= CSV_MAX_NEED, "CSV_MAX_NEED too small");
 
 /* Read one line (any length); strips \n and \r. Returns length or -1 at EOF. */
 static long read_line(csv_reader_t *r)
@@ -55,7 +59,14 @@ static FILE *copy_stdin(void)
 
 int csv_open(csv_reader_t *r, const char *path)
 {
+  return csv_open_layout(r, path, &CSV_PHASE);
+}
+
+int csv_open_layout(csv_reader_t *r, const char *path, const csv_layout_t *layout)
+{
   memset(r, 0, sizeof *r);
+  r->names = layout->names;
+  r->need = layout->n;
   const int from_stdin = strcmp(path, "-") == 0;
   r->name = from_stdin ? "stdin" : path;
   path = r->name;
@@ -64,7 +75,7 @@ int csv_open(csv_reader_t *r, const char *path)
     snprintf(r->err, sizeof r->err, "%s: cannot %s: %s", path, from_stdin ? "read" : "open", strerror(errno));
     return -1;
   }
-  for (int k = 0; k < CSV_NEED; ++k) r->col[k] = -1;
+  for (int k = 0; k < r->need; ++k) r->col[k] = -1;
   errno = 0;
   long len = read_line(r);
   if (len < 0) {
@@ -82,8 +93,8 @@ int csv_open(csv_reader_t *r, const char *path)
     char *comma = strchr(tok, ',');
     if (comma) *comma = '\0';
     const char *name = trim(tok);
-    for (int k = 0; k < CSV_NEED; ++k) {
-      if (strcmp(name, CSV_NAMES[k]) == 0) {
+    for (int k = 0; k < r->need; ++k) {
+      if (strcmp(name, r->names[k]) == 0) {
         if (r->col[k] >= 0) {
           snprintf(r->err, sizeof r->err, "%s:1: column '%s' appears twice", path, name);
           return -1;
@@ -95,11 +106,15 @@ int csv_open(csv_reader_t *r, const char *path)
     tok = comma + 1;
   }
   r->ncols = idx + 1;
-  for (int k = 0; k < CSV_NEED; ++k) {
+  for (int k = 0; k < r->need; ++k) {
     if (r->col[k] < 0) {
-      snprintf(r->err, sizeof r->err,
-               "%s:1: missing column '%s' (the header needs t,u_a,u_b,u_c,i_a,i_b,i_c,theta in any order)",
-               path, CSV_NAMES[k]);
+      char all[128] = "";
+      for (int j = 0; j < r->need; ++j) {
+        strncat(all, j ? "," : "", sizeof all - strlen(all) - 1);
+        strncat(all, r->names[j], sizeof all - strlen(all) - 1);
+      }
+      snprintf(r->err, sizeof r->err, "%s:1: missing column '%s' (the header needs %s in any order)", path,
+               r->names[k], all);
       return -1;
     }
   }
@@ -127,7 +142,7 @@ static int at_last_line(csv_reader_t *r)
   return len < 0;
 }
 
-int csv_next(csv_reader_t *r, double v[CSV_NEED])
+int csv_next(csv_reader_t *r, double *v)
 {
   long len;
   do {
@@ -139,21 +154,21 @@ int csv_next(csv_reader_t *r, double v[CSV_NEED])
   for (;; ++idx) {
     char *comma = strchr(tok, ',');
     if (comma) *comma = '\0';
-    for (int k = 0; k < CSV_NEED; ++k) {
+    for (int k = 0; k < r->need; ++k) {
       if (r->col[k] != idx) continue;
       char *s = trim(tok), *end = NULL;
       errno = 0;
       double x = strtod(s, &end);
       if (*s == '\0' || end == s || *trim(end) != '\0') {
         snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': '%.40s' is not a number", r->name, r->line,
-                 CSV_NAMES[k], s);
+                 r->names[k], s);
         /* cut off inside its last field: what is left of it is the start of a number */
         cut = comma == NULL && idx + 1 <= r->ncols && strspn(s, "0123456789+-.eE") == strlen(s);
         goto bad;
       }
       if (!isfinite(x)) {
         snprintf(r->err, sizeof r->err, "%s:%ld: column '%s': non-finite value '%.40s'", r->name, r->line,
-                 CSV_NAMES[k], s);
+                 r->names[k], s);
         return -1;
       }
       if (k == 0) r->t_round = half_unit(s);
@@ -163,7 +178,7 @@ int csv_next(csv_reader_t *r, double v[CSV_NEED])
     if (!comma) break;
     tok = comma + 1;
   }
-  if (idx + 1 != r->ncols || got != CSV_NEED) {
+  if (idx + 1 != r->ncols || got != r->need) {
     snprintf(r->err, sizeof r->err, "%s:%ld: %d fields, the header has %d", r->name, r->line, idx + 1,
              r->ncols);
     cut = idx + 1 < r->ncols;

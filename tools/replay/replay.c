@@ -1,7 +1,8 @@
-/* imest-replay: runs a recorded CSV (t,u_a,u_b,u_c,i_a,i_b,i_c,theta, any
- * order, more columns ignored) through exactly the code a firmware runs: the
- * float32 ISR call per sample, the background call when a window completes.
- * Prints one CSV row per window on stdout.
+/* imest-replay: runs a recorded CSV (t,u_a,u_b,u_c,i_a,i_b,i_c,theta, or
+ * with --voltage duty t,d_a,d_b,d_c,v_dc,i_a,i_b,i_c,theta; any order, more
+ * columns ignored) through exactly the code a firmware runs: the float32 ISR
+ * call per sample (imest_isr_abc or imest_isr_duty), the background call when
+ * a window completes. Prints one CSV row per window on stdout.
  *
  * parse (replay_options.c) -> scan: time base, clipping, conventions
  * (replay_scan.c) -> configure, with advice on what the estimator refuses
@@ -24,6 +25,10 @@
 #endif
 
 static const char *const k_prog = "imest-replay";
+
+/* One count of a 4096-count encoder [rad]: a first angle step this small is
+ * encoder noise on a still rotor. */
+#define ENCODER_COUNT_STILL_RAD (6.283185307179586 / 4096.0 * 1.0001)
 
 /* ------------------------------------------------------------------------- */
 /* configure: from the options and the scan to an estimator config            */
@@ -60,9 +65,11 @@ static int configure(const replay_opts_t *o, const replay_scan_t *s, imest_confi
   cfg->u_limit_v = (float)adc_limit(o->u_limit, s->clip_u, 'u', "V", "--u-limit", o->quiet);
   /* At rest: no current and a still rotor imply a zero history for every
    * filter (no current means no flux and no voltage either). The rotor test
-   * uses the first step only: a DOL start accelerates within ms. */
-  cfg->start_at_rest =
-      o->from_rest >= 0 ? o->from_rest : (s->i_first <= 0.01 * s->i_max && s->th_step1 * s->fs < 2.0);
+   * uses the first step only: a DOL start accelerates within ms. A still
+   * rotor may show one count of a fine encoder (at 8 kHz one count of 16384
+   * is 3 rad/s), so a step up to a 4096-count encoder's count is still. */
+  const int still = s->th_step1 * s->fs < 2.0 || s->th_step1 <= ENCODER_COUNT_STILL_RAD;
+  cfg->start_at_rest = o->from_rest >= 0 ? o->from_rest : (s->i_first <= 0.01 * s->i_max && still);
   const char *field = NULL;
   if (imest_config_check(cfg, &field) != IMEST_OK) return replay_explain_config(o, s, cfg, field);
   return -1;
@@ -131,10 +138,22 @@ static int can_log_close(can_log_t *c)
 /* ------------------------------------------------------------------------- */
 /* run: every sample through the ISR call, the background per window          */
 
+/* The columns up to flags keep their places (tools/accuracy reads them by
+ * position); the per-parameter verdicts and bounds came later and follow. */
 static void print_header(void)
 {
   printf("t_end_s,T_R_s,R_S_ohm,E_I,valid,status,seq,K1,K2,pe_k1_rel,pe_k2_rel,"
-         "H11,H12,H22,hessian_pd,n_roots,n_admissible,slip_ratio,i_rms_a,used_samples,flags\n");
+         "H11,H12,H22,hessian_pd,n_roots,n_admissible,slip_ratio,i_rms_a,used_samples,flags,"
+         "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel\n");
+}
+
+/* A bound that was not computed is NaN: printed as "nan" whatever its sign bit. */
+static void print_bound(double x)
+{
+  if (isnan(x))
+    printf(",nan");
+  else
+    printf(",%.6g", x);
 }
 
 typedef struct {
@@ -148,26 +167,35 @@ static void print_row(void *ctx, const imest_result_t *r)
   const row_ctx_t *x = (const row_ctx_t *)ctx;
   const double t0_s = x->t0_s;
   can_log_publish(x->can, r);
-  printf("%.6f,%.9g,%.9g,%.6g,%d,%s,%u,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%u,%u,%.4g,%.6g,%u,0x%x\n",
+  printf("%.6f,%.9g,%.9g,%.6g,%d,%s,%u,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%u,%u,%.4g,%.6g,%u,0x%x,",
          t0_s + r->t_end_s, r->tr_s, r->rs_ohm, r->e_i, r->valid, imest_reason_name(r->status), r->seq, r->k1,
          r->k2, r->pe_k1_rel, r->pe_k2_rel, r->hessian[0][0], r->hessian[0][1], r->hessian[1][1],
          (r->flags & IMEST_FLAG_HESSIAN_PD) ? 1 : 0, r->n_roots, r->n_admissible, r->slip_ratio, r->i_rms_a,
          r->used_samples, r->flags);
+  printf("%d,%d,%s,%s,%.6g,%u", r->tr_valid, r->rs_valid, imest_reason_name(r->tr_reason),
+         imest_reason_name(r->rs_reason), r->span_s, r->windows);
+  print_bound(r->tr_bound_rel);
+  print_bound(r->rs_bound_rel);
+  printf("\n");
 }
 
-static int run(csv_reader_t *r, const replay_scan_t *s, drive_t *d, can_log_t *can)
+static int run(csv_reader_t *r, const replay_opts_t *o, const replay_scan_t *s, drive_t *d, can_log_t *can)
 {
   if (csv_rewind(r) != 0) {
     fprintf(stderr, "%s: %s: cannot read the file a second time\n", k_prog, r->name);
     return TOOL_EXIT_DATA;
   }
   print_header();
-  double v[CSV_NEED];
+  double v[CSV_MAX_NEED];
+  replay_sample_t x;
   long k = 0;
   int rc;
   while ((rc = csv_next(r, v)) == 1) {
     can_log_time(can, s->t0 * s->t_unit_s + (double)k / s->fs);
-    if (drive_sample(d, &v[1], &v[4], v[7]) < 0) break;
+    replay_decode(o->voltage, v, &x);
+    const int n = o->voltage == REPLAY_VOLTAGE_DUTY ? drive_sample_duty(d, x.d, x.vdc, x.i, x.theta)
+                                                    : drive_sample(d, x.u, x.i, x.theta);
+    if (n < 0) break;
     k++;
   }
   if (rc < 0) {
@@ -194,8 +222,11 @@ static long run_last_window(drive_t *d, const replay_scan_t *s, const imest_conf
 static void summary(const drive_t *d, const replay_scan_t *s, const imest_config_t *cfg, long rest,
                     int flushed)
 {
-  fprintf(stderr, "%s: %ld samples at %.6g Hz, %ld windows (%ld valid)", k_prog, s->n, s->fs, d->windows,
+  fprintf(stderr, "%s: %ld samples at %.6g Hz, %ld windows (%ld valid", k_prog, s->n, s->fs, d->windows,
           d->valid);
+  if (d->tr_valid != d->valid || d->rs_valid != d->valid)
+    fprintf(stderr, "; T_R valid in %ld, R_S in %ld", d->tr_valid, d->rs_valid);
+  fprintf(stderr, ")");
   int most = 0;
   for (int k = 1; k < DRIVE_NSTATUS; ++k) {
     if (d->by_status[k]) fprintf(stderr, ", %ld %s", d->by_status[k], imest_reason_name(k));
@@ -213,6 +244,24 @@ static void summary(const drive_t *d, const replay_scan_t *s, const imest_config
             imest_reason_name(most), what);
 }
 
+/* Opens the recording with the columns of the chosen input. A header that has
+ * the other input's columns gets the --voltage that reads it. */
+static int open_recording(csv_reader_t *r, const replay_opts_t *o)
+{
+  if (csv_open_layout(r, o->path, replay_layout(o->voltage)) == 0) return 0;
+  fprintf(stderr, "%s: %s", k_prog, r->err);
+  const replay_voltage_t other =
+      o->voltage == REPLAY_VOLTAGE_DUTY ? REPLAY_VOLTAGE_PHASE : REPLAY_VOLTAGE_DUTY;
+  csv_reader_t alt;
+  memset(&alt, 0, sizeof alt);
+  if (strstr(r->err, "missing column") != NULL && strcmp(o->path, "-") != 0 &&
+      csv_open_layout(&alt, o->path, replay_layout(other)) == 0)
+    fprintf(stderr, "; it has the columns of --voltage %s", other == REPLAY_VOLTAGE_DUTY ? "duty" : "phase");
+  csv_close(&alt);
+  fprintf(stderr, "\n");
+  return -1;
+}
+
 int main(int argc, char **argv)
 {
   replay_opts_t o;
@@ -220,8 +269,7 @@ int main(int argc, char **argv)
   if (rc >= 0) return rc;
 
   csv_reader_t r;
-  if (csv_open(&r, o.path) != 0) {
-    fprintf(stderr, "%s: %s\n", k_prog, r.err);
+  if (open_recording(&r, &o) != 0) {
     csv_close(&r);
     return TOOL_EXIT_DATA;
   }
@@ -236,7 +284,7 @@ int main(int argc, char **argv)
   if ((rc = can_log_open(&can, &o)) >= 0) goto done;
   row.t0_s = s.t0 * s.t_unit_s;
   drive_init(&d, &est, print_row, &row);
-  if ((rc = run(&r, &s, &d, &can)) >= 0) goto done;
+  if ((rc = run(&r, &o, &s, &d, &can)) >= 0) goto done;
   int flushed;
   const long rest = run_last_window(&d, &s, &cfg, &can, &flushed);
   if (can_log_close(&can) != 0 || fflush(stdout) != 0) {
@@ -257,11 +305,4 @@ int main(int argc, char **argv)
 done:
   csv_close(&r);
   return rc;
-}
-#include <stdlib.h>
-double getenv_h(void);
-double getenv_h(void)
-{
-  const char *e = getenv("IMEST_H");
-  return e ? atof(e) : 0.0;
 }

@@ -42,8 +42,25 @@ int replay_explain_config(const replay_opts_t *o, const replay_scan_t *s, const 
     fprintf(stderr, "--aa-hz %g must be below 0.45 x the sample rate (%.6g Hz at %.6g Hz)\n",
             (double)cfg->aa_hz, 0.45 * fs, fs);
   } else if (strcmp(field, "u_delay_s") == 0) {
-    fprintf(stderr, "--u-delay %g s must be between 0 and one sample period (1/fs = %.6g s at %.6g Hz)\n",
+    fprintf(stderr,
+            "--u-delay %g s must be within one sample period either way (|S| <= 1/fs = %.6g s at "
+            "%.6g Hz)\n",
             (double)cfg->u_delay_s, 1.0 / fs, fs);
+  } else if (strcmp(field, "pwm_hz") == 0) {
+    fprintf(stderr,
+            "--pwm-hz %g is below the sample rate %.6g Hz (from %s): a sample per carrier period "
+            "at most; leave --pwm-hz out when the drive samples once per period\n",
+            (double)cfg->pwm_hz, fs, fs_origin(o));
+  } else if (strcmp(field, "inverter.dead_time_s") == 0) {
+    const double fpwm = cfg->pwm_hz > 0.0f ? (double)cfg->pwm_hz : fs;
+    fprintf(stderr,
+            "--dead-time %g s must be below half a carrier period (%.6g s at %.6g Hz%s): is it in "
+            "seconds (2e-6 for 2 us)?\n",
+            (double)cfg->inverter.dead_time_s, 0.5 / fpwm, fpwm,
+            cfg->pwm_hz > 0.0f ? "" : ", the sample rate");
+  } else if (strcmp(field, "timing_uncertainty_s") == 0) {
+    fprintf(stderr, "--timing-uncertainty %g s must be below one sample period (1/fs = %.6g s at %.6g Hz)\n",
+            (double)cfg->timing_uncertainty_s, 1.0 / fs, fs);
   } else if (strcmp(field, "dc_block_hz") == 0) {
     fprintf(stderr,
             "--dc-block-hz %g%s must be between 0 and fs/100 (%.6g Hz at %.6g Hz from %s): "
@@ -105,6 +122,18 @@ const char *replay_remedy(int status)
   case IMEST_REASON_RS_OUT_OF_RANGE:
     return "R_S comes out negative or huge: the voltage scale (phase-to-phase instead of "
            "phase-to-neutral?), the current scale, or --u-delay";
+  case IMEST_REASON_WIRING_MISMATCH:
+    return "the data contradict the conventions: the encoder direction, the phase order, "
+           "--pole-pairs, an electrical instead of a mechanical angle, or the units";
+  case IMEST_REASON_CONSTANTS_MISMATCH:
+    return "R_S is far from what heating explains around --rs: check --ls, --sigma and --rs";
+  case IMEST_REASON_RS_UNCERTAIN:
+    return "R_S's error bound exceeds --rs-tolerance (T_R may still be valid: see the tr_valid "
+           "column). With --voltage duty give the inverter's numbers (--dead-time, --v-switch, "
+           "--v-diode ...) and how well they are known (--inverter-uncertainty); check "
+           "--pwm-timing and --u-delay";
+  case IMEST_REASON_GAIN_MISMATCH:
+    return "the three current sensors' gains differ by more than R_S tolerates: calibrate them";
   default: return NULL;
   }
 }

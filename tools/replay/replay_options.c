@@ -17,11 +17,12 @@ static void usage(FILE *o)
   fprintf(o, "usage: imest-replay --pole-pairs N --ls HENRY --sigma VALUE [options] FILE.csv\n"
              "\n"
              "Runs a recording through the estimator exactly as firmware does and prints one\n"
-             "CSV row per window: t_end_s,T_R_s,R_S_ohm,E_I,valid,status,...\n"
+             "CSV row per window: t_end_s,T_R_s,R_S_ohm,E_I,valid,status,...,tr_valid,rs_valid,...\n"
              "FILE (\"-\" = stdin) needs a header with t,u_a,u_b,u_c,i_a,i_b,i_c,theta (any\n"
              "order; other columns ignored): t in s, phase-to-neutral V, phase currents in A\n"
              "(positive into the motor), mechanical angle in rad (wrapped or unwrapped,\n"
-             "increasing with the a-b-c field). Guide: docs/feeding-logs.md.\n"
+             "increasing with the a-b-c field). With --voltage duty it needs\n"
+             "t,d_a,d_b,d_c,v_dc,i_a,i_b,i_c,theta instead. Guide: docs/feeding-logs.md.\n"
              "Options take a value as '--opt VALUE' or '--opt=VALUE'.\n"
              "\n"
              "motor (required):\n"
@@ -33,29 +34,61 @@ static void usage(FILE *o)
              "                      unit (ms, a sample index) or too coarse (default: from t,\n"
              "                      which must then be in seconds; rounding of t to its printed\n"
              "                      decimals is tolerated)\n"
+             "voltage:\n"
+             "  --voltage phase|duty  phase: measured phase-to-neutral voltages u_a,u_b,u_c\n"
+             "                      (default); duty: the upper switches' duty cycles d_a,d_b,d_c\n"
+             "                      in [0,1], row k's applied from t_k to t_k+1, and the DC bus\n"
+             "                      v_dc [V] sampled at t_k (the library forms the voltage)\n"
+             "  --u-delay S         the voltage lags the currents by S seconds beyond what\n"
+             "                      --pwm-timing accounts for; negative: it leads; |S| <= 1/fs\n"
+             "                      (e.g. 50e-6 for phase voltages taken as the volt-seconds of\n"
+             "                      the PWM period that just ended at 10 kHz)\n"
+             "duty cycles and the inverter (--voltage duty only):\n"
+             "  --pwm-timing next|centred|last  when row k's duties apply: next = during\n"
+             "                      [t_k, t_k+1) (default: computed one ISR earlier, loaded at\n"
+             "                      the carrier valley where sample k is taken); centred =\n"
+             "                      [t_k - T/2, t_k + T/2); last = [t_k-1, t_k)\n"
+             "  --pwm-hz HZ         carrier frequency when it is faster than the sample rate\n"
+             "                      (default: the sample rate, one sample per period)\n"
+             "  --dead-time S       effective dead time, switching delays included [s]\n"
+             "  --v-switch V        switch (IGBT, MOSFET) threshold voltage [V]\n"
+             "  --r-switch OHM      switch slope resistance [ohm]\n"
+             "  --v-diode V         freewheeling diode threshold voltage [V]\n"
+             "  --r-diode OHM       diode slope resistance [ohm]\n"
+             "  --i-band A          half-width of the current band around a zero crossing in\n"
+             "                      which the error fades (default: the ripple's peak)\n"
+             "  --inverter-uncertainty X  relative uncertainty of that model's voltage error\n"
+             "                      (default 0.2 when any of --dead-time .. --i-band is\n"
+             "                      given; without them the error is unknown and R_S is not\n"
+             "                      valid; negative: unknown)\n"
              "estimator:\n"
              "  --window S          window length [s] (default 1; at least 64 samples)\n"
              "  --filter-hz HZ      front-end Butterworth-3 cut-off (default 100; needs\n"
              "                      fs > 2.5 x cut-off)\n"
              "  --aa-hz HZ          cut-off of a 2nd-order analog anti-alias filter on the\n"
              "                      electrical channels, modelled on the angle (default none)\n"
-             "  --u-delay S         the voltage samples lag the currents by S seconds, 0..1/fs\n"
-             "                      (e.g. 50e-6 for volt-seconds of the PWM period that just\n"
-             "                      ended at 10 kHz)\n"
              "  --dc-block-hz HZ    cut-off of the offset high-pass on voltages and currents\n"
              "                      (default 1; 0 = off)\n"
              "  --angle-observer-hz HZ  natural frequency of the angle observer between the\n"
-             "                      encoder and the rotation (default 0: filter-hz / 2;\n"
+             "                      encoder and the rotation (default 0: filter-hz / 4;\n"
              "                      negative: off)\n"
              "  --tr-nominal S      nominal T_R for scaling (default 0.1)\n"
              "  --tr-min S --tr-max S   admissible T_R band (default 0.001 .. 10)\n"
              "  --max-pe-k2 X       validity threshold on the relative PE index of K2 (0.1)\n"
+             "  --rs OHM            R_S at ambient temperature (data sheet, commissioning);\n"
+             "                      an R_S far from it marks the window constants_mismatch\n"
+             "                      (default 0: unknown)\n"
+             "  --rs-tolerance X    R_S is valid only if its error bound is within this,\n"
+             "                      relative (default 0.05)\n"
+             "  --timing-uncertainty S  uncertainty of the voltage/current alignment after\n"
+             "                      --pwm-timing and --u-delay [s] (default 2e-6)\n"
              "  --speed-limit RAD_S an angle step faster than this is an encoder fault\n"
              "                      (default min(3000, 2 x fs); below 3 x fs, i.e. less than\n"
              "                      pi per sample)\n"
              "  --i-limit A|auto    |phase current| at which the ADC saturates (default auto:\n"
              "                      detected from plateaus at the record's extreme; 0 = off)\n"
-             "  --u-limit V|auto    the same for the phase voltages (default auto)\n"
+             "  --u-limit V|auto    the same for measured phase voltages (default auto; not\n"
+             "                      with --voltage duty: a duty-cycle voltage has no ADC)\n"
              "  --from-rest auto|yes|no  the record starts at rest (no warm-up needed);\n"
              "                      auto = current ~0 and rotor still at the first samples\n"
              "CAN telemetry:\n"
@@ -73,46 +106,119 @@ static void usage(FILE *o)
              "message says why and what to do); 2 bad option or argument.\n");
 }
 
+/* Which input an option belongs to. */
+enum {
+  FOR_ANY = 0,     /* either voltage input */
+  FOR_DUTY = 1,    /* the duty-cycle input only */
+  FOR_INVERTER = 2 /* the duty-cycle input, and part of the inverter's error model */
+};
+
 /* The config fields set by a plain numeric option. */
 static const struct {
   const char *name, *field;
   size_t offset;
+  int use; /* FOR_* */
 } k_numeric[] = {
-    {"--window", "window_s", offsetof(imest_config_t, window_s)},
-    {"--filter-hz", "filter_hz", offsetof(imest_config_t, filter_hz)},
-    {"--aa-hz", "aa_hz", offsetof(imest_config_t, aa_hz)},
-    {"--u-delay", "u_delay_s", offsetof(imest_config_t, u_delay_s)},
-    {"--dc-block-hz", "dc_block_hz", offsetof(imest_config_t, dc_block_hz)},
-    {"--tr-nominal", "tr_nominal_s", offsetof(imest_config_t, tr_nominal_s)},
-    {"--tr-min", "tr_min_s", offsetof(imest_config_t, tr_min_s)},
-    {"--tr-max", "tr_max_s", offsetof(imest_config_t, tr_max_s)},
-    {"--max-pe-k2", "max_pe_k2_rel", offsetof(imest_config_t, max_pe_k2_rel)},
-    {"--ls", "ls_h", offsetof(imest_config_t, ls_h)},
-    {"--sigma", "sigma", offsetof(imest_config_t, sigma)},
-    {"--angle-observer-hz", "angle_observer_hz", offsetof(imest_config_t, angle_observer_hz)},
+    {"--window", "window_s", offsetof(imest_config_t, window_s), FOR_ANY},
+    {"--filter-hz", "filter_hz", offsetof(imest_config_t, filter_hz), FOR_ANY},
+    {"--aa-hz", "aa_hz", offsetof(imest_config_t, aa_hz), FOR_ANY},
+    {"--u-delay", "u_delay_s", offsetof(imest_config_t, u_delay_s), FOR_ANY},
+    {"--dc-block-hz", "dc_block_hz", offsetof(imest_config_t, dc_block_hz), FOR_ANY},
+    {"--tr-nominal", "tr_nominal_s", offsetof(imest_config_t, tr_nominal_s), FOR_ANY},
+    {"--tr-min", "tr_min_s", offsetof(imest_config_t, tr_min_s), FOR_ANY},
+    {"--tr-max", "tr_max_s", offsetof(imest_config_t, tr_max_s), FOR_ANY},
+    {"--max-pe-k2", "max_pe_k2_rel", offsetof(imest_config_t, max_pe_k2_rel), FOR_ANY},
+    {"--ls", "ls_h", offsetof(imest_config_t, ls_h), FOR_ANY},
+    {"--sigma", "sigma", offsetof(imest_config_t, sigma), FOR_ANY},
+    {"--angle-observer-hz", "angle_observer_hz", offsetof(imest_config_t, angle_observer_hz), FOR_ANY},
+    {"--rs", "rs_nominal_ohm", offsetof(imest_config_t, rs_nominal_ohm), FOR_ANY},
+    {"--rs-tolerance", "rs_tolerance", offsetof(imest_config_t, rs_tolerance), FOR_ANY},
+    {"--timing-uncertainty", "timing_uncertainty_s", offsetof(imest_config_t, timing_uncertainty_s), FOR_ANY},
+    {"--pwm-hz", "pwm_hz", offsetof(imest_config_t, pwm_hz), FOR_DUTY},
+    {"--inverter-uncertainty", "inverter.uncertainty", offsetof(imest_config_t, inverter.uncertainty),
+     FOR_DUTY},
+    {"--dead-time", "inverter.dead_time_s", offsetof(imest_config_t, inverter.dead_time_s), FOR_INVERTER},
+    {"--v-switch", "inverter.v_switch_v", offsetof(imest_config_t, inverter.v_switch_v), FOR_INVERTER},
+    {"--r-switch", "inverter.r_switch_ohm", offsetof(imest_config_t, inverter.r_switch_ohm), FOR_INVERTER},
+    {"--v-diode", "inverter.v_diode_v", offsetof(imest_config_t, inverter.v_diode_v), FOR_INVERTER},
+    {"--r-diode", "inverter.r_diode_ohm", offsetof(imest_config_t, inverter.r_diode_ohm), FOR_INVERTER},
+    {"--i-band", "inverter.i_band_a", offsetof(imest_config_t, inverter.i_band_a), FOR_INVERTER},
 };
-#define N_NUMERIC   (sizeof k_numeric / sizeof k_numeric[0])
-#define GIVEN_LS    (1u << 9)
-#define GIVEN_SIGMA (1u << 10)
+#define N_NUMERIC (sizeof k_numeric / sizeof k_numeric[0])
+_Static_assert(N_NUMERIC <= 32, "replay_opts_t.given holds one bit per numeric option");
 
-const char *replay_option_of(const replay_opts_t *o, const char *field, int *given)
+/* The relative uncertainty of an inverter model the user gave without saying
+ * how good it is: data-sheet dead times and drops are typically this close. */
+#define INVERTER_UNCERTAINTY_GIVEN 0.2f
+
+/* Whether the numeric option `name` was given. */
+static int given(const replay_opts_t *o, const char *name)
+{
+  for (size_t k = 0; k < N_NUMERIC; ++k)
+    if (strcmp(name, k_numeric[k].name) == 0) return (int)((o->given >> k) & 1u);
+  return 0;
+}
+
+const char *replay_option_of(const replay_opts_t *o, const char *field, int *is_given)
 {
   for (size_t k = 0; k < N_NUMERIC; ++k) {
     if (strcmp(field, k_numeric[k].field) == 0) {
-      *given = (o->given >> k) & 1u;
+      *is_given = (int)((o->given >> k) & 1u);
       return k_numeric[k].name;
     }
   }
   if (strcmp(field, "speed_limit_rad_s") == 0) {
-    *given = o->speed_limit > 0;
+    *is_given = o->speed_limit > 0;
     return "--speed-limit";
   }
   if (strcmp(field, "pole_pairs") == 0) {
-    *given = 1;
+    *is_given = 1;
     return "--pole-pairs";
   }
-  *given = 0;
+  if (strcmp(field, "pwm_timing") == 0) {
+    *is_given = 1;
+    return "--pwm-timing";
+  }
+  *is_given = 0;
   return NULL;
+}
+
+/* The duty-cycle input's options make no sense for measured phase voltages
+ * (they already contain the inverter's error): name the first one given. */
+static int check_input_options(const replay_opts_t *o, int pwm_timing_given)
+{
+  if (o->voltage == REPLAY_VOLTAGE_DUTY) {
+    if (o->u_limit >= 0) {
+      fprintf(stderr,
+              "%s: --u-limit applies to measured phase voltages; with --voltage duty the voltage "
+              "comes from the duty cycles and has no ADC to clip\n",
+              k_prog);
+      return TOOL_EXIT_USAGE;
+    }
+    return -1;
+  }
+  const char *opt = pwm_timing_given ? "--pwm-timing" : NULL;
+  for (size_t k = 0; opt == NULL && k < N_NUMERIC; ++k)
+    if (k_numeric[k].use != FOR_ANY && ((o->given >> k) & 1u)) opt = k_numeric[k].name;
+  if (opt == NULL) return -1;
+  fprintf(stderr,
+          "%s: %s describes the duty-cycle input: give --voltage duty with the columns "
+          "d_a,d_b,d_c,v_dc (measured phase voltages already contain the inverter's error)\n",
+          k_prog, opt);
+  return TOOL_EXIT_USAGE;
+}
+
+/* With a model of the inverter but no word on its quality: a data sheet's
+ * numbers (INVERTER_UNCERTAINTY_GIVEN); without any model the library's
+ * default stands (the error is unknown). */
+static void default_uncertainty(replay_opts_t *o)
+{
+  if (given(o, "--inverter-uncertainty")) return;
+  for (size_t k = 0; k < N_NUMERIC; ++k)
+    if (k_numeric[k].use == FOR_INVERTER && ((o->given >> k) & 1u)) {
+      o->cfg.inverter.uncertainty = INVERTER_UNCERTAINTY_GIVEN;
+      return;
+    }
 }
 
 /* "auto" or a number >= 0 (-1 stands for auto). */
@@ -142,7 +248,7 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
   o->can_id = IMEST_CAN_DEFAULT_BASE_ID;
   o->i_limit = o->u_limit = -1.0;
   o->from_rest = -1;
-  int have_np = 0, can_ext = 0;
+  int have_np = 0, can_ext = 0, pwm_timing_given = 0;
   const char *can_id = NULL;
   double d;
   tool_args_t a;
@@ -162,7 +268,7 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
     if (k < N_NUMERIC) {
       if (tool_args_number(&a, &d)) return TOOL_EXIT_USAGE;
       *(float *)(void *)((char *)&o->cfg + k_numeric[k].offset) = (float)d;
-      o->given |= 1u << k;
+      o->given |= 1ul << k;
     } else if (tool_args_is(&a, "-h") || tool_args_is(&a, "--help")) {
       usage(stdout);
       return TOOL_EXIT_OK;
@@ -174,6 +280,31 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
       }
       o->cfg.pole_pairs = (unsigned int)d;
       have_np = 1;
+    } else if (tool_args_is(&a, "--voltage")) {
+      const char *v = tool_args_value(&a);
+      if (v == NULL) return TOOL_EXIT_USAGE;
+      if (!strcmp(v, "phase"))
+        o->voltage = REPLAY_VOLTAGE_PHASE;
+      else if (!strcmp(v, "duty"))
+        o->voltage = REPLAY_VOLTAGE_DUTY;
+      else {
+        fprintf(stderr, "%s: --voltage takes phase or duty, not '%s'\n", k_prog, v);
+        return TOOL_EXIT_USAGE;
+      }
+    } else if (tool_args_is(&a, "--pwm-timing")) {
+      const char *v = tool_args_value(&a);
+      if (v == NULL) return TOOL_EXIT_USAGE;
+      if (!strcmp(v, "next"))
+        o->cfg.pwm_timing = IMEST_PWM_NEXT_PERIOD;
+      else if (!strcmp(v, "centred") || !strcmp(v, "centered"))
+        o->cfg.pwm_timing = IMEST_PWM_CENTRED;
+      else if (!strcmp(v, "last"))
+        o->cfg.pwm_timing = IMEST_PWM_LAST_PERIOD;
+      else {
+        fprintf(stderr, "%s: --pwm-timing takes next, centred or last, not '%s'\n", k_prog, v);
+        return TOOL_EXIT_USAGE;
+      }
+      pwm_timing_given = 1;
     } else if (tool_args_is(&a, "--fs")) {
       if (tool_args_number(&a, &o->fs_hz)) return TOOL_EXIT_USAGE;
       if (!(o->fs_hz > 0.0) || o->fs_hz > 1e6) {
@@ -219,7 +350,7 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
       return tool_args_unknown(&a);
     }
   }
-  if (!have_np || !(o->given & GIVEN_LS) || !(o->given & GIVEN_SIGMA)) {
+  if (!have_np || !given(o, "--ls") || !given(o, "--sigma")) {
     fprintf(stderr, "%s: --pole-pairs, --ls and --sigma are required (see --help)\n", k_prog);
     return TOOL_EXIT_USAGE;
   }
@@ -227,6 +358,9 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
     fprintf(stderr, "%s: no input file (\"-\" reads stdin; see --help)\n", k_prog);
     return TOOL_EXIT_USAGE;
   }
+  const int rc = check_input_options(o, pwm_timing_given);
+  if (rc >= 0) return rc;
+  default_uncertainty(o);
   /* the same parser as imest-monitor's --base-id (port/canid) */
   o->can_id = IMEST_CAN_DEFAULT_BASE_ID | (can_ext ? IMEST_CAN_ID_EXT : 0u);
   char err[256];

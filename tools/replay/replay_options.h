@@ -6,9 +6,16 @@
 
 #include "imest/imest.h"
 
+/* Where the phase voltage comes from (--voltage). */
+typedef enum {
+  REPLAY_VOLTAGE_PHASE = 0, /* measured phase-to-neutral voltages u_a,u_b,u_c: imest_isr_abc() */
+  REPLAY_VOLTAGE_DUTY = 1   /* duty cycles d_a,d_b,d_c and the bus v_dc: imest_isr_duty() */
+} replay_voltage_t;
+
 typedef struct {
   imest_config_t cfg;       /* motor constants and the plain numeric options */
-  unsigned int given;       /* bit k: option k of the numeric table was given */
+  unsigned long given;      /* bit k: option k of the numeric table was given */
+  replay_voltage_t voltage; /* --voltage */
   const char *path;         /* the recording, "-" = stdin */
   const char *candump_path; /* NULL = no CAN log; "-" = stdout */
   const char *can_iface;

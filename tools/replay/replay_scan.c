@@ -40,6 +40,36 @@ static void clip_feed(clip_t *c, double x)
   c->prev = x;
 }
 
+const csv_layout_t *replay_layout(replay_voltage_t voltage)
+{
+  return voltage == REPLAY_VOLTAGE_DUTY ? &CSV_DUTY : &CSV_PHASE;
+}
+
+void replay_decode(replay_voltage_t voltage, const double *v, replay_sample_t *x)
+{
+  x->t = v[0];
+  if (voltage == REPLAY_VOLTAGE_DUTY) {
+    /* the voltage a drive commands, without the zero sequence its neutral
+     * does not see (for the scan's checks; the library forms its own) */
+    const double mean = (v[1] + v[2] + v[3]) / 3.0;
+    for (int k = 0; k < 3; ++k) {
+      x->d[k] = v[1 + k];
+      x->u[k] = v[4] * (v[1 + k] - mean);
+      x->i[k] = v[5 + k];
+    }
+    x->vdc = v[4];
+    x->theta = v[8];
+  } else {
+    for (int k = 0; k < 3; ++k) {
+      x->u[k] = v[1 + k];
+      x->i[k] = v[4 + k];
+      x->d[k] = 0.0;
+    }
+    x->vdc = 0.0;
+    x->theta = v[7];
+  }
+}
+
 /* What the time column and the conventions look like over the whole file. */
 typedef struct {
   double tprev, qprev;   /* previous t and its rounding bound */
@@ -55,23 +85,44 @@ typedef struct {
   double field_rad, mech_rad; /* net rotation of the current vector, of theta */
   double i_prev[2];
   double th_prev, th_min, th_max;
-  long th_wraps; /* steps beyond +-pi: the angle wraps somewhere */
+  long th_wraps;                /* steps beyond +-pi: the angle wraps somewhere */
+  double d_min, d_max, vdc_min; /* duty input: the duties' and the bus's range */
+  long line_d_min, line_d_max, line_vdc_min;
 } tally_t;
 
-static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const double v[CSV_NEED])
+static void tally_duty(tally_t *y, const csv_reader_t *r, const replay_sample_t *x)
+{
+  for (int k = 0; k < 3; ++k) {
+    if (x->d[k] < y->d_min) {
+      y->d_min = x->d[k];
+      y->line_d_min = r->line;
+    }
+    if (x->d[k] > y->d_max) {
+      y->d_max = x->d[k];
+      y->line_d_max = r->line;
+    }
+  }
+  if (x->vdc < y->vdc_min) {
+    y->vdc_min = x->vdc;
+    y->line_vdc_min = r->line;
+  }
+}
+
+static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const replay_sample_t *x,
+                      replay_voltage_t voltage)
 {
   /* power-invariant alpha/beta of the currents: the field's direction */
-  const double ia = (2.0 * v[4] - v[5] - v[6]) / 3.0, ib = (v[5] - v[6]) / sqrt(3.0);
-  const double u2 = v[1] * v[1] + v[2] * v[2] + v[3] * v[3];
-  const double i2 = v[4] * v[4] + v[5] * v[5] + v[6] * v[6];
-  y->p_sum += v[1] * v[4] + v[2] * v[5] + v[3] * v[6];
+  const double ia = (2.0 * x->i[0] - x->i[1] - x->i[2]) / 3.0, ib = (x->i[1] - x->i[2]) / sqrt(3.0);
+  const double u2 = x->u[0] * x->u[0] + x->u[1] * x->u[1] + x->u[2] * x->u[2];
+  const double i2 = x->i[0] * x->i[0] + x->i[1] * x->i[1] + x->i[2] * x->i[2];
+  y->p_sum += x->u[0] * x->i[0] + x->u[1] * x->i[1] + x->u[2] * x->i[2];
   y->s_sum += sqrt(u2 * i2);
   if (s->n == 0) {
-    s->t0 = v[0];
-    s->i_first = fmax(fabs(v[4]), fmax(fabs(v[5]), fabs(v[6])));
-    y->th_min = y->th_max = v[7];
+    s->t0 = x->t;
+    s->i_first = fmax(fabs(x->i[0]), fmax(fabs(x->i[1]), fabs(x->i[2])));
+    y->th_min = y->th_max = x->theta;
   } else {
-    const double dt = v[0] - y->tprev, q = r->t_round + y->qprev;
+    const double dt = x->t - y->tprev, q = r->t_round + y->qprev;
     if (dt < y->dt_min) {
       y->dt_min = dt;
       y->line_min = r->line;
@@ -91,27 +142,29 @@ static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const
     if (dt == y->dt_max) y->q_worst = r->t_round;
     if (dt == 0.0 && y->repeats++ == 0) {
       y->line_repeat = r->line;
-      y->t_repeat = v[0];
+      y->t_repeat = x->t;
       y->q_repeat = r->t_round;
     }
     if (dt != 1.0) y->all_unit_steps = 0;
-    const double dth = v[7] - y->th_prev;
+    const double dth = x->theta - y->th_prev;
     if (fabs(dth) > PI) y->th_wraps++;
     y->mech_rad += wrap_pi(dth);
     if (s->n == 1) s->th_step1 = fabs(wrap_pi(dth));
     y->field_rad += atan2(y->i_prev[0] * ib - y->i_prev[1] * ia, y->i_prev[0] * ia + y->i_prev[1] * ib);
-    y->th_min = fmin(y->th_min, v[7]);
-    y->th_max = fmax(y->th_max, v[7]);
+    y->th_min = fmin(y->th_min, x->theta);
+    y->th_max = fmax(y->th_max, x->theta);
   }
   for (int k = 0; k < 3; ++k) {
-    clip_feed(&s->clip_u[k], v[1 + k]);
-    clip_feed(&s->clip_i[k], v[4 + k]);
-    s->i_max = fmax(s->i_max, fabs(v[4 + k]));
+    /* a voltage formed from duty cycles has no ADC that could clip */
+    if (voltage == REPLAY_VOLTAGE_PHASE) clip_feed(&s->clip_u[k], x->u[k]);
+    clip_feed(&s->clip_i[k], x->i[k]);
+    s->i_max = fmax(s->i_max, fabs(x->i[k]));
   }
+  if (voltage == REPLAY_VOLTAGE_DUTY) tally_duty(y, r, x);
   y->i_prev[0] = ia;
   y->i_prev[1] = ib;
-  y->th_prev = v[7];
-  y->tprev = v[0];
+  y->th_prev = x->theta;
+  y->tprev = x->t;
   y->qprev = r->t_round;
   s->n++;
 }
@@ -232,6 +285,40 @@ static int time_base_given(const char *name, const tally_t *y, replay_scan_t *s,
   return -1;
 }
 
+/* Duties are the upper switch's share of the period, in [0, 1], and the bus
+ * a positive voltage: other scales (percent, a signed modulation index, timer
+ * compare counts) would pass as a wrong voltage, so they are refused with the
+ * conversion. Rounding of the printed duties is tolerated. */
+#define DUTY_SLACK 1e-6
+static int check_duty(const tally_t *y, const char *name)
+{
+  if (y->d_min < -DUTY_SLACK) {
+    fprintf(stderr,
+            "%s: %s:%ld: a duty cycle of %.6g: duties must be the upper switch's on-time share in "
+            "[0, 1].%s\n",
+            k_prog, name, y->line_d_min, y->d_min,
+            y->d_min >= -1.0 - DUTY_SLACK && y->d_max <= 1.0 + DUTY_SLACK
+                ? " A signed modulation index m in [-1, 1] converts as d = (m + 1) / 2."
+                : " Convert the log's duty scale to [0, 1].");
+    return TOOL_EXIT_DATA;
+  }
+  if (y->d_max > 1.0 + DUTY_SLACK) {
+    fprintf(stderr,
+            "%s: %s:%ld: a duty cycle of %.6g: duties must be the upper switch's on-time share in "
+            "[0, 1].%s\n",
+            k_prog, name, y->line_d_max, y->d_max,
+            y->d_max <= 100.0 + DUTY_SLACK ? " In percent? Divide by 100."
+                                           : " Timer compare counts? Divide by the timer's period.");
+    return TOOL_EXIT_DATA;
+  }
+  if (y->vdc_min < 0.0) {
+    fprintf(stderr, "%s: %s:%ld: v_dc = %.6g V: the DC-bus voltage must be positive, in V\n", k_prog, name,
+            y->line_vdc_min, y->vdc_min);
+    return TOOL_EXIT_DATA;
+  }
+  return -1;
+}
+
 /* The quick tests of the conventions (docs/feeding-logs.md). A negative power
  * is a note (a braking drive draws it); theta turning against the field over
  * the whole record is an error: such data fit a motor with a far smaller T_R
@@ -270,17 +357,21 @@ int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s)
   y.dt_min = y.lo = INFINITY;
   y.dt_max = y.hi = -INFINITY;
   y.all_unit_steps = 1;
-  double v[CSV_NEED];
+  y.d_min = y.vdc_min = INFINITY;
+  y.d_max = -INFINITY;
+  double v[CSV_MAX_NEED];
+  replay_sample_t x;
   int rc;
   while ((rc = csv_next(r, v)) == 1) {
-    if (s->n > 0 && v[0] < y.tprev && o->fs_hz <= 0) {
+    replay_decode(o->voltage, v, &x);
+    if (s->n > 0 && x.t < y.tprev && o->fs_hz <= 0) {
       fprintf(stderr,
               "%s: %s:%ld: t = %.9g does not increase (previous %.9g): rows out of "
               "order, or a timer that wrapped (then give --fs HZ)\n",
-              k_prog, r->name, r->line, v[0], y.tprev);
+              k_prog, r->name, r->line, x.t, y.tprev);
       return TOOL_EXIT_DATA;
     }
-    tally_row(&y, s, r, v);
+    tally_row(&y, s, r, &x, o->voltage);
   }
   if (rc < 0) {
     fprintf(stderr, "%s: %s\n", k_prog, r->err);
@@ -300,5 +391,6 @@ int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s)
   rc = o->fs_hz > 0 ? time_base_given(r->name, &y, s, o->fs_hz, o->quiet)
                     : time_base_from_t(r->name, &y, s, o->quiet);
   if (rc >= 0) return rc;
+  if (o->voltage == REPLAY_VOLTAGE_DUTY && (rc = check_duty(&y, r->name)) >= 0) return rc;
   return check_conventions(&y, r->name, o->quiet);
 }

@@ -13,16 +13,31 @@ typedef struct {
   long run, plateau;
 } clip_t;
 
+/* One row of a recording, either input. */
 typedef struct {
-  long n;            /* data rows */
-  double t0, t_last; /* first and last t, in the file's unit */
-  double fs;         /* the sample rate used [Hz]: --fs, or from t */
-  double fs_t;       /* the rate t implies if it is in seconds [Hz] */
-  double t_unit_s;   /* seconds per unit of t (1 unless --fs says otherwise) */
-  int t_rounded;     /* t's steps vary only by its printed rounding */
-  clip_t clip_i[3], clip_u[3];
-  double i_first, i_max; /* for the at-rest test */
-  double th_step1;       /* |first angle step| [rad] */
+  double t;
+  double u[3];      /* phase-to-neutral voltage [V]: measured, or v_dc (d - mean d) of the duties */
+  double d[3], vdc; /* duty input: the upper switches' duties (row k: [t_k, t_k+1)), bus [V] */
+  double i[3];      /* phase currents [A] */
+  double theta;     /* mechanical angle [rad] */
+} replay_sample_t;
+
+/* A row as csv_next() returned it (the layout of `voltage`) into *x. */
+void replay_decode(replay_voltage_t voltage, const double *v, replay_sample_t *x);
+
+/* The CSV columns of an input. */
+const csv_layout_t *replay_layout(replay_voltage_t voltage);
+
+typedef struct {
+  long n;                      /* data rows */
+  double t0, t_last;           /* first and last t, in the file's unit */
+  double fs;                   /* the sample rate used [Hz]: --fs, or from t */
+  double fs_t;                 /* the rate t implies if it is in seconds [Hz] */
+  double t_unit_s;             /* seconds per unit of t (1 unless --fs says otherwise) */
+  int t_rounded;               /* t's steps vary only by its printed rounding */
+  clip_t clip_i[3], clip_u[3]; /* clip_u: measured phase voltages only */
+  double i_first, i_max;       /* for the at-rest test */
+  double th_step1;             /* |first angle step| [rad] */
 } replay_scan_t;
 
 /* Reads the whole file once. Returns -1 to go on, or the exit code after a

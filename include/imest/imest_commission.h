@@ -1,0 +1,472 @@
+/**
+ * @file imest_commission.h
+ * @brief imest self-commissioning: identifies, on the drive and before normal
+ *        operation, the constants the estimator needs (R_S, sigma*L_S, L_S,
+ *        sigma, n_p, the inverter's voltage error) and checks the wiring
+ *        (current channels, encoder direction and counts, phase order).
+ *
+ * The routine is a state machine the firmware calls once per sample from its
+ * PWM-synchronous ISR, in place of its own controller. It reads the phase
+ * currents, the DC bus and the encoder angle and returns the three duty cycles
+ * for the next PWM period. Fitting runs in a background call. Nothing is
+ * allocated; the instance is caller-owned (about 4 KiB, needed only while
+ * commissioning: it may share memory with the estimator's instance).
+ *
+ * Usage:
+ *
+ *     imest_comm_config_t cc;
+ *     imest_comm_config_default(&cc);
+ *     cc.fs_hz = 8000.0f;  cc.i_max_a = 11.6f;          // peak phase current allowed
+ *     cc.allow_rotation = 1;                             // the shaft may turn (no load)
+ *     cc.rated_voltage_v = 400.0f; cc.rated_freq_hz = 50.0f; cc.rated_speed_rpm = 1441.0f;
+ *     cc.encoder_cpr = 4096.0f;                          // what the firmware assumes
+ *     static imest_comm_t comm;
+ *     if (imest_comm_init(&comm, &cc) != IMEST_OK) { imest_comm_config_check() names the field }
+ *
+ *     // PWM ISR, once per sample, instead of the controller:
+ *     float d[3];
+ *     if (imest_comm_isr(&comm, i_abc_a, vdc_v, theta_rad, d) == 1) load_shadow_registers(d);
+ *     else disable_pwm_outputs();                         // finished, failed or aborted
+ *
+ *     // background task (any lower priority), as often as convenient (>= every 10 ms):
+ *     (void)imest_comm_background(&comm);
+ *
+ *     // when imest_comm_status() says DONE:
+ *     imest_comm_result_t r;  imest_comm_result(&comm, &r);
+ *     imest_config_t cfg; imest_config_default(&cfg); cfg.fs_hz = ...;
+ *     imest_comm_apply(&r, &cfg);                         // pole_pairs, ls_h, sigma, rs_nominal_ohm,
+ *                                                         // tr_nominal_s, inverter
+ *     // and apply r.encoder_dir / r.encoder_cpr in the firmware's angle computation
+ *
+ * What the firmware must provide:
+ *   - the three phase currents [A], positive into the motor, from three sensors (or two, with
+ *     i_c = -i_a - i_b: then the gain mismatch is not observable), sampled at the carrier valley
+ *     (the centre of the zero vector, as for current control);
+ *   - the DC-bus voltage [V] sampled at the same instant;
+ *   - the mechanical angle [rad] as the firmware computes it from its encoder with the counts per
+ *     revolution it assumes (cc.encoder_cpr), wrapped or not;
+ *   - the duties (upper switch on-time / period, centre-aligned PWM) returned by call k must be
+ *     applied during the PWM period(s) that start at the next sample, k+1 (the usual scheme:
+ *     written to the shadow registers, loaded at the next valley); cc.pwm_hz is the carrier
+ *     (one or more periods per sample). The dead time must be the inverter's own, not compensated
+ *     by the firmware: the routine measures it;
+ *   - an ISR at a fixed rate cc.fs_hz, a background call at least every 10 ms (it does the
+ *     fitting; the ISR waits for it at a few points, at most 10 s), and a motor at rest, free to turn
+ *     if cc.allow_rotation (no load coupled, or only a small one).
+ *
+ * The sequence (durations for the motors of the README's table: 0.4 kW to 37 kW):
+ *   1. Offsets (0.25 s): zero voltage (all duties 0.5); the mean currents are the sensors'
+ *      offsets, subtracted from here on. Fails if a current flows (> 5 % of i_max_a).
+ *   2. Wiring (< 0.2 s): short bipolar voltage pulses along the a, b and c axes, doubled until
+ *      the current responds; the 3x3 response says which channel reads which leg and with which
+ *      sign, and whether a phase is open. A rough sigma*L_S sets the current controller.
+ *   3. Time constant (0.1 .. 8 s, about 3 T_R): a DC current on the a axis; the decay of the
+ *      voltage as the rotor flux builds gives T_R, which sets the length of what follows.
+ *   4. For each axis a, b, c: a DC current staircase 1/3, 2/3, 1, 2/3, 1/3 of level_frac * i_max_a,
+ *      each plateau about 3 T_R long, under PI current control. Within each plateau the
+ *      modulation alternates between three patterns with the same voltage: centred (every leg
+ *      switches), lower-clamped (the two return legs' lower switches stay on) and upper-clamped.
+ *      Clamped legs do not switch, so they lose no dead time and conduct one device type only.
+ *      Then, at 1/3 level, a square-wave voltage (fs/8) on top of the DC current (0.2 s): the
+ *      current's slope gives sigma*L_S. Then zero current until the rotor flux has decayed.
+ *   5. With cc.allow_rotation only: a current-fed rotating field at the rated magnetising
+ *      current (rated V/f flux with the standstill L_S), the identified inverter model as
+ *      feed-forward: magnetise on the a axis (1 s + 3 T_R), ramp to speed_frac of rated
+ *      frequency (ramp_s), settle (1 s + 3 T_R), measure (>= 1 s, whole electrical periods),
+ *      ramp down. (A voltage-fed V/f run oscillates at no load on a low-inertia motor.)
+ *   The routine ends with zero voltage; its ISR call then returns 0 and the background call
+ *   completes the result. Measured totals: 8.4 s at standstill for a 4 kW motor (T_R 128 ms),
+ *   30 s for 37 kW (T_R 553 ms), plus 8 to 10.5 s of rotation (README, Commissioning).
+ *
+ * What is measured, and how (per axis, then combined; the spread between the three axes is
+ * reported as a quality figure for each quantity):
+ *   - R_S: slope of the plateau voltage against current, fitted per axis with a model of the
+ *     flux tail (V = V_inf + A_p exp(-t/T_R) on each plateau, T_R shared), so the plateaus need
+ *     not settle; the three patterns share R. A resistance in series with every leg cannot be
+ *     told from R_S by any terminal measurement: the common part of the switch and diode slope
+ *     resistances, min(r_sw, r_d), and the cables are in the identified R_S (subtract a known
+ *     value with cc.r_series_ohm). That is also what the online estimator sees.
+ *   - the inverter's voltage error (imest_inverter_t): the centred pattern loses twice the dead
+ *     time per period along the axis (both legs switch), a clamped pattern once, and both have
+ *     one switch and one diode drop in the loop: the difference gives the dead time, the rest the
+ *     sum of the threshold voltages (split evenly between switch and diode: their difference
+ *     enters only with the active-vector share, ~2 % at standstill, and is not separable); the
+ *     upper- and lower-clamped patterns put the switch and the diode in the loop with different
+ *     currents, which separates r_sw - r_d. i_band_a is the PWM current ripple's peak,
+ *     V_dc / (8 sigma L_S f_pwm), computed, not measured (at standstill the ripple is tiny).
+ *   - current-sensor gains (three sensors): the motor's neutral floats, so the true currents sum
+ *     to zero; the measured sum against the axis current gives each sensor's gain relative to
+ *     the mean of the three (a common gain error is not observable: it scales R_S and L_S).
+ *   - sigma*L_S: the current's response to the square wave (regression of the current step per
+ *     period on the applied voltage, the current and a constant).
+ *   - T_R: the flux tail's time constant (reported; fills tr_nominal_s). L_S at standstill:
+ *     sigma*L_S plus (1-sigma)L_S from the tail amplitudes at the current steps (used only when
+ *     the shaft may not turn).
+ *   - L_S (rotating): reactive part of the impedance at the field's frequency, from the commanded
+ *     voltage (the inverter error compensated by its model) and the current, demodulated at the
+ *     commanded angle; at no load the slip is ~1e-4, and is corrected for.
+ *   - n_p, encoder direction and counts: the ratio of the commanded electrical frequency to the
+ *     measured mechanical speed is dir * n_p * cpr_assumed / cpr_true. With cc.rated_speed_rpm,
+ *     n_p = floor(60 f_rated / n_rated) (the nameplate is the only independent evidence: a
+ *     4-pole motor with a 2048-count encoder looks exactly like a 2-pole motor with 4096), and the
+ *     ratio gives the true counts per revolution. Without it, the firmware's counts are assumed
+ *     right and n_p is the ratio rounded; a ratio more than 2 % from an integer fails with
+ *     IMEST_COMM_REASON_POLE_PAIRS_AMBIGUOUS. The direction is the ratio's sign: -1 means the
+ *     angle decreases while the field turns a-b-c (negate it, or swap two motor phases).
+ *   - phase order: the wiring pulses (standstill) and, rotating, the current's negative-sequence
+ *     share (a swapped pair of current channels makes the measured current turn backwards).
+ *
+ * Accuracy (closed loop on the simulator: 12-bit sensors with offsets and +-1 % gain mismatch,
+ * 4096-count encoder, 2 us dead time, 1 V / 0.8 V drops with slopes; README, Commissioning, for
+ * the table per motor, 0.4 to 37 kW): R_S within 0.15 % of the identifiable value (winding plus
+ * the devices' common slope resistance), L_S within 0.1 % rotating (0.1 % standstill), sigma
+ * within 0.25 %, T_R within 0.2 %, dead time within 2 ns, the inverter's per-leg voltage error
+ * within 0.1 V where the switch and diode thresholds differ by 0.2 V (the part standstill cannot
+ * see; the rest of the model is right to a few mV).
+ *
+ * Limits: the current never exceeds i_max_a in any phase (the routine stops with
+ * IMEST_COMM_REASON_OVERCURRENT if it does: the firmware's own protection stays in charge); the
+ * phase voltage stays below v_max_v and the bus; the whole run stops after time_max_s. Every call
+ * is bounded: the ISR call has no data-dependent loop (a few hundred instructions, fw/README.md);
+ * the background's fits have fixed iteration counts.
+ *
+ * Concurrency: imest_comm_isr() from one context, imest_comm_background() from one other of
+ * lower priority (or the same one); imest_comm_abort() and the read-only calls from anywhere.
+ * The ISR hands blocks of sums to the background through counters, as the estimator does
+ * (IMEST_BARRIER).
+ */
+#ifndef IMEST_IMEST_COMMISSION_H
+#define IMEST_IMEST_COMMISSION_H
+
+#include <stdint.h>
+
+#include "imest/imest.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ----------------------------------------------------------------------------
+ * Configuration
+ * ------------------------------------------------------------------------- */
+
+/** Commissioning configuration. Fill with imest_comm_config_default(), then set at least fs_hz
+ *  and i_max_a (and the rated values for the rotating part). */
+typedef struct {
+  float fs_hz;  /**< rate of the ISR call [Hz] (default 8000) */
+  float pwm_hz; /**< carrier frequency [Hz]; a multiple of fs_hz (default 0: = fs_hz) */
+  /** largest phase current the routine may reach, peak [A] (required; e.g. sqrt(2) x rated rms).
+   *  The DC staircase goes up to level_frac of it; beyond it the routine stops. */
+  float i_max_a;
+  float level_frac;       /**< top of the DC staircase as a fraction of i_max_a (default 0.8) */
+  float v_max_v;          /**< largest phase voltage amplitude commanded [V] (default 0: the bus) */
+  float time_max_s;       /**< the whole run stops after this [s] (default 300) */
+  float tr_max_s;         /**< longest rotor time constant to expect [s] (default 3) */
+  unsigned int n_sensors; /**< current sensors: 3, or 2 (i_c computed by the firmware) (default 3) */
+  /** counts per mechanical revolution the firmware assumes when it computes theta (0: not
+   *  given; the result then reports the ratio only) */
+  float encoder_cpr;
+  /** known resistance in series with each phase that should not count as R_S [ohm]: cables, or the
+   *  common part of the switch and diode slope resistances from a data sheet (default 0) */
+  float r_series_ohm;
+  /** PWM layout: nonzero (default) if the upper switches' on-time is centred on the sample
+   *  instant (output high while the up-down counter is below the compare value, sample at the
+   *  counter's zero; the simulator's layout); 0 if the lower switches' on-time is (high while
+   *  above). One clamped pattern then has its sample inside the active pulse, which the dead
+   *  time shifts by half its length: the routine corrects for it. */
+  int pwm_on_centred;
+
+  /* Rotating part. */
+  int allow_rotation;    /**< nonzero: the shaft may turn, at no load (default 0: standstill only) */
+  float rated_voltage_v; /**< rated line-to-line rms voltage [V] (required for rotation) */
+  float rated_freq_hz;   /**< rated frequency [Hz] (required for rotation) */
+  /** rated speed [rpm] from the nameplate (0: unknown): n_p = floor(60 f_rated / n_rated), and
+   *  the encoder counts are then checked, not assumed */
+  float rated_speed_rpm;
+  float speed_frac; /**< speed of the rotating run as a fraction of rated (default 0.4) */
+  float ramp_s;     /**< frequency ramp time up and down [s] (default 2) */
+} imest_comm_config_t;
+
+/** Fill with defaults (fs 8 kHz, level 0.8, 300 s, standstill only; i_max_a must be set). */
+void imest_comm_config_default(imest_comm_config_t *cc);
+
+/** Check a commissioning config.
+ *  @param field  optional: receives the name of the first bad field (NULL if none)
+ *  @retval IMEST_OK          usable
+ *  @retval IMEST_ERR_NULL    cc is NULL
+ *  @retval IMEST_ERR_CONFIG  a field is out of range (*field names it) */
+int imest_comm_config_check(const imest_comm_config_t *cc, const char **field);
+
+/* ----------------------------------------------------------------------------
+ * Progress and result
+ * ------------------------------------------------------------------------- */
+
+/** State of a run. */
+typedef enum {
+  IMEST_COMM_IDLE = 0,      /**< initialised, no sample yet */
+  IMEST_COMM_RUNNING = 1,   /**< commanding the inverter (imest_comm_isr returns 1) */
+  IMEST_COMM_COMPUTING = 2, /**< finished commanding; the background completes the result */
+  IMEST_COMM_DONE = 3,      /**< result complete (check its flags and qualities) */
+  IMEST_COMM_FAILED = 4,    /**< stopped: imest_comm_result_t.reason says why */
+  IMEST_COMM_ABORTED = 5    /**< stopped by imest_comm_abort() */
+} imest_comm_state_t;
+
+/** The stage being run (progress). */
+typedef enum {
+  IMEST_COMM_STAGE_OFFSETS = 0,
+  IMEST_COMM_STAGE_WIRING = 1,
+  IMEST_COMM_STAGE_TIME_CONSTANT = 2,
+  IMEST_COMM_STAGE_STAIRCASE = 3, /**< DC current staircase with the three modulation patterns */
+  IMEST_COMM_STAGE_PULSES = 4,    /**< square-wave voltage for sigma*L_S */
+  IMEST_COMM_STAGE_DEMAGNETISE = 5,
+  IMEST_COMM_STAGE_ROTATE = 6, /**< rotating field: magnetise, ramp, settle, measure, ramp down */
+  IMEST_COMM_STAGE_END = 7
+} imest_comm_stage_t;
+
+/** Why a run failed (imest_comm_result_t.reason). Stable values. */
+typedef enum {
+  IMEST_COMM_REASON_NONE = 0,
+  IMEST_COMM_REASON_ABORTED = 1,         /**< imest_comm_abort() */
+  IMEST_COMM_REASON_INPUT_FAULT = 2,     /**< a non-finite sample, or the bus voltage absent or moving */
+  IMEST_COMM_REASON_OVERCURRENT = 3,     /**< a phase current beyond i_max_a */
+  IMEST_COMM_REASON_CURRENT_AT_REST = 4, /**< current flows at zero voltage: offsets beyond 5 % of i_max_a */
+  IMEST_COMM_REASON_OPEN_PHASE = 5,      /**< an axis draws no current: open phase, motor not connected */
+  /** the current channels do not match the legs (permuted or reversed): details in
+   *  imest_comm_result_t.wiring_map */
+  IMEST_COMM_REASON_WIRING = 6,
+  IMEST_COMM_REASON_CURRENT_NOT_REACHED = 7, /**< the voltage limit is reached before the current level */
+  IMEST_COMM_REASON_ROTOR_MOVED = 8,         /**< the rotor turned during the standstill tests */
+  IMEST_COMM_REASON_TIMEOUT = 9,             /**< time_max_s reached */
+  IMEST_COMM_REASON_BACKGROUND = 10,         /**< imest_comm_background() not called in time */
+  IMEST_COMM_REASON_FIT = 11,                /**< a fit failed (no decay, singular, residual) */
+  IMEST_COMM_REASON_IMPLAUSIBLE = 12,        /**< identified values outside physical ranges */
+  IMEST_COMM_REASON_ENCODER_STILL = 13, /**< the motor turned (by its currents) but the angle did not move */
+  IMEST_COMM_REASON_ROTOR_BLOCKED = 14, /**< the field turned but the rotor did not */
+  IMEST_COMM_REASON_PHASE_ORDER = 15,   /**< the measured current turns against the commanded field */
+  /** the speed ratio fits no integer n_p with the firmware's counts, and no rated speed was given */
+  IMEST_COMM_REASON_POLE_PAIRS_AMBIGUOUS = 16,
+  IMEST_COMM_REASON_CURRENT_LIMIT_ROTATING = 17 /**< the rotating run needs more than i_max_a */
+} imest_comm_reason_t;
+
+/** Short lower-case names ("none", "overcurrent", ...; "offsets", "staircase", ...). */
+const char *imest_comm_reason_name(int reason);
+const char *imest_comm_stage_name(int stage);
+const char *imest_comm_state_name(int state);
+
+/** Result flags (imest_comm_result_t.flags): what the result holds and what to watch. */
+#define IMEST_COMM_FLAG_STANDSTILL    0x0001u /**< the standstill part completed */
+#define IMEST_COMM_FLAG_ROTATED       0x0002u /**< the rotating part completed (L_S, n_p, encoder) */
+#define IMEST_COMM_FLAG_GAINS         0x0004u /**< sensor gains identified (three sensors) */
+#define IMEST_COMM_FLAG_LS_STANDSTILL 0x0008u /**< L_S and sigma from standstill only (less accurate) */
+#define IMEST_COMM_FLAG_NP_NAMEPLATE  0x0010u /**< n_p from the rated speed; encoder counts measured */
+#define IMEST_COMM_FLAG_NP_ASSUMED_CPR                                                                       \
+  0x0020u /**< n_p from the speed ratio with the firmware's counts assumed right */
+#define IMEST_COMM_FLAG_ENCODER_REVERSED 0x0040u /**< the angle decreases with the a-b-c field */
+#define IMEST_COMM_FLAG_CPR_MISMATCH     0x0080u /**< the encoder counts differ from encoder_cpr */
+#define IMEST_COMM_FLAG_AXIS_SPREAD      0x0100u /**< R_S or sigma*L_S differ by > 3 % between axes */
+#define IMEST_COMM_FLAG_ROTOR_CREPT                                                                          \
+  0x0200u /**< the rotor moved at standstill, by more than 0.01 rad (the stop is at 1 rad) */
+#define IMEST_COMM_FLAG_LOAD_ON_SHAFT   0x0400u /**< slip x T_R > 0.05 while rotating: not at no load */
+#define IMEST_COMM_FLAG_GAIN_MISMATCH   0x0800u /**< sensor gains differ by more than 0.5 % */
+/** dead time and threshold voltages not separable (the clamped patterns' pulses were too short):
+ *  the whole error is in dead_time_s */
+#define IMEST_COMM_FLAG_INVERTER_LUMPED 0x1000u
+
+/** One identified value with its quality. */
+typedef struct {
+  float value;      /**< the estimate (NaN if not identified) */
+  float std_rel;    /**< relative standard error from the fit's residuals (NaN if not known) */
+  float spread_rel; /**< (max - min) / mean over the three axes (NaN if not per axis) */
+} imest_comm_value_t;
+
+/** Result of a run. Every quantity carries its quality; `valid` says whether the result as a
+ *  whole may fill a config (imest_comm_apply). */
+typedef struct {
+  int state;          /**< imest_comm_state_t */
+  int reason;         /**< imest_comm_reason_t: why it failed (NONE if not) */
+  int stage;          /**< imest_comm_stage_t reached (where it failed, if it did) */
+  int valid;          /**< 1: DONE and every identified value plausible */
+  unsigned int flags; /**< IMEST_COMM_FLAG_* */
+  float time_s;       /**< duration of the run so far [s] */
+  float i_peak_a;     /**< largest phase current seen [A] */
+  float vdc_v;        /**< mean DC-bus voltage at the offsets stage [V] */
+
+  /* current sensors */
+  float i_offset_a[3]; /**< offsets (subtracted by the routine; the firmware should too) */
+  float i_gain_rel[3]; /**< gain of each sensor relative to the mean of the three (1 if unknown) */
+  /** channel read for each leg (0..2) times the sign (+1/-1), encoded as (channel + 1) * sign;
+   *  {1, 2, 3} when the wiring is right */
+  int wiring_map[3];
+
+  /* standstill */
+  imest_comm_value_t rs_ohm;          /**< stator resistance (incl. min(r_sw, r_d), minus r_series_ohm) */
+  float rs_axis_ohm[3];               /**< R_S per axis (gain corrected) */
+  imest_comm_value_t sigma_ls_h;      /**< transient inductance sigma*L_S [H] */
+  imest_comm_value_t tr_s;            /**< rotor time constant from the flux tails [s] */
+  imest_comm_value_t rr_ohm;          /**< rotor resistance referred to the stator, (1-sigma)L_S/T_R [ohm] */
+  imest_comm_value_t ls_standstill_h; /**< L_S from the standstill flux tails [H] */
+  imest_inverter_t inverter;          /**< the inverter's voltage error model (incl. i_band_a, uncertainty) */
+  imest_comm_value_t dead_time_s;     /**< dead time with its quality (also in inverter) */
+  imest_comm_value_t v_threshold_v;   /**< (V_sw0 + V_d0) / 2 [V] */
+  imest_comm_value_t dr_ohm;          /**< r_sw - r_d [ohm] */
+  float dc_fit_rms_v;                 /**< rms residual of the plateau fits [V] */
+  float rotor_moved_rad;              /**< largest angle change during the standstill part [rad] */
+
+  /* rotating */
+  imest_comm_value_t ls_h;  /**< stator inductance L_S [H] (rotating; else standstill) */
+  imest_comm_value_t sigma; /**< total leakage factor sigma_L_S / L_S */
+  unsigned int pole_pairs;  /**< n_p (0 if not identified) */
+  int encoder_dir;          /**< +1: the angle increases with the a-b-c field; -1: reversed; 0: unknown */
+  float encoder_cpr;        /**< true counts per revolution (NaN if encoder_cpr not given) */
+  float speed_ratio;        /**< commanded electrical / measured mechanical speed (signed) */
+  float slip;               /**< slip of the rotating run (no load: ~1e-4) */
+  float neg_seq_rel;        /**< |negative-sequence current| / |positive|, rotating (wiring check) */
+  float rotating_r_ohm;     /**< resistive part of the impedance rotating (R_S + losses) [ohm] */
+  float rotating_i_a;       /**< magnetising current of the rotating run (alpha/beta amplitude) [A] */
+  float rotating_f_hz;      /**< electrical frequency of the rotating run [Hz] */
+} imest_comm_result_t;
+
+/** Progress, readable from any context. */
+typedef struct {
+  int state;         /**< imest_comm_state_t */
+  int stage;         /**< imest_comm_stage_t */
+  int reason;        /**< imest_comm_reason_t (NONE while running) */
+  unsigned int axis; /**< axis of the staircase (0..2) */
+  float time_s;      /**< elapsed [s] */
+  float progress;    /**< 0..1, estimated */
+} imest_comm_status_t;
+
+/* ----------------------------------------------------------------------------
+ * Instance (caller-owned; every field is private)
+ * ------------------------------------------------------------------------- */
+
+#define IMEST_COMM_NSUM 9  /**< sums per block */
+#define IMEST_COMM_NBLK 56 /**< blocks of one axis (5 plateaus x 9 + 8 square-wave) or of the probe */
+
+/** One block of samples in one state, handed from the ISR to the background. */
+typedef struct {
+  uint32_t k0;  /**< index of its first sample */
+  uint32_t n;   /**< samples summed */
+  uint32_t tag; /**< kind, plateau and pattern */
+  float s[IMEST_COMM_NSUM];
+} imest_comm_block_t;
+
+/** Per-axis fit (background). */
+typedef struct {
+  double r_ohm, r_std, td_s, td_std, vth_v, vth_std, dr_ohm, dr_std;
+  double tau_s, tau_std, lm_h, slsig_h, slsig_std, rhf_ohm, gain_dev, rms_v, i_top_a;
+  int ok, separable;
+} imest_comm_axis_fit_t;
+
+/** Commissioning instance. */
+typedef struct {
+  /* configuration and derived constants */
+  imest_comm_config_t cfg;
+  float ts_s, fpwm, i_trip, v_lim, wc, kp, ki, level_a, tau;
+  uint32_t n_off, n_disc_level, n_disc_pattern, n_blk, n_hf_half, n_hf_blk, n_zero, n_max;
+  uint32_t n_ramp, n_settle, n_meas;
+
+  /* ISR state */
+  uint32_t k;     /* samples since start */
+  uint32_t stage; /* imest_comm_stage_t */
+  uint32_t step;  /* sub-step within the stage */
+  uint32_t cnt;   /* samples in the sub-step or block */
+  uint32_t axis;  /* 0..2 */
+  uint32_t plateau, block, posted, probe_k0, wait, lim_cnt, cnt_demag;
+  float off[3];    /* current offsets */
+  float ginv[3];   /* 1 / relative gains (after the standstill part) */
+  float vdc0;      /* bus at the offsets stage */
+  float d_app[3];  /* duties applied during the present period */
+  float d_next[3]; /* duties returned at the last call (applied from the next sample) */
+  float v_app;     /* axis voltage applied during the present period */
+  float i_prev;    /* axis current at the last sample */
+  float i_ref, i_ref_old, integ[3], step_area, i_mag;
+  float sl_rough;             /* sigma*L_S the controller is tuned with [H] */
+  float v_hf;                 /* square-wave amplitude */
+  float th0, th_prev, th_dev; /* encoder */
+  int32_t wraps;
+  float i_peak;
+  float acc_m[3], acc_m2[3], acc_vdc;
+  float pulse_v, pulse_resp[3][3], pulse_vk[3], pulse_ik[3];
+  uint32_t pulse_n, pulse_tries, pulse_nk[3];
+  imest_comm_block_t cur; /* block being accumulated */
+  /* rotation */
+  float we, we_test, psi, psi_im, ls_ss, rs_ff, ph_c, ph_s, if_d, if_q;
+  float rot_sum[10]; /* I_sync d/q, I_neg d/q, U d/q, |i|^2, n, w_e, samples limited */
+  float rot_th0, rot_th1;
+  int32_t rot_w0, rot_wraps;
+  float inv_td_f, inv_v, inv_rsw, inv_rd, inv_band; /* inverter feed-forward model */
+
+  /* hand-off */
+  imest_comm_block_t blk[IMEST_COMM_NBLK];
+  volatile uint32_t nblk;     /* blocks written (ISR) */
+  volatile uint32_t job;      /* jobs posted (ISR) */
+  volatile uint32_t job_kind; /* what to do (ISR) */
+  volatile uint32_t job_nblk; /* blocks of the job (ISR) */
+  volatile uint32_t done;     /* jobs done (background) */
+  volatile uint32_t abort_req;
+  volatile int state, reason;
+
+  /* background results (the ISR reads them once their job is done) */
+  float bg_tau, bg_sl, bg_ginv[3];
+  int bg_tau_ok, bg_fail, final_ready, final_fail;
+  imest_comm_axis_fit_t fit[3];
+  imest_comm_result_t res;
+} imest_comm_t;
+
+/* ----------------------------------------------------------------------------
+ * API
+ * ------------------------------------------------------------------------- */
+
+/** Initialise (config checked). Not concurrently with the other calls.
+ *  @retval IMEST_OK, IMEST_ERR_NULL, IMEST_ERR_CONFIG (imest_comm_config_check() names the field) */
+int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc);
+
+/**
+ * ISR call, once per sample. Bounded, no data-dependent loop.
+ * @param i_abc_a   phase currents [A], positive into the motor (as sampled, offsets included)
+ * @param vdc_v     DC-bus voltage sampled now [V]
+ * @param theta_rad mechanical angle [rad] as the firmware computes it (encoder_cpr assumed)
+ * @param duty_abc  out: upper-switch duties in [0, 1] for the period(s) starting at the next
+ *                  sample; 0.5 each when the return value is not 1
+ * @retval 1               running: apply duty_abc
+ * @retval 0               not commanding (finished, failed or aborted): disable the PWM outputs
+ * @retval IMEST_ERR_NULL  a pointer is NULL
+ */
+int imest_comm_isr(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float theta_rad, float duty_abc[3]);
+
+/**
+ * Background call: runs the fits the ISR has handed over. Call it at least every 10 ms while
+ * the state is RUNNING or COMPUTING. Bounded (fixed iteration counts).
+ * @retval 1               a fit was done
+ * @retval 0               nothing to do
+ * @retval IMEST_ERR_NULL  c is NULL
+ */
+int imest_comm_background(imest_comm_t *c);
+
+/** Stop at the next ISR call (zero voltage, state ABORTED). Any context.
+ *  @retval IMEST_OK, IMEST_ERR_NULL */
+int imest_comm_abort(imest_comm_t *c);
+
+/** Progress. @retval IMEST_OK, IMEST_ERR_NULL */
+int imest_comm_status(const imest_comm_t *c, imest_comm_status_t *st);
+
+/** The result (complete when the state is DONE; partial otherwise, with the failure reason).
+ *  @retval IMEST_OK, IMEST_ERR_NULL */
+int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r);
+
+/**
+ * Fill an estimator config from a result: pole_pairs, ls_h, sigma, rs_nominal_ohm, tr_nominal_s
+ * and inverter (with i_band_a and uncertainty) - each only if the result holds it. The sample
+ * rate, window and the other fields stay as they are; set pwm_hz to the carrier.
+ * @return the number of fields filled (0..6), or
+ * @retval IMEST_ERR_NULL  a pointer is NULL
+ * @retval IMEST_ERR_ARG   the result is not valid (r->valid == 0): nothing filled
+ */
+int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* IMEST_IMEST_COMMISSION_H */

@@ -1,0 +1,206 @@
+/* Background stage: the bias that white sensor noise puts into the window
+ * sums, and its removal (bias-compensated least squares, docs/METHOD.md §16).
+ *
+ * Noise inside the regressor (the derivatives of the currents above all) adds
+ * its covariance to R_W, R_Wy and R_y: E(K) gains K' Sigma K, which is least
+ * for a small T_R, so the minimum moves (paper motor, 25 % load, 1 LSB of
+ * noise: T_R +2 %, R_S -5 %). The covariance follows from the noise level and
+ * the front end's known transfer functions: white noise of variance v per
+ * alpha/beta axis stays white of variance v per rotor-frame axis after the
+ * rotation, and the filter and the central differences give (x, dx, d2x) the
+ * covariance v G (bg_noise_gains). Each regressor column is a linear function
+ * of that noise with coefficients in n_p w (acceleration neglected: the
+ * compensation is for steady operation, where the bias matters). The noise
+ * level itself comes from the window: the squared third differences of
+ * i_alpha and u_alpha that the ISR sums. The bias matrix is formed in float32
+ * (a 1e-7 error of a correction is nothing); the subtraction in float64. */
+#include <math.h>
+
+#include "bg_noise.h"
+#include "isr_accumulate.h"
+
+/* x_f[n] of the Butterworth-3 (as isr_bw3, in float64) for an input x. */
+typedef struct {
+  double s1, s2a, s2b;
+} bw3_state_t;
+
+static double bw3_step(const imest_bw3_t *f, bw3_state_t *c, double x)
+{
+  const double t = (double)f->b0 * x, v = t + c->s1;
+  c->s1 = t - (double)f->a1 * v;
+  const double t2 = (double)f->c0 * v, y = t2 + c->s2a;
+  c->s2a = (t2 + t2) - (double)f->d1 * y + c->s2b;
+  c->s2b = t2 - (double)f->d2 * y;
+  return y;
+}
+
+void bg_noise_gains(const imest_bw3_t *bw, double fs, float g[6])
+{
+  bw3_state_t c = {0.0, 0.0, 0.0};
+  double y1 = 0.0, y2 = 0.0, peak = 0.0;
+  double gxx = 0.0, gxd = 0.0, gxdd = 0.0, gdd = 0.0, gddd = 0.0, gd2 = 0.0;
+  for (uint32_t n = 0; n < 65536u; ++n) {
+    const double y0 = bw3_step(bw, &c, n == 0u ? 1.0 : 0.0);
+    const double x = y1, dx = (y0 - y2) * 0.5 * fs, d2x = ((y0 - y1) - (y1 - y2)) * fs * fs;
+    gxx += x * x;
+    gxd += x * dx;
+    gxdd += x * d2x;
+    gdd += dx * dx;
+    gddd += dx * d2x;
+    gd2 += d2x * d2x;
+    y2 = y1;
+    y1 = y0;
+    peak = fmax(peak, fabs(y0));
+    /* the response has decayed far below float32 resolution of the sums */
+    if (n > 16u && fabs(y0) + fabs(y2) < 1e-10 * peak && fabs(c.s1) + fabs(c.s2a) < 1e-10 * peak) break;
+  }
+  g[0] = (float)gxx;
+  g[1] = (float)gxd;
+  g[2] = (float)gxdd;
+  g[3] = (float)gdd;
+  g[4] = (float)gddd;
+  g[5] = (float)gd2;
+}
+
+/* A regressor column's noise coefficients in one row (x): on the row's own
+ * current (i, di, d2i), the other row's current, the own voltage/(sigma L_S)
+ * (u, du). The other row gives the same quadratic form (isotropy). */
+typedef struct {
+  float own[3], cross[3], v[2];
+} coef_t;
+
+static float quad3(const float *g, const float *a, const float *b)
+{
+  /* a' G b with G symmetric, packed (xx, xd, xdd, dd, ddd, d2d2) */
+  const float ga0 = g[0] * a[0] + g[1] * a[1] + g[2] * a[2];
+  const float ga1 = g[1] * a[0] + g[3] * a[1] + g[4] * a[2];
+  const float ga2 = g[2] * a[0] + g[4] * a[1] + g[5] * a[2];
+  return ga0 * b[0] + ga1 * b[1] + ga2 * b[2];
+}
+
+void bg_noise_estimate(const imest_t *s, const imest_window_t *w, const bg_window_stats_t *st,
+                       const bg_sums_t *sums, int steady, bg_noise_t *nz)
+{
+  const double n = w->nreg > 0u ? (double)w->nreg : 1.0;
+  const double fs = (double)s->fs, np = (double)s->n;
+  /* the smooth signal's share of the third differences: a sinusoid at the
+   * stator frequency, half of |i|^2 on the alpha axis */
+  const double we = np * st->w_mean + st->slip_rate;
+  const double h = 2.0 * sin(0.5 * we / fs), h6 = h * h * h * h * h * h;
+  const double ni = ((double)w->sum[IMEST_ACC_NOISE_I] + (double)w->blk[IMEST_ACC_NOISE_I]) / n;
+  const double nu = ((double)w->sum[IMEST_ACC_NOISE_U] + (double)w->blk[IMEST_ACC_NOISE_U]) / n;
+  const double i2 = 0.5 * sums->rw[3][3] / n;
+  const double u2 = st->u_ms;
+  /* two current sensors (the third computed: the zero sequence is exactly
+   * zero) give beta 5/3 of alpha's noise: 4/3 per axis on average */
+  const int two = w->sum[IMEST_ACC_I0A] == (imest_real_t)0 && w->sum[IMEST_ACC_I0B] == (imest_real_t)0;
+  nz->var_i = fmax(0.0, ni - h6 * i2) / 20.0 * (two ? 4.0 / 3.0 : 1.0);
+  nz->var_u = fmax(0.0, nu - h6 * u2) / 20.0;
+  nz->scale = 1.0;
+  nz->steady = steady;
+  /* the columns W1 W2 W4 W5 W6 W7 W8 y in one row (docs/METHOD.md §2, b = n w' = 0) */
+  const float a = (float)(np * st->w_mean), a2 = a * a, a3 = a2 * a;
+  const float m = s->m, m1 = 1.0f + m;
+  static const coef_t zero = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, {0.0f, 0.0f}};
+  coef_t c[8];
+  for (unsigned int k = 0; k < 8u; ++k) c[k] = zero;
+  c[0].own[1] = -1.0f; /* W1 = -di */
+  c[1].own[1] = -1.0f; /* W2 = -di + (1+m) a i_other + u/s */
+  c[1].cross[0] = m1 * a;
+  c[1].v[0] = 1.0f;
+  c[2].own[0] = -1.0f; /* W4 = -i */
+  c[3].own[1] = -a2;   /* W5 = -a^2 di + a^2 u/s + (1+m) a^3 i_other */
+  c[3].cross[0] = m1 * a3;
+  c[3].v[0] = a2;
+  c[4].own[0] = -a2; /* W6 = -a^2 i */
+  c[5].own[1] = -a2; /* W7 = -a^2 di */
+  c[6].own[2] = -a2; /* W8 = -a^2 d2i + a^2 du/s + a^3 di_other */
+  c[6].cross[1] = a3;
+  c[6].v[1] = a2;
+  c[7].own[0] = -m * a2; /* y = d2i - a di_other - m a^2 i - du/s */
+  c[7].own[2] = 1.0f;
+  c[7].cross[1] = -a;
+  c[7].v[1] = -1.0f;
+
+  const float inv_s = s->inv_s;
+  const float vi = (float)nz->var_i, vv = (float)nz->var_u * inv_s * inv_s;
+  const float *g = s->noise_g;
+  const float twice_n = (float)(2.0 * n); /* two rows, every sample */
+  unsigned int p = 0;
+  for (unsigned int i = 0; i < 8u; ++i) {
+    for (unsigned int j = i; j < 8u; ++j) {
+      const float gi = quad3(g, c[i].own, c[j].own) + quad3(g, c[i].cross, c[j].cross);
+      const float gv = g[0] * c[i].v[0] * c[j].v[0] + g[1] * (c[i].v[0] * c[j].v[1] + c[i].v[1] * c[j].v[0]) +
+                       g[3] * c[i].v[1] * c[j].v[1];
+      nz->bias[p++] = twice_n * (vi * gi + vv * gv);
+    }
+  }
+}
+
+/* 7-column index (W1 W2 W4 ...) -> 8-entry K index */
+static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
+
+/* The bias entry of ISR columns i, j (0..7, 7 = y). */
+static double bias_at(const bg_noise_t *nz, unsigned int i, unsigned int j)
+{
+  const unsigned int lo = i < j ? i : j, hi = i < j ? j : i;
+  return (double)nz->bias[IMEST_ACC_INDEX(lo, hi)];
+}
+
+static void apply(bg_sums_t *sm, const bg_noise_t *nz, double f, double m)
+{
+  double c0[7];
+  for (unsigned int i = 0; i < 7u; ++i) c0[i] = sm->c0[k_of_col[i]];
+  double bwc[7]; /* B_WW c0 */
+  for (unsigned int i = 0; i < 7u; ++i) {
+    bwc[i] = 0.0;
+    for (unsigned int j = 0; j < 7u; ++j) bwc[i] += bias_at(nz, i, j) * c0[j];
+  }
+  double cbc = 0.0, cby = 0.0;
+  for (unsigned int i = 0; i < 7u; ++i) {
+    for (unsigned int j = 0; j < 7u; ++j) sm->rw[k_of_col[i]][k_of_col[j]] -= f * bias_at(nz, i, j);
+    sm->rwy[k_of_col[i]] -= f * bias_at(nz, i, 7u);
+    sm->rwe[k_of_col[i]] -= f * (bias_at(nz, i, 7u) - bwc[i]);
+    cbc += c0[i] * bwc[i];
+    cby += c0[i] * bias_at(nz, i, 7u);
+  }
+  sm->ry -= f * bias_at(nz, 7u, 7u);
+  sm->ree -= f * (bias_at(nz, 7u, 7u) - 2.0 * cby + cbc);
+  sm->e_slack = f * (bias_at(nz, 7u, 7u) - 2.0 * cby + cbc);
+  /* column 3 is -m column 4, for the noise as for everything */
+  for (unsigned int j = 0; j < 8u; ++j) sm->rw[2][j] = -m * sm->rw[3][j];
+  for (unsigned int i = 0; i < 8u; ++i) sm->rw[i][2] = -m * sm->rw[i][3];
+  sm->rw[2][2] = m * m * sm->rw[3][3];
+  sm->rwy[2] = -m * sm->rwy[3];
+  sm->rwe[2] = -m * sm->rwe[3];
+}
+
+void bg_noise_subtract(bg_sums_t *sums, bg_noise_t *nz, double m)
+{
+  /* Where the noise would take more than 90 % of a column's energy, the
+   * window is noise and the bias estimate the weakest: take only as much of
+   * it as leaves every column (and y) 10 % of its energy. (R_W is nearly
+   * singular at constant speed, W6 ~ a^2 W4 and W7 ~ a^2 W1, so definiteness
+   * is no test: the bias has the same near-collinearity.) */
+  double f = nz->steady ? 1.0 : 0.0;
+  for (unsigned int i = 0; i < 8u; ++i) {
+    const double r = (i < 7u) ? sums->rw[k_of_col[i]][k_of_col[i]] : sums->ry, b = bias_at(nz, i, i);
+    if (b > 0.9 * r) f = fmin(f, r > 0.0 ? 0.9 * r / b : 0.0);
+  }
+  nz->scale = f;
+  sums->e_slack = 0.0;
+  if (f > 0.0) apply(sums, nz, f, m);
+  nz->e_c0 = sums->e_slack;
+}
+
+double bg_noise_e(const bg_noise_t *nz, const double k[8], double m)
+{
+  /* W3 K3 + W4 K4 = W4 (K4 - m K3): the 7-column coefficients */
+  const double c[7] = {k[0], k[1], k[3] - m * k[2], k[4], k[5], k[6], k[7]};
+  double e = bias_at(nz, 7u, 7u);
+  for (unsigned int i = 0; i < 7u; ++i) {
+    e -= 2.0 * c[i] * bias_at(nz, i, 7u);
+    for (unsigned int j = 0; j < 7u; ++j) e += c[i] * c[j] * bias_at(nz, i, j);
+  }
+  return e;
+}

@@ -1,0 +1,48 @@
+/* Commissioning result: the background's values with the ISR's live figures, and an estimator
+ * config filled from it. Read-only calls, any context. */
+#include <math.h>
+#include <stddef.h>
+
+#include "commission_internal.h"
+
+int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r)
+{
+  if (c == NULL || r == NULL) return IMEST_ERR_NULL;
+  *r = c->res;
+  r->state = c->state;
+  r->reason = c->reason;
+  if (c->state == IMEST_COMM_RUNNING || c->state == IMEST_COMM_IDLE) r->stage = (int)c->stage;
+  r->time_s = (float)c->k * c->ts_s;
+  r->i_peak_a = c->i_peak;
+  r->rotor_moved_rad = c->th_dev;
+  if (c->th_dev > 0.01f) r->flags |= IMEST_COMM_FLAG_ROTOR_CREPT;
+  const int plausible = isfinite(r->rs_ohm.value) && isfinite(r->sigma_ls_h.value) &&
+                        isfinite(r->ls_h.value) && isfinite(r->sigma.value) && r->sigma.value > 0.0f &&
+                        r->sigma.value < 1.0f;
+  r->valid = c->state == IMEST_COMM_DONE && plausible;
+  return IMEST_OK;
+}
+
+int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)
+{
+  if (r == NULL || cfg == NULL) return IMEST_ERR_NULL;
+  if (!r->valid) return IMEST_ERR_ARG;
+  int n = 0;
+  if (r->pole_pairs > 0u) {
+    cfg->pole_pairs = r->pole_pairs;
+    n++;
+  }
+  cfg->ls_h = r->ls_h.value;
+  cfg->sigma = r->sigma.value;
+  cfg->rs_nominal_ohm = r->rs_ohm.value;
+  n += 3;
+  if (isfinite(r->tr_s.value) && r->tr_s.value > 0.0f) {
+    cfg->tr_nominal_s = r->tr_s.value;
+    n++;
+  }
+  if (r->inverter.uncertainty >= 0.0f) {
+    cfg->inverter = r->inverter;
+    n++;
+  }
+  return n;
+}

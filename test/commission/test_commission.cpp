@@ -1,0 +1,393 @@
+// Self-commissioning (include/imest/imest_commission.h): closed loop on the simulator
+// (tools/commission/commission_sim.c: imsim with external duties, firmware timing, 2 us dead
+// time, 1 V / 0.8 V drops with slopes, 12-bit sensors with offsets and gain errors, 4096-count
+// encoder) on four motors, the wiring and encoder mistakes a user makes, and the routine's
+// protections on synthetic inputs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "commission_online.h"
+#include "commission_sim.h"
+#include "imest/imest_commission.h"
+
+namespace {
+
+double rel(double a, double b)
+{
+  return (a - b) / b;
+}
+
+comm_sim_out_t run(const comm_sim_opts_t &o)
+{
+  comm_sim_out_t out;
+  EXPECT_EQ(comm_sim_run(&o, &out), 0);
+  return out;
+}
+
+comm_sim_opts_t opts(const char *preset)
+{
+  comm_sim_opts_t o;
+  EXPECT_EQ(comm_sim_defaults(&o, preset), 0);
+  return o;
+}
+
+// The accuracy the issue asks for, on each motor, closed loop.
+void expect_accurate(const comm_sim_out_t &out, double i_max)
+{
+  const imest_comm_result_t &r = out.r;
+  ASSERT_EQ(r.state, IMEST_COMM_DONE) << imest_comm_reason_name(r.reason);
+  ASSERT_TRUE(r.valid);
+  // R_S against what a terminal measurement can see (winding + min(r_sw, r_d))
+  EXPECT_LT(std::fabs(rel(r.rs_ohm.value, out.rs_identifiable_ohm)), 0.01);
+  EXPECT_LT(std::fabs(rel(r.ls_h.value, out.ls_h)), 0.02);
+  EXPECT_LT(std::fabs(rel(r.sigma.value, out.sigma)), 0.05);
+  EXPECT_LT(std::fabs(rel(r.sigma_ls_h.value, out.sigma_ls_h)), 0.01);
+  EXPECT_LT(std::fabs(rel(r.tr_s.value, out.tr_s)), 0.01);
+  EXPECT_EQ(r.pole_pairs, out.pole_pairs);
+  EXPECT_EQ(r.encoder_dir, 1);
+  EXPECT_FLOAT_EQ(r.encoder_cpr, 4096.0f);
+  EXPECT_NEAR(r.inverter.dead_time_s, out.sim.dead_time_s, 0.02e-6);
+  EXPECT_NEAR(r.v_threshold_v.value, 0.5 * (out.sim.v_switch_v + out.sim.v_diode_v), 0.03);
+  // the inverter model's per-leg voltage error against the simulator's devices
+  EXPECT_LT(out.inv_err_model_v, 0.1);
+  // sensors
+  for (int x = 0; x < 3; ++x) {
+    EXPECT_NEAR(r.i_offset_a[x], out.sim.i_offset_a[x], 0.002 * out.sim.i_range_a);
+    const double gm = (out.sim.i_gain_err[0] + out.sim.i_gain_err[1] + out.sim.i_gain_err[2]) / 3.0;
+    EXPECT_NEAR(r.i_gain_rel[x], (1.0 + out.sim.i_gain_err[x]) / (1.0 + gm), 5e-4);
+    EXPECT_EQ(r.wiring_map[x], x + 1);
+  }
+  // the limit held, the rotor stayed put at standstill
+  EXPECT_LE(out.i_peak_true_a, i_max);
+  EXPECT_LT(r.rotor_moved_rad, 0.2f);
+  EXPECT_TRUE(r.flags & IMEST_COMM_FLAG_ROTATED);
+  EXPECT_TRUE(r.flags & IMEST_COMM_FLAG_GAINS);
+}
+
+} // namespace
+
+class CommissionMotor : public ::testing::TestWithParam<const char *> {};
+
+TEST_P(CommissionMotor, ClosedLoopWithinTheIssuesAccuracy)
+{
+  const comm_sim_opts_t o = opts(GetParam());
+  const comm_sim_out_t out = run(o);
+  expect_accurate(out, out.cc.i_max_a);
+  // the config it fills is one the estimator accepts
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  cfg.fs_hz = (float)out.sim.fs_hz;
+  cfg.pwm_hz = (float)out.sim.carrier_hz;
+  EXPECT_EQ(imest_comm_apply(&out.r, &cfg), 6);
+  EXPECT_EQ(imest_config_check(&cfg, nullptr), IMEST_OK);
+  EXPECT_EQ(cfg.pole_pairs, out.pole_pairs);
+  EXPECT_FLOAT_EQ(cfg.ls_h, out.r.ls_h.value);
+  EXPECT_FLOAT_EQ(cfg.inverter.dead_time_s, out.r.inverter.dead_time_s);
+  EXPECT_GT(cfg.inverter.uncertainty, 0.0f);
+  EXPECT_GT(cfg.inverter.i_band_a, 0.0f);
+}
+
+INSTANTIATE_TEST_SUITE_P(Presets, CommissionMotor, ::testing::Values("exp1", "4kw", "11kw", "37kw"),
+                         [](const ::testing::TestParamInfo<const char *> &i) {
+                           return std::string("m") + i.param;
+                         });
+
+// Then the online estimator on the same drive at rated load, fed the duty cycles (no voltage
+// sensors) with the identified constants and inverter model: T_R within 1 %, and what
+// commissioning costs against the true constants within 0.1 % of T_R.
+TEST_P(CommissionMotor, ThenTheEstimatorOnTheDutyCyclesGetsTrWithinOnePercent)
+{
+  const comm_sim_opts_t o = opts(GetParam());
+  const comm_sim_out_t out = run(o);
+  ASSERT_TRUE(out.r.valid);
+  comm_online_t id, tr;
+  ASSERT_EQ(comm_online_run(&o, 1.0, 20.0, &out.r, &id), 0);
+  ASSERT_EQ(comm_online_run(&o, 1.0, 20.0, nullptr, &tr), 0);
+  ASSERT_GT(id.windows, 10);
+  EXPECT_LT(std::fabs(id.tr_all_rel), 0.01);
+  EXPECT_LT(std::fabs(id.tr_all_rel - tr.tr_all_rel), 0.001);
+  if (id.tr_valid > 0) EXPECT_LT(std::fabs(id.tr_rel), 0.01);
+}
+
+TEST(Commission, StandstillOnlyFillsLsFromTheFluxTails)
+{
+  comm_sim_opts_t o = opts("4kw");
+  o.allow_rotation = 0;
+  const comm_sim_out_t out = run(o);
+  ASSERT_EQ(out.r.state, IMEST_COMM_DONE);
+  EXPECT_TRUE(out.r.valid);
+  EXPECT_TRUE(out.r.flags & IMEST_COMM_FLAG_LS_STANDSTILL);
+  EXPECT_FALSE(out.r.flags & IMEST_COMM_FLAG_ROTATED);
+  EXPECT_LT(std::fabs(rel(out.r.ls_h.value, out.ls_h)), 0.01);
+  EXPECT_LT(std::fabs(rel(out.r.sigma.value, out.sigma)), 0.02);
+  EXPECT_EQ(out.r.pole_pairs, 0u); // not identified without turning
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  EXPECT_EQ(imest_comm_apply(&out.r, &cfg), 5); // all but n_p
+}
+
+TEST(Commission, EncoderCountingBackwardsIsFound)
+{
+  comm_sim_opts_t o = opts("4kw");
+  o.encoder_reversed = 1;
+  const comm_sim_out_t out = run(o);
+  ASSERT_EQ(out.r.state, IMEST_COMM_DONE);
+  EXPECT_EQ(out.r.encoder_dir, -1);
+  EXPECT_TRUE(out.r.flags & IMEST_COMM_FLAG_ENCODER_REVERSED);
+  EXPECT_EQ(out.r.pole_pairs, 2u);
+}
+
+TEST(Commission, WrongCountsPerRevolutionWithTheNameplate)
+{
+  comm_sim_opts_t o = opts("11kw");
+  o.cpr_assumed = 1024; // quadrature x4 forgotten
+  const comm_sim_out_t out = run(o);
+  ASSERT_EQ(out.r.state, IMEST_COMM_DONE);
+  EXPECT_EQ(out.r.pole_pairs, 2u);
+  EXPECT_FLOAT_EQ(out.r.encoder_cpr, 4096.0f);
+  EXPECT_TRUE(out.r.flags & IMEST_COMM_FLAG_CPR_MISMATCH);
+  EXPECT_TRUE(out.r.flags & IMEST_COMM_FLAG_NP_NAMEPLATE);
+}
+
+TEST(Commission, ElectricalAngleWithoutNameplateGivesAConsistentProduct)
+{
+  // the firmware passes the electrical angle (its counts are the true ones / n_p): without the
+  // rated speed the routine cannot tell, and reports n_p = 1, which with that angle is right
+  comm_sim_opts_t o = opts("exp1");
+  o.nameplate_speed = 0;
+  o.cpr_assumed = 2048;
+  const comm_sim_out_t out = run(o);
+  ASSERT_EQ(out.r.state, IMEST_COMM_DONE);
+  EXPECT_TRUE(out.r.flags & IMEST_COMM_FLAG_NP_ASSUMED_CPR);
+  EXPECT_EQ(out.r.pole_pairs * 4096u / 2048u, out.pole_pairs);
+}
+
+TEST(Commission, CountsThatFitNoPolePairNumberFail)
+{
+  comm_sim_opts_t o = opts("4kw");
+  o.nameplate_speed = 0;
+  o.cpr_assumed = 3000;
+  const comm_sim_out_t out = run(o);
+  EXPECT_EQ(out.r.state, IMEST_COMM_FAILED);
+  EXPECT_EQ(out.r.reason, IMEST_COMM_REASON_POLE_PAIRS_AMBIGUOUS);
+  EXPECT_NEAR(out.r.speed_ratio, 2.0 * 3000.0 / 4096.0, 0.01);
+}
+
+TEST(Commission, AnEncoderThatDoesNotMoveIsNamed)
+{
+  comm_sim_opts_t o = opts("4kw");
+  o.encoder_stuck = 1;
+  const comm_sim_out_t out = run(o);
+  EXPECT_EQ(out.r.state, IMEST_COMM_FAILED);
+  EXPECT_EQ(out.r.reason, IMEST_COMM_REASON_ENCODER_STILL);
+  EXPECT_TRUE(out.r.flags & IMEST_COMM_FLAG_STANDSTILL); // the standstill part stands
+  EXPECT_LT(std::fabs(rel(out.r.rs_ohm.value, out.rs_identifiable_ohm)), 0.01);
+}
+
+TEST(Commission, SwappedCurrentChannelsStopAtTheWiringCheck)
+{
+  comm_sim_opts_t o = opts("4kw");
+  o.swap_sensors_bc = 1;
+  const comm_sim_out_t out = run(o);
+  EXPECT_EQ(out.r.state, IMEST_COMM_FAILED);
+  EXPECT_EQ(out.r.reason, IMEST_COMM_REASON_WIRING);
+  EXPECT_EQ(out.r.stage, IMEST_COMM_STAGE_WIRING);
+  EXPECT_EQ(out.r.wiring_map[0], 1);
+  EXPECT_EQ(out.r.wiring_map[1], 3); // leg b is read by channel c
+  EXPECT_EQ(out.r.wiring_map[2], 2);
+  EXPECT_LT(out.r.time_s, 1.0f);
+}
+
+TEST(Commission, TwoSensorsWorkWithoutTheGainCheck)
+{
+  comm_sim_opts_t o = opts("4kw");
+  o.two_sensors = 1;
+  const comm_sim_out_t out = run(o);
+  ASSERT_EQ(out.r.state, IMEST_COMM_DONE);
+  EXPECT_FALSE(out.r.flags & IMEST_COMM_FLAG_GAINS);
+  for (int x = 0; x < 3; ++x) EXPECT_FLOAT_EQ(out.r.i_gain_rel[x], 1.0f);
+  // the gain errors of a and b (+1 %, -0.4 %) now reach R_S and L_S: within their mean
+  EXPECT_LT(std::fabs(rel(out.r.rs_ohm.value, out.rs_identifiable_ohm)), 0.01);
+  EXPECT_LT(std::fabs(rel(out.r.ls_h.value, out.ls_h)), 0.01);
+}
+
+// ---------------------------------------------------------------------------
+// Protections, on synthetic inputs
+
+namespace {
+
+imest_comm_config_t base_config()
+{
+  imest_comm_config_t cc;
+  imest_comm_config_default(&cc);
+  cc.fs_hz = 8000.0f;
+  cc.i_max_a = 10.0f;
+  return cc;
+}
+
+// Zero currents at a 560 V bus until the routine stops commanding (at most n samples); the
+// background called every sample or never. Returns the samples taken.
+int run_silent(imest_comm_t *c, int n, bool background)
+{
+  float d[3];
+  const float i0[3] = {0.0f, 0.0f, 0.0f};
+  int rc = 1, k = 0;
+  for (; k < n && rc == 1; ++k) {
+    rc = imest_comm_isr(c, i0, 560.0f, 0.0f, d);
+    if (background) (void)imest_comm_background(c);
+  }
+  return k;
+}
+
+} // namespace
+
+TEST(CommissionGuard, ConfigCheckNamesTheField)
+{
+  imest_comm_config_t cc;
+  imest_comm_config_default(&cc);
+  const char *field = nullptr;
+  EXPECT_EQ(imest_comm_config_check(&cc, &field), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(field, "i_max_a"); // required
+  cc = base_config();
+  EXPECT_EQ(imest_comm_config_check(&cc, &field), IMEST_OK);
+  EXPECT_EQ(field, nullptr);
+  cc.allow_rotation = 1;
+  EXPECT_EQ(imest_comm_config_check(&cc, &field), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(field, "rated_voltage_v");
+  cc = base_config();
+  cc.n_sensors = 1u;
+  EXPECT_EQ(imest_comm_config_check(&cc, &field), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(field, "n_sensors");
+  cc = base_config();
+  cc.pwm_hz = 1000.0f; // slower than the ISR
+  EXPECT_EQ(imest_comm_config_check(&cc, &field), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(field, "pwm_hz");
+  static imest_comm_t c;
+  EXPECT_EQ(imest_comm_init(&c, &cc), IMEST_ERR_CONFIG);
+  EXPECT_EQ(imest_comm_init(nullptr, &cc), IMEST_ERR_NULL);
+  EXPECT_EQ(imest_comm_config_check(nullptr, nullptr), IMEST_ERR_NULL);
+}
+
+TEST(CommissionGuard, NonFiniteInputStopsWithZeroVoltage)
+{
+  static imest_comm_t c;
+  const imest_comm_config_t cc = base_config();
+  ASSERT_EQ(imest_comm_init(&c, &cc), IMEST_OK);
+  float d[3];
+  const float i0[3] = {0.0f, 0.0f, 0.0f};
+  EXPECT_EQ(imest_comm_isr(&c, i0, 560.0f, 0.0f, d), 1);
+  const float bad[3] = {0.0f, NAN, 0.0f};
+  EXPECT_EQ(imest_comm_isr(&c, bad, 560.0f, 0.0f, d), 0);
+  EXPECT_FLOAT_EQ(d[0], 0.5f);
+  EXPECT_FLOAT_EQ(d[1], 0.5f);
+  EXPECT_FLOAT_EQ(d[2], 0.5f);
+  imest_comm_status_t st;
+  ASSERT_EQ(imest_comm_status(&c, &st), IMEST_OK);
+  EXPECT_EQ(st.state, IMEST_COMM_FAILED);
+  EXPECT_EQ(st.reason, IMEST_COMM_REASON_INPUT_FAULT);
+  EXPECT_EQ(imest_comm_isr(&c, i0, 560.0f, 0.0f, d), 0); // stays stopped
+}
+
+TEST(CommissionGuard, OvercurrentStops)
+{
+  static imest_comm_t c;
+  const imest_comm_config_t cc = base_config();
+  ASSERT_EQ(imest_comm_init(&c, &cc), IMEST_OK);
+  float d[3];
+  const float i0[3] = {0.0f, 0.0f, 0.0f}, big[3] = {10.5f, -5.0f, -5.5f};
+  EXPECT_EQ(imest_comm_isr(&c, i0, 560.0f, 0.0f, d), 1);
+  EXPECT_EQ(imest_comm_isr(&c, big, 560.0f, 0.0f, d), 0);
+  imest_comm_result_t r;
+  ASSERT_EQ(imest_comm_result(&c, &r), IMEST_OK);
+  EXPECT_EQ(r.state, IMEST_COMM_FAILED);
+  EXPECT_EQ(r.reason, IMEST_COMM_REASON_OVERCURRENT);
+  EXPECT_FLOAT_EQ(r.i_peak_a, 10.5f);
+  EXPECT_FALSE(r.valid);
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  EXPECT_EQ(imest_comm_apply(&r, &cfg), IMEST_ERR_ARG); // nothing filled from a failed run
+}
+
+TEST(CommissionGuard, AbortAtAnySample)
+{
+  comm_sim_opts_t o = opts("4kw");
+  imsim_config_t sc;
+  ASSERT_EQ(comm_sim_config(&o, &sc), 0);
+  imest_comm_config_t cc;
+  comm_sim_comm_config(&o, &sc, &cc);
+  static imest_comm_t c;
+  static imsim_t sim;
+  imsim_sample_t s;
+  ASSERT_EQ(imest_comm_init(&c, &cc), IMEST_OK);
+  ASSERT_EQ(imsim_init(&sim, &sc, &s), 0);
+  float d[3];
+  int n = 0;
+  for (; n < 20000; ++n) { // into the staircase
+    const float i[3] = {(float)s.i_abc[0], (float)s.i_abc[1], (float)s.i_abc[2]};
+    ASSERT_EQ(imest_comm_isr(&c, i, (float)s.vdc_v, 0.0f, d), 1);
+    (void)imest_comm_background(&c);
+    const double dd[3] = {d[0], d[1], d[2]};
+    imsim_set_duty(&sim, dd);
+    imsim_step(&sim, &s);
+  }
+  imest_comm_status_t st;
+  ASSERT_EQ(imest_comm_status(&c, &st), IMEST_OK);
+  EXPECT_EQ(st.stage, IMEST_COMM_STAGE_STAIRCASE);
+  EXPECT_GT(st.progress, 0.05f);
+  EXPECT_LT(st.progress, 0.5f);
+  EXPECT_EQ(imest_comm_abort(&c), IMEST_OK);
+  const float i[3] = {(float)s.i_abc[0], (float)s.i_abc[1], (float)s.i_abc[2]};
+  EXPECT_EQ(imest_comm_isr(&c, i, (float)s.vdc_v, 0.0f, d), 0);
+  EXPECT_FLOAT_EQ(d[0], 0.5f);
+  ASSERT_EQ(imest_comm_status(&c, &st), IMEST_OK);
+  EXPECT_EQ(st.state, IMEST_COMM_ABORTED);
+  EXPECT_EQ(st.reason, IMEST_COMM_REASON_ABORTED);
+}
+
+TEST(CommissionGuard, NoCurrentAnswerIsAnOpenPhase)
+{
+  // a plant that never answers (motor not connected): the pulses double up to half the bus,
+  // then the wiring check says open phase
+  static imest_comm_t c;
+  const imest_comm_config_t cc = base_config();
+  ASSERT_EQ(imest_comm_init(&c, &cc), IMEST_OK);
+  const int n = run_silent(&c, 100000, true);
+  imest_comm_result_t r;
+  ASSERT_EQ(imest_comm_result(&c, &r), IMEST_OK);
+  EXPECT_EQ(r.state, IMEST_COMM_FAILED);
+  EXPECT_EQ(r.reason, IMEST_COMM_REASON_OPEN_PHASE);
+  EXPECT_LT(n, 8000); // within a second
+}
+
+TEST(CommissionGuard, BackgroundNeverCalledTimesOut)
+{
+  static imest_comm_t c;
+  const imest_comm_config_t cc = base_config();
+  ASSERT_EQ(imest_comm_init(&c, &cc), IMEST_OK);
+  const int n = run_silent(&c, 100000, false);
+  imest_comm_status_t st;
+  ASSERT_EQ(imest_comm_status(&c, &st), IMEST_OK);
+  EXPECT_EQ(st.state, IMEST_COMM_FAILED);
+  EXPECT_EQ(st.reason, IMEST_COMM_REASON_BACKGROUND);
+  EXPECT_LT(n, 8000 * 12); // 10 s of waiting
+}
+
+TEST(CommissionGuard, NamesAndNullArguments)
+{
+  EXPECT_STREQ(imest_comm_reason_name(IMEST_COMM_REASON_WIRING), "wiring");
+  EXPECT_STREQ(imest_comm_reason_name(IMEST_COMM_REASON_CURRENT_LIMIT_ROTATING), "current_limit_rotating");
+  EXPECT_STREQ(imest_comm_reason_name(99), "unknown");
+  EXPECT_STREQ(imest_comm_stage_name(IMEST_COMM_STAGE_STAIRCASE), "staircase");
+  EXPECT_STREQ(imest_comm_state_name(IMEST_COMM_DONE), "done");
+  float d[3];
+  const float i0[3] = {0, 0, 0};
+  EXPECT_EQ(imest_comm_isr(nullptr, i0, 1.0f, 0.0f, d), IMEST_ERR_NULL);
+  EXPECT_EQ(imest_comm_background(nullptr), IMEST_ERR_NULL);
+  EXPECT_EQ(imest_comm_abort(nullptr), IMEST_ERR_NULL);
+  EXPECT_EQ(imest_comm_status(nullptr, nullptr), IMEST_ERR_NULL);
+  EXPECT_EQ(imest_comm_result(nullptr, nullptr), IMEST_ERR_NULL);
+  EXPECT_EQ(imest_comm_apply(nullptr, nullptr), IMEST_ERR_NULL);
+}

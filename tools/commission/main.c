@@ -1,0 +1,362 @@
+/* imest-commission: the library's self-commissioning routine run closed loop on the simulator
+ * for a drive preset; prints what it identified against the simulator's truth, with the errors,
+ * the time and the peak current of the routine, per stage.
+ *
+ *   imest-commission --preset 4kw
+ *   imest-commission --preset 37kw --no-rotation --dead-time 3e-6
+ *
+ * Exit status: 0 the routine completed with a valid result, 1 it failed (the reason is
+ * printed), 2 usage error. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "commission_online.h"
+#include "commission_sensitivity.h"
+#include "commission_sim.h"
+#include "tool_args.h"
+
+static const char *const k_prog = "imest-commission";
+
+static void usage(FILE *f)
+{
+  fprintf(f,
+          "usage: %s [options]\n"
+          "Runs the self-commissioning routine (include/imest/imest_commission.h) closed loop on the\n"
+          "simulator and prints identified vs true values.\n"
+          "  --preset NAME        4kw, 11kw, 15kw, 37kw, 75kw, exp1 (the paper's 0.4 kW motor) [4kw]\n"
+          "  --no-rotation        standstill only (L_S and sigma from the flux tails)\n"
+          "  --no-nameplate       do not give the rated speed (n_p from the encoder's counts)\n"
+          "  --speed-frac X       speed of the rotating run, fraction of rated [0.4]\n"
+          "  --i-max A            current limit, peak [sqrt(2) x rated]\n"
+          "  --r-series OHM       known series resistance passed to the routine [0]\n"
+          "  --dead-time S        inverter dead time [2e-6]\n"
+          "  --v-switch V         switch threshold [1]\n"
+          "  --r-switch OHM       switch slope [0.02 x 8.2 A / rated current]\n"
+          "  --v-diode V          diode threshold [0.8]\n"
+          "  --r-diode OHM        diode slope [0.01 x 8.2 A / rated current]\n"
+          "  --offsets A,B,C      current-sensor offsets [A] [1, -0.6, 0.4 %% of full scale]\n"
+          "  --gain-errors A,B,C  current-sensor gain errors [0.01,-0.004,-0.006]\n"
+          "  --ideal-sensors      exact currents and angle\n"
+          "  --encoder-counts N   true counts per revolution [4096]\n"
+          "  --cpr-assumed N      counts the firmware assumes [the true ones]\n"
+          "  --encoder-reversed   the angle counts against the a-b-c field\n"
+          "  --encoder-stuck      the angle never moves\n"
+          "  --swap-sensors       current channels b and c swapped\n"
+          "  --two-sensors        the firmware computes i_c = -i_a - i_b\n"
+          "  --seed N             noise seed [1]\n"
+          "  --trace FILE         per-sample CSV (t, stage, currents, duties, speed, angle)\n"
+          "  --trace-decimate N   every N-th sample in the trace [1]\n"
+          "  --csv                one machine-readable line instead of the table\n"
+          "  --verbose            also the per-axis fits\n"
+          "  --sensitivity        instead: the online estimator's T_R and R_S error per 1 %% error of\n"
+          "                       L_S and sigma and per 0.1 V of inverter model error (preset at\n"
+          "                       --load of rated torque, phase-voltage input)\n"
+          "  --duty               --sensitivity with the duty-cycle input on the commissioned drive\n"
+          "                       (the 0.1 V taken off the true inverter model's thresholds)\n"
+          "  --load X             load for --sensitivity and --online, fraction of rated [1]\n"
+          "  --online             then: the online estimator on the same drive at --load with the\n"
+          "                       identified constants and inverter model (duty-cycle input),\n"
+          "                       against the same with the true ones\n"
+          "  --help\n",
+          k_prog);
+}
+
+static int parse3(tool_args_t *a, double v[3])
+{
+  const char *s = tool_args_value(a);
+  if (s == NULL) return -1;
+  char *end;
+  for (int k = 0; k < 3; ++k) {
+    v[k] = strtod(s, &end);
+    if (end == s || !isfinite(v[k]) || (k < 2 && *end != ',') || (k == 2 && *end != '\0')) {
+      fprintf(stderr, "%s: %s needs three numbers A,B,C\n", k_prog, a->opt);
+      return -1;
+    }
+    s = end + 1;
+  }
+  return 0;
+}
+
+static double pct(double id, double tr)
+{
+  return 100.0 * (id - tr) / tr;
+}
+
+static void row(const char *name, double scale, double id, double tr, const char *note)
+{
+  printf("  %-26s %12.5g %12.5g %+9.3f %%  %s\n", name, id * scale, tr * scale, pct(id, tr),
+         note ? note : "");
+}
+
+int main(int argc, char **argv)
+{
+  comm_sim_opts_t o;
+  const char *preset = "4kw";
+  for (int k = 1; k + 1 < argc; ++k)
+    if (strcmp(argv[k], "--preset") == 0) preset = argv[k + 1];
+  for (int k = 1; k < argc; ++k)
+    if (strncmp(argv[k], "--preset=", 9) == 0) preset = argv[k] + 9;
+  if (comm_sim_defaults(&o, preset) != 0) {
+    fprintf(stderr, "%s: unknown preset '%s' (%s)\n", k_prog, preset, imsim_preset_names());
+    return 2;
+  }
+  int csv = 0, verbose = 0, sensitivity = 0, online = 0, duty_input = 0;
+  double load = 1.0;
+  const char *trace = NULL;
+  tool_args_t a;
+  tool_args_init(&a, k_prog, argc, argv);
+  tool_arg_kind_t kind;
+  while ((kind = tool_args_next(&a)) != TOOL_ARG_END) {
+    if (kind == TOOL_ARG_OPERAND) {
+      fprintf(stderr, "%s: unexpected argument '%s' (see --help)\n", k_prog, a.operand);
+      return 2;
+    }
+    double v;
+    if (tool_args_is(&a, "--help")) {
+      usage(stdout);
+      return 0;
+    } else if (tool_args_is(&a, "--preset")) {
+      if (tool_args_value(&a) == NULL) return 2;
+    } else if (tool_args_is(&a, "--no-rotation")) {
+      if (tool_args_flag(&a)) return 2;
+      o.allow_rotation = 0;
+    } else if (tool_args_is(&a, "--no-nameplate")) {
+      if (tool_args_flag(&a)) return 2;
+      o.nameplate_speed = 0;
+    } else if (tool_args_is(&a, "--ideal-sensors")) {
+      if (tool_args_flag(&a)) return 2;
+      o.ideal_sensors = 1;
+    } else if (tool_args_is(&a, "--encoder-reversed")) {
+      if (tool_args_flag(&a)) return 2;
+      o.encoder_reversed = 1;
+    } else if (tool_args_is(&a, "--swap-sensors")) {
+      if (tool_args_flag(&a)) return 2;
+      o.swap_sensors_bc = 1;
+    } else if (tool_args_is(&a, "--encoder-stuck")) {
+      if (tool_args_flag(&a)) return 2;
+      o.encoder_stuck = 1;
+    } else if (tool_args_is(&a, "--two-sensors")) {
+      if (tool_args_flag(&a)) return 2;
+      o.two_sensors = 1;
+    } else if (tool_args_is(&a, "--verbose")) {
+      if (tool_args_flag(&a)) return 2;
+      verbose = 1;
+    } else if (tool_args_is(&a, "--duty")) {
+      if (tool_args_flag(&a)) return 2;
+      duty_input = 1;
+    } else if (tool_args_is(&a, "--online")) {
+      if (tool_args_flag(&a)) return 2;
+      online = 1;
+    } else if (tool_args_is(&a, "--sensitivity")) {
+      if (tool_args_flag(&a)) return 2;
+      sensitivity = 1;
+    } else if (tool_args_is(&a, "--load")) {
+      if (tool_args_number(&a, &load) || load < 0.0 || load > 2.0) {
+        fprintf(stderr, "%s: --load needs a fraction of rated torque in [0, 2]\n", k_prog);
+        return 2;
+      }
+    } else if (tool_args_is(&a, "--csv")) {
+      if (tool_args_flag(&a)) return 2;
+      csv = 1;
+    } else if (tool_args_is(&a, "--trace")) {
+      if ((trace = tool_args_value(&a)) == NULL) return 2;
+    } else if (tool_args_is(&a, "--offsets")) {
+      if (parse3(&a, o.i_offset_a)) return 2;
+    } else if (tool_args_is(&a, "--gain-errors")) {
+      if (parse3(&a, o.i_gain_err)) return 2;
+    } else {
+      static const char *const num[] = {
+          "--speed-frac", "--i-max",   "--r-series", "--dead-time",      "--v-switch",    "--r-switch",
+          "--v-diode",    "--r-diode", "--seed",     "--encoder-counts", "--cpr-assumed", "--trace-decimate"};
+      int which = -1;
+      for (int k = 0; k < (int)(sizeof num / sizeof num[0]); ++k)
+        if (tool_args_is(&a, num[k])) which = k;
+      if (which < 0) return tool_args_unknown(&a);
+      if (tool_args_number(&a, &v)) return 2;
+      if (v < 0.0 || (which == 0 && (v < 0.05 || v > 1.0))) {
+        fprintf(stderr, "%s: %s out of range\n", k_prog, num[which]);
+        return 2;
+      }
+      switch (which) {
+      case 0: o.speed_frac = v; break;
+      case 1: o.i_max_a = v; break;
+      case 2: o.r_series_ohm = v; break;
+      case 3: o.dead_time_s = v; break;
+      case 4: o.v_switch_v = v; break;
+      case 5: o.r_switch_ohm = v; break;
+      case 6: o.v_diode_v = v; break;
+      case 7: o.r_diode_ohm = v; break;
+      case 8: o.seed = (unsigned long)v; break;
+      case 9: o.encoder_counts = (int)v; break;
+      case 10: o.cpr_assumed = v; break;
+      default: o.trace_decimate = v >= 1.0 ? (unsigned int)v : 1u; break;
+      }
+    }
+  }
+  if (sensitivity) {
+    comm_sens_opts_t so;
+    memset(&so, 0, sizeof so);
+    snprintf(so.preset, sizeof so.preset, "%s", o.preset);
+    so.load_frac = load;
+    so.duration_s = 14.0;
+    so.settle_s = 4.0;
+    so.seed = o.seed;
+    so.duty = duty_input;
+    comm_sens_t r;
+    if (comm_sensitivity(&so, &r) != 0) {
+      fprintf(stderr, "%s: the sensitivity runs failed for %s\n", k_prog, o.preset);
+      return 1;
+    }
+    if (csv) {
+      printf("preset,load,tr_base_pct,rs_base_pct,valid,windows,tr_per_ls_pct,rs_per_ls_pct,tr_per_sigma_pct,"
+             "rs_per_sigma_pct,tr_per_0p1v_pct,rs_per_0p1v_pct\n");
+      printf("%s,%.2f,%.3f,%.3f,%d,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", o.preset, load, 100.0 * r.base.tr_rel,
+             100.0 * r.base.rs_rel, r.base.valid, r.base.windows, 100.0 * r.tr_per_ls, 100.0 * r.rs_per_ls,
+             100.0 * r.tr_per_sigma, 100.0 * r.rs_per_sigma, 100.0 * r.tr_per_dv, 100.0 * r.rs_per_dv);
+    } else {
+      printf(
+          "%s: preset %s at %.0f %% of rated torque, phase-voltage input, true constants: T_R %+.3f %%, R_S "
+          "%+.3f %% (%d of %d windows valid)\n",
+          k_prog, o.preset, 100.0 * load, 100.0 * r.base.tr_rel, 100.0 * r.base.rs_rel, r.base.valid,
+          r.base.windows);
+      printf("  error per +1 %% of L_S:    T_R %+.3f %%, R_S %+.3f %%\n", 100.0 * r.tr_per_ls,
+             100.0 * r.rs_per_ls);
+      printf("  error per +1 %% of sigma:  T_R %+.3f %%, R_S %+.3f %%\n", 100.0 * r.tr_per_sigma,
+             100.0 * r.rs_per_sigma);
+      printf("  error per +0.1 V per leg: T_R %+.3f %%, R_S %+.3f %%\n", 100.0 * r.tr_per_dv,
+             100.0 * r.rs_per_dv);
+    }
+    return 0;
+  }
+  if (trace) {
+    o.trace = strcmp(trace, "-") == 0 ? stdout : fopen(trace, "w");
+    if (o.trace == NULL) {
+      fprintf(stderr, "%s: cannot write %s\n", k_prog, trace);
+      return 1;
+    }
+  }
+  static comm_sim_out_t out;
+  if (comm_sim_run(&o, &out) != 0) return 1;
+  if (o.trace && o.trace != stdout) fclose(o.trace);
+  const imest_comm_result_t *r = &out.r;
+  const imsim_config_t *sc = &out.sim;
+  comm_online_t on_id, on_true;
+  if (online && r->valid) {
+    if (comm_online_run(&o, load, 20.0, r, &on_id) != 0 ||
+        comm_online_run(&o, load, 20.0, NULL, &on_true) != 0) {
+      fprintf(stderr, "%s: the online run failed\n", k_prog);
+      return 1;
+    }
+  }
+  if (csv) {
+    printf(
+        "preset,state,reason,valid,time_s,i_peak_a,rs_err_pct,rs_winding_err_pct,sigma_ls_err_pct,ls_err_pct,"
+        "sigma_err_pct,tr_err_pct,np,np_true,encoder_dir,dead_time_err_us,inv_err_model_v,inv_err_total_v\n");
+    printf("%s,%s,%s,%d,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%d,%.4f,%.4f,%.4f\n", o.preset,
+           imest_comm_state_name(r->state), imest_comm_reason_name(r->reason), r->valid, (double)r->time_s,
+           out.i_peak_true_a, pct(r->rs_ohm.value, out.rs_identifiable_ohm), pct(r->rs_ohm.value, out.rs_ohm),
+           pct(r->sigma_ls_h.value, out.sigma_ls_h), pct(r->ls_h.value, out.ls_h),
+           pct(r->sigma.value, out.sigma), pct(r->tr_s.value, out.tr_s), r->pole_pairs, out.pole_pairs,
+           r->encoder_dir, ((double)r->inverter.dead_time_s - sc->dead_time_s) * 1e6, out.inv_err_model_v,
+           out.inv_err_total_v);
+    return r->valid ? 0 : 1;
+  }
+  printf(
+      "%s: preset %s, %.0f V bus, %.0f kHz PWM, dead time %.2g us, switch %.2g V + %.4g ohm, diode %.2g V + "
+      "%.4g ohm\n",
+      k_prog, o.preset, sc->vdc_v, sc->carrier_hz / 1000.0, sc->dead_time_s * 1e6, sc->v_switch_v,
+      sc->r_switch_ohm, sc->v_diode_v, sc->r_diode_ohm);
+  printf("state %s%s%s, %s, %.2f s (simulated %.2f s), peak phase current %.3f A (limit %.3f A)\n",
+         imest_comm_state_name(r->state), r->reason ? ": " : "",
+         r->reason ? imest_comm_reason_name(r->reason) : "", r->valid ? "valid" : "not valid",
+         (double)r->time_s, out.sim_time_s, out.i_peak_true_a, (double)out.cc.i_max_a);
+  printf("stages: ");
+  for (int k = 0; k < IMEST_COMM_STAGE_END; ++k)
+    if (out.stage_s[k] > 0.0)
+      printf("%s %.2f s (%.2f A)  ", imest_comm_stage_name(k), out.stage_s[k], out.stage_ipk_a[k]);
+  printf("\n\n  %-26s %12s %12s %10s\n", "quantity", "identified", "true", "error");
+  char note[160];
+  snprintf(note, sizeof note, "true = winding %.5g + min(r_sw, r_d) %.4g; vs winding %+.3f %%", out.rs_ohm,
+           out.rs_identifiable_ohm - out.rs_ohm, pct(r->rs_ohm.value, out.rs_ohm));
+  row("R_S [ohm]", 1.0, r->rs_ohm.value, out.rs_identifiable_ohm, note);
+  snprintf(note, sizeof note, "axes %.5g %.5g %.5g, spread %.2g %%", (double)r->rs_axis_ohm[0],
+           (double)r->rs_axis_ohm[1], (double)r->rs_axis_ohm[2], 100.0 * (double)r->rs_ohm.spread_rel);
+  printf("  %-26s %s\n", "", note);
+  snprintf(note, sizeof note, "spread %.2g %%", 100.0 * (double)r->sigma_ls_h.spread_rel);
+  row("sigma*L_S [mH]", 1e3, r->sigma_ls_h.value, out.sigma_ls_h, note);
+  snprintf(note, sizeof note, "%s; standstill %.5g mH (%+.2f %%)",
+           (r->flags & IMEST_COMM_FLAG_LS_STANDSTILL) ? "standstill" : "rotating",
+           1e3 * (double)r->ls_standstill_h.value, pct(r->ls_standstill_h.value, out.ls_h));
+  row("L_S [mH]", 1e3, r->ls_h.value, out.ls_h, note);
+  row("sigma", 1.0, r->sigma.value, out.sigma, NULL);
+  row("T_R [ms]", 1e3, r->tr_s.value, out.tr_s, "flux tails");
+  row("R_R' [ohm]", 1.0, r->rr_ohm.value, out.rr_ohm, "(1-sigma) L_S / T_R");
+  {
+    /* with the firmware's counts assumed right, n_p x the firmware's angle is what must match */
+    const double cpr_fw = o.cpr_assumed > 0.0 ? o.cpr_assumed : (double)sc->encoder_counts;
+    const double np_equiv = (double)r->pole_pairs * (double)sc->encoder_counts / cpr_fw;
+    const char *verdict = r->pole_pairs == out.pole_pairs                  ? "ok"
+                          : fabs(np_equiv - (double)out.pole_pairs) < 1e-9 ? "ok x angle"
+                                                                           : "WRONG";
+    printf("  %-26s %12u %12u %9s   %s\n", "n_p", r->pole_pairs, out.pole_pairs, verdict,
+           (r->flags & IMEST_COMM_FLAG_NP_NAMEPLATE)
+               ? "from the rated speed"
+               : "from the speed ratio (n_p x the firmware's angle is what counts)");
+  }
+  const int dir_true = o.encoder_reversed ? -1 : 1;
+  printf("  %-26s %12d %12d %9s   speed ratio %.5f\n", "encoder direction", r->encoder_dir, dir_true,
+         r->encoder_dir == dir_true ? "ok" : "WRONG", (double)r->speed_ratio);
+  printf("  %-26s %12.6g %12d %9s\n", "encoder counts/rev", (double)r->encoder_cpr, sc->encoder_counts,
+         (double)r->encoder_cpr == sc->encoder_counts ? "ok" : "differs");
+  printf("  %-26s %12.4f %12.4f %+9.3f us\n", "dead time [us]", 1e6 * (double)r->inverter.dead_time_s,
+         1e6 * sc->dead_time_s, 1e6 * ((double)r->inverter.dead_time_s - sc->dead_time_s));
+  printf("  %-26s %12.4f %12.4f %+9.4f V\n", "(V_sw0 + V_d0)/2 [V]", (double)r->v_threshold_v.value,
+         0.5 * (sc->v_switch_v + sc->v_diode_v),
+         (double)r->v_threshold_v.value - 0.5 * (sc->v_switch_v + sc->v_diode_v));
+  printf("  %-26s %12.5f %12.5f %+9.5f ohm\n", "r_sw - r_d [ohm]", (double)r->dr_ohm.value,
+         sc->r_switch_ohm - sc->r_diode_ohm, (double)r->dr_ohm.value - (sc->r_switch_ohm - sc->r_diode_ohm));
+  printf("  %-26s %12.4f (ripple peak V_dc / (8 sigma L_S f_pwm)), model uncertainty %.3f\n", "i_band [A]",
+         (double)r->inverter.i_band_a, (double)r->inverter.uncertainty);
+  printf("  inverter per-leg voltage error, |i| in [2 i_band, i_max], duty 0.05..0.95: model vs devices "
+         "(common slope\n"
+         "  in R_S) max %.3f V; model + R_S vs devices + winding max %.3f V, rms %.3f V\n",
+         out.inv_err_model_v, out.inv_err_total_v, out.inv_err_rms_v);
+  printf("  %-26s", "sensor gains (rel. mean)");
+  for (int x = 0; x < 3; ++x) {
+    const double gm = (o.i_gain_err[0] + o.i_gain_err[1] + o.i_gain_err[2]) / 3.0;
+    printf(" %.5f (true %.5f)", (double)r->i_gain_rel[x], (1.0 + o.i_gain_err[x]) / (1.0 + gm));
+  }
+  printf("\n  %-26s", "sensor offsets [A]");
+  for (int x = 0; x < 3; ++x) printf(" %.4f (true %.4f)", (double)r->i_offset_a[x], o.i_offset_a[x]);
+  if (verbose)
+    for (int k = 0; k < 3; ++k) {
+      const imest_comm_axis_fit_t *f = &out.fit[k];
+      printf("\n  axis %d: R %.5f (%.2g) td %.4f us (%.2g) vth %.4f (%.2g) dr %.5f (%.2g) tau %.5f (%.2g) lm "
+             "%.5f sl %.6f (%.2g) "
+             "rhf %.4f gain %.5f rms %.4f",
+             k, f->r_ohm, f->r_std, f->td_s * 1e6, f->td_std * 1e6, f->vth_v, f->vth_std, f->dr_ohm,
+             f->dr_std, f->tau_s, f->tau_std, f->lm_h, f->slsig_h, f->slsig_std, f->rhf_ohm, f->gain_dev,
+             f->rms_v);
+    }
+  if (online && r->valid) {
+    const comm_online_t *v[2] = {&on_id, &on_true};
+    printf("\n  online estimator on this drive, %.0f %% load, duty-cycle input, windows after 6 s of 20 s:",
+           100.0 * load);
+    for (int k = 0; k < 2; ++k)
+      printf("\n    %-10s constants: T_R %+.3f %% (all windows), %+.3f %% (valid: %d of %d); R_S %+.3f %% "
+             "(all), %+.3f "
+             "%% (valid: %d); status %s",
+             k == 0 ? "identified" : "true", 100.0 * v[k]->tr_all_rel, 100.0 * v[k]->tr_rel, v[k]->tr_valid,
+             v[k]->windows, 100.0 * v[k]->rs_all_rel, 100.0 * v[k]->rs_rel, v[k]->rs_valid,
+             imest_reason_name(v[k]->reason));
+  }
+  printf(
+      "\n  rotor travel at standstill %.2g rad; rotating run %.2f Hz, %.3f A, slip %.2g, negative sequence "
+      "%.3g; flags "
+      "0x%04x\n",
+      out.theta_max_standstill_rad, (double)r->rotating_f_hz, (double)r->rotating_i_a, (double)r->slip,
+      (double)r->neg_seq_rel, r->flags);
+  return r->valid ? 0 : 1;
+}
