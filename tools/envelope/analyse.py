@@ -58,8 +58,9 @@ def load_point(p, work, skip, replay_name=None):
             w["status"] = r["status"]
             w["tr_reason"] = r.get("tr_reason") or ("none" if w["tr_valid"] else r["status"])
             w["rs_reason"] = r.get("rs_reason") or ("none" if w["rs_valid"] else r["status"])
-            for k in ("E_I", "pe_k1_rel", "pe_k2_rel", "slip_ratio"):
-                w[k] = _f(r.get(k))
+            for k in ("E_I", "pe_k1_rel", "pe_k2_rel", "slip_ratio", "span_s", "tr_bound_rel",
+                      "rs_bound_rel"):
+                w[k] = _f(r.get(k))  # nan where this imest-replay does not write it
             w["e_tr"] = w["tr_s"] / w["tr_true_s"] - 1.0
             w["e_rs"] = w["rs_ohm"] / w["rs_true_ohm"] - 1.0
             classify(w)
@@ -133,6 +134,7 @@ def point_table(rows, pts):
             pe_k2_med=median([w["pe_k2_rel"] for w in ws]),
             ei_med=median([w["E_I"] for w in ws]),
             slip_med=median([w["slip_ratio"] for w in ws]),
+            span_med_s=median([w["span_s"] for w in ws]),
             tr_refused=";".join(f"{k} {v}" for k, v in trr.most_common()),
             rs_refused=";".join(f"{k} {v}" for k, v in rsr.most_common()),
         ))
@@ -142,7 +144,8 @@ def point_table(rows, pts):
 WINDOW_COLS = ["name", "family", "motor", "f_pct", "load_pct", "sensors", "encoder", "input", "goal",
                "seq", "t_end_s", "tr_s", "tr_true_s", "e_tr", "rs_ohm", "rs_true_ohm", "e_rs",
                "valid", "tr_valid", "rs_valid", "status", "tr_reason", "rs_reason", "E_I",
-               "pe_k1_rel", "pe_k2_rel", "slip_ratio", "speed_rad_s", "load_nm", "tr_good",
+               "pe_k1_rel", "pe_k2_rel", "slip_ratio", "span_s", "tr_bound_rel", "rs_bound_rel",
+               "speed_rad_s", "load_nm", "tr_good",
                "rs_good", "fv_gross", "fv_marginal"]
 
 

@@ -78,6 +78,20 @@ def evidence(rows):
             L.append(f"| {fam} | " + " | ".join(cells) + " |")
         L.append("")
 
+    spans = [w["span_s"] for w in goal if math.isfinite(w["span_s"])]
+    if spans:
+        L.append("**Effective window length** (`span_s`, s) of the goal region's windows with T_R "
+                 "valid: median / max; and of those refused.\n")
+        L.append("| | " + " | ".join(names) + " |")
+        L.append("|---" * (len(names) + 1) + "|")
+        for label, ok in (("T_R valid", 1), ("T_R refused", 0)):
+            cells = []
+            for n in names:
+                s = [w["span_s"] for w in goal if w["motor"] == n and w["tr_valid"] == ok]
+                cells.append(f"{_q(s, .5):.3g} / {_q(s, 1):.3g}" if s else "–")
+            L.append(f"| {label} | " + " | ".join(cells) + " |")
+        L.append("")
+
     ideal = [w for w in rows if w["family"] == "sensors_ideal"]
     if ideal:
         L.append("**Systematic R_S error with ideal sensors** (median %, phase-voltage input: exact "
