@@ -159,6 +159,9 @@ def render(summary, rows, table, meta):
         f"{'writes' if meta['per_param'] else 'does not write'} `tr_valid`/`rs_valid`"
         f"{'' if meta['per_param'] else ' (both judged by `valid`)'}; duty-cycle input "
         f"{'run' if meta['duty'] else 'not run (imest-replay has no `--voltage duty`)'}.\n")
+    if meta.get("not_held"):
+        add(f"Left out, the motor did not hold its operating point (it stalled or reversed): "
+            f"{', '.join(meta['not_held'])}.\n")
     if meta.get("replay_args"):
         add(f"Extra imest-replay options: `{meta['replay_args']}`.\n")
     add("## Summary\n")

@@ -91,19 +91,41 @@ def truth_to(csv_path, out_path, lf):
     return None if r.returncode == 0 else "truth averaging failed"
 
 
+NOT_HELD = "not held"  # run_point's answer when the motor left its operating point
+
+
+def held(p, truth_path):
+    """Whether the recording kept its operating point: every window's mean speed positive and
+    within 20 % of synchronous speed of the planned one. A drive that stalls (a small motor at
+    5 % frequency under full load with dead time: the rotor reverses and the load runs it away)
+    is not an operating point to estimate at."""
+    m = motor_of(p)
+    w_sync = 2.0 * 3.141592653589793 * p["f_hz"] / motors.constants(m)["np"]
+    with open(truth_path) as f:
+        next(f)
+        speeds = [float(line.split(",")[3]) for line in f if line.strip()]
+    return bool(speeds) and all(w > 0.0 and abs(w - p["speed_rad_s"]) <= 0.2 * w_sync for w in speeds)
+
+
 def run_point(p, sim, replay, work, duration_s, extra_replay=(), keep=False):
     """Simulate and replay one point into work/<name>.{replay,truth}.csv; returns an error
-    message or None."""
+    message, NOT_HELD (nothing replayed), or None."""
     name = p["name"]
     csv_path = os.path.join(work, name + ".sim.csv")
     log = os.path.join(work, name + ".log")
+    truth = os.path.join(work, name + ".truth.csv")
     with open(log, "w") as lf:
-        err = (simulate(sim, sim_args(p, duration_s), csv_path, lf) or
-               replay_to(replay, replay_args(p, extra_replay), csv_path,
-                         os.path.join(work, name + ".replay.csv"), lf) or
-               truth_to(csv_path, os.path.join(work, name + ".truth.csv"), lf))
-    if err:
+        err = simulate(sim, sim_args(p, duration_s), csv_path, lf) or truth_to(csv_path, truth, lf)
+        if not err and not held(p, truth):
+            for path in (truth, os.path.join(work, name + ".replay.csv")):
+                if os.path.exists(path):
+                    os.remove(path)
+            err = NOT_HELD
+        elif not err:
+            err = replay_to(replay, replay_args(p, extra_replay), csv_path,
+                            os.path.join(work, name + ".replay.csv"), lf)
+    if err and err != NOT_HELD:
         return f"{err}, see {log}"
-    if not keep:
+    if not keep and os.path.exists(csv_path):
         os.remove(csv_path)
-    return None
+    return err
