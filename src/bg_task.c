@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "bg_combine.h"
 #include "bg_noise.h"
 #include "bg_validity.h"
 
@@ -52,6 +53,29 @@ int imest_background(imest_t *s, imest_result_t *out)
   bg_noise_subtract(&sums, &nz, m);
   out->noise_i_a = sqrt(nz.var_i);
   out->noise_u_v = sqrt(nz.var_u);
+  /* Too little information in the window before (poorly determined, nothing
+   * else wrong) and this one steady and clean: solve the windows together
+   * (bg_combine.c), the span grows by this window. */
+  const unsigned int dirty = w->flags & (IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ADC_SAT |
+                                         IMEST_FLAG_ENCODER_FAULT | IMEST_FLAG_WARMUP | IMEST_FLAG_OVERRUN);
+  double e_c0 = nz.e_c0, noise_share = 1.0;
+  /* A window joins only if it fits the estimate it is centred on: its
+   * residual there, the noise's share taken out, within the residual bound
+   * (a window with a plausible spike would spoil every later combination). */
+  const int fits = sums.centred && sums.ree <= (double)s->max_ei * (double)s->max_ei * ry_raw;
+  const int combined = s->combo.n > 0u && s->combo.n < BG_COMBINE_MAX && steady && !dirty && fits;
+  if (combined) {
+    bg_combine_add(&s->combo, &sums, nz.e_c0, ry_raw, w->samples);
+    bg_combine_sums(&s->combo, m, &sums);
+    e_c0 = s->combo.e_c0;
+    noise_share = (double)s->combo.samples / (double)(w->samples ? w->samples : 1u);
+    out->span_s = (double)s->combo.samples / (double)s->fs;
+    out->windows = (unsigned int)s->combo.n;
+    out->flags |= IMEST_FLAG_COMBINED;
+  } else {
+    s->combo.n = 0u;
+  }
+  const double ry_all = combined ? s->combo.ry_raw : ry_raw;
   bg_solve_out_t so = {0};
   so.status = IMEST_REASON_NUMERIC;
   so.tr_s = NAN;
@@ -63,7 +87,7 @@ int imest_background(imest_t *s, imest_result_t *out)
     cfg.tr_min_s = (double)s->tr_min_s;
     cfg.tr_max_s = (double)s->tr_max_s;
     cfg.weight_c = bg_solve_weight_c(&sums); /* speed-normalised cost (bg_solve.h) */
-    cfg.e_noise = nz.e_c0;
+    cfg.e_noise = e_c0;
     (void)bg_solve(&sums, &cfg, &so);
   }
 
@@ -76,10 +100,10 @@ int imest_background(imest_t *s, imest_result_t *out)
      * part the noise explains */
     const double k1 = so.k1, k2 = so.k2;
     const double kv[8] = {k1, k2, k2 * k2, k1 * k2, 1.0 / k2, k1 / k2, k1 / (k2 * k2), 1.0 / (k2 * k2)};
-    const double e_noise = fmax(0.0, bg_noise_e(&nz, kv, m));
+    const double e_noise = fmax(0.0, bg_noise_e(&nz, kv, m)) * noise_share;
     out->e = so.e + nz.scale * e_noise;
-    out->e_i = sqrt(out->e / ry_raw);
-    out->e_i_noise = sqrt(e_noise / ry_raw);
+    out->e_i = sqrt(out->e / ry_all);
+    out->e_i_noise = sqrt(e_noise / ry_all);
     out->hessian[0][0] = so.hessian[0][0];
     out->hessian[0][1] = so.hessian[0][1];
     out->hessian[1][0] = so.hessian[1][0];
@@ -107,7 +131,14 @@ int imest_background(imest_t *s, imest_result_t *out)
   for (unsigned int k = 0; k < out->n_roots && k < IMEST_MAX_ROOTS; ++k) {
     out->roots_k2[k] = so.roots_k2[k];
   }
-  bg_judge(s, &st, &so, out);
+  bg_judge(s, w, &st, &sums, &so, steady, out);
+  /* A combination goes on while it is poorly determined, steady and clean,
+   * up to BG_COMBINE_MAX windows; a window poorly determined alone starts one. */
+  if (out->tr_valid || !steady || dirty || !fits || out->tr_reason != IMEST_REASON_POORLY_DETERMINED ||
+      s->combo.n >= BG_COMBINE_MAX)
+    s->combo.n = 0u;
+  else if (!combined)
+    bg_combine_add(&s->combo, &sums, nz.e_c0, ry_raw, w->samples);
 
   /* centre later windows on the latest trusted estimate */
   if (out->valid) {

@@ -7,6 +7,7 @@
 
 /* Fills valid/status and the per-parameter verdicts of r from the window
  * flags, the window's statistics and the solve. */
-void bg_judge(const imest_t *s, const bg_window_stats_t *st, const bg_solve_out_t *so, imest_result_t *r);
+void bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, const bg_sums_t *sm,
+              const bg_solve_out_t *so, int steady, imest_result_t *r);
 
 #endif /* IMEST_BG_VALIDITY_H */

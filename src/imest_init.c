@@ -48,7 +48,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->inverter.uncertainty = -1.0f; /* unknown until the user (or commissioning) says */
   cfg->rs_tolerance = 0.05f;
   cfg->u_uncertainty_v = 0.0f;
-  cfg->timing_uncertainty_s = 2.0e-6f;
+  cfg->timing_uncertainty_s = 1.0e-6f;
   cfg->rs_nominal_ohm = 0.0f;
 }
 
@@ -340,6 +340,7 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   s->u_uncertainty_v = cfg->u_uncertainty_v;
   s->timing_uncertainty_s = cfg->timing_uncertainty_s;
   s->rs_nominal_ohm = cfg->rs_nominal_ohm;
+  s->tr_nominal_known = cfg->tr_nominal_known != 0;
   s->inverter = cfg->inverter;
   s->pwm_hz = cfg->pwm_hz > 0.0f ? cfg->pwm_hz : cfg->fs_hz;
 

@@ -244,6 +244,7 @@ int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a, f
   /* the limits apply to whatever quantities the caller passes */
   const int in_range = (isr_abs(ia) < s->i_lim) & (isr_abs(ib) < s->i_lim) & (isr_abs(ua) < s->u_lim) &
                        (isr_abs(ub) < s->u_lim);
+  s->duty_input = 0u;
   return isr_step(s, ua, ub, ia, ib, RL(0), (imest_real_t)theta_rad,
                   (in_range ? ISR_IN_RANGE : 0u) | ISR_U_NOISY);
 }
@@ -261,6 +262,7 @@ int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], fl
   imest_real_t ua, ub, ia, ib;
   isr_clarke(u, &ua, &ub);
   isr_clarke(i, &ia, &ib);
+  s->duty_input = 0u;
   return isr_step(s, ua, ub, ia, ib, (i[0] + i[1]) + i[2], (imest_real_t)theta_rad,
                   (in_range ? ISR_IN_RANGE : 0u) | ISR_U_NOISY);
 }
@@ -304,6 +306,7 @@ int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float
   isr_clarke(step, &sa, &sb);
   ia_ab += m->zoh * sa;
   ib_ab += m->zoh * sb;
+  s->duty_input = 1u;
   return isr_step(s, ua, ub, ia_ab, ib_ab, (ia + ib) + ic, (imest_real_t)theta_rad,
                   in_range ? ISR_IN_RANGE : 0u);
 }

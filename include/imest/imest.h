@@ -238,6 +238,9 @@ typedef struct {
   /* Solve and selection. */
   /** nominal T_R, used for scaling and the first centring (default 0.1 s) */
   float tr_nominal_s;
+  /** nonzero: tr_nominal_s is the motor's own (data sheet L_R / R_R, or commissioning), so an
+   *  estimate outside 0.45 .. 1.5 of it is constants_mismatch (default 0: a guess for scaling) */
+  int tr_nominal_known;
   float tr_min_s; /**< admissible T_R band [s] (default 1 ms .. 10 s) */
   float tr_max_s;
   float rs_min_ohm; /**< admissible R_S band [ohm] (default 0 .. 1e3) */
@@ -257,7 +260,7 @@ typedef struct {
   /** phase-voltage input: uncertainty of the measured voltage's fundamental [V] (default 0: measured
    *  voltages are trusted) */
   float u_uncertainty_v;
-  /** uncertainty of the voltage/current alignment after pwm_timing and u_delay_s [s] (default 2e-6) */
+  /** uncertainty of the voltage/current alignment after pwm_timing and u_delay_s [s] (default 1e-6: an ADC sampling instant) */
   float timing_uncertainty_s;
   /** R_S at ambient temperature, from the data sheet or commissioning (0: unknown, default). A window
    *  whose R_S lies outside what heating explains (0.7 .. 1.8 x this) is constants_mismatch */
@@ -331,6 +334,8 @@ typedef struct {
   double pe_k2_rel;          /**< pe_k2 / K2 */
   double slip_ratio;         /**< slip excitation (slip frequency x tr_nominal_s), see min_slip_ratio */
   double i_rms_a;            /**< rms stator current over the window (alpha/beta amplitude) */
+  double ls_noload_h;        /**< L_S measured in a window at no load (NaN: none); more than 6 % from
+                                  the configured L_S is constants_mismatch from then on */
   unsigned int n_roots;      /**< positive roots of the resultant */
   unsigned int n_admissible; /**< roots with K1 > 0 and T_R in band */
   double roots_k2[IMEST_MAX_ROOTS]; /**< the positive roots, ascending */
@@ -412,6 +417,19 @@ typedef struct {
   uint32_t enabled;          /**< configured (angle_observer_hz >= 0) */
 } imest_angle_t;
 
+/** Consecutive windows' sums combined by the background (src/bg_combine.c). */
+typedef struct {
+  double rw[36]; /**< upper triangle of the 8x8 R_W (K form) */
+  double rwy[8], rwe[8];
+  double ry, ree;
+  double e_c0;      /**< the noise's E at the centring, summed */
+  double ry_raw;    /**< R_y before the noise compensation, summed */
+  float c0[8];      /**< the centring of the last window */
+  uint32_t n;       /**< windows combined (0: none) */
+  uint32_t samples; /**< their samples */
+  uint32_t centred; /**< every window had the same centring: rwe, ree hold */
+} imest_combo_t;
+
 /** Estimator instance. All fields are private; sizes are what the ISR needs. */
 typedef struct {
   /* constants derived at init */
@@ -456,12 +474,15 @@ typedef struct {
   float sigma, ls_h, tr_nominal_s, tr_min_s, tr_max_s, rs_min_ohm, rs_max_ohm;
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
   float rs_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
+  uint32_t tr_nominal_known;
+  uint32_t ls_check;         /* L_S measured at no load: 0 not yet, 1 agrees, 2 differs (latched) */
   imest_inverter_t inverter; /* as configured: the R_S verdict weighs its uncertainty */
   float pwm_hz;
   uint32_t duty_input; /* the last window was fed by imest_isr_duty */
   float noise_g[6];    /* the front end's noise gains (bg_noise.h) */
   float w_prev_rad_s;  /* the previous window's mean speed (angle observer) */
   uint32_t w_prev_valid;
+  imest_combo_t combo;    /* windows combined where one has too little information */
   float last_k1, last_k2; /* last valid estimate: centring of later windows */
 } imest_t;
 

@@ -286,7 +286,7 @@ TEST(ReplayInput, InvertedCurrentSignIsNamed)
   EXPECT_EQ(o.code, 0) << o.err;
   EXPECT_EQ(valid_windows(o), 0);
   EXPECT_TRUE(has(o, "the current sign is inverted")) << o.err;
-  EXPECT_TRUE(has(o, "most are no_root: the data contradict the motor model: check the current sign"))
+  EXPECT_TRUE(has(o, "most are wiring_mismatch: the data contradict the conventions: the current sign"))
       << o.err;
 }
 

@@ -123,10 +123,13 @@ const char *replay_remedy(int status)
     return "R_S comes out negative or huge: the voltage scale (phase-to-phase instead of "
            "phase-to-neutral?), the current scale, or --u-delay";
   case IMEST_REASON_WIRING_MISMATCH:
-    return "the data contradict the conventions: the encoder direction, the phase order, "
-           "--pole-pairs, an electrical instead of a mechanical angle, or the units";
+    return "the data contradict the conventions: the current sign (positive into the motor), "
+           "the encoder direction, the phase order, --pole-pairs, an electrical instead of a "
+           "mechanical angle, or the units (A, V, rad)";
   case IMEST_REASON_CONSTANTS_MISMATCH:
-    return "R_S is far from what heating explains around --rs: check --ls, --sigma and --rs";
+    return "the motor constants cannot be this motor's (R_S far from what heating explains "
+           "around --rs, T_R outside its band around a known --tr-nominal, or L_S measured at "
+           "no load 6 % off --ls): check --ls, --sigma, --rs, and line-to-line voltages";
   case IMEST_REASON_RS_UNCERTAIN:
     return "R_S's error bound exceeds --rs-tolerance (T_R may still be valid: see the tr_valid "
            "column). With --voltage duty give the inverter's numbers (--dead-time, --v-switch, "
