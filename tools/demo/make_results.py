@@ -10,7 +10,7 @@ Reads OUT_DIR/raw/ (written by imest-demo and imest-monitor, see tools/demo/READ
   exp1_wave.csv           exp1 waveforms, measured and simulated with the identified parameters
   exp1_identified.csv     which exp1 window gave the identified parameters
 Writes OUT_DIR/{windows.csv, exp1_windows.csv, ifoc_fixed_windows.csv,
-ifoc_adaptive_windows.csv, exp2_avg30.csv, exp2_avg120.csv, fig*.png, summary.md}.
+ifoc_adaptive_windows.csv, ifoc11_*_windows.csv, exp2_avg30.csv, exp2_avg120.csv, fig*.png, summary.md}.
 Plots with matplotlib's Agg backend (Debian python3-matplotlib).
 """
 import csv
@@ -25,9 +25,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-EXPS = ["exp1", "exp2", "ifoc_fixed", "ifoc_adaptive"]
+EXPS = ["exp1", "exp2", "ifoc_fixed", "ifoc_adaptive", "ifoc11_fixed", "ifoc11_adaptive"]
 WIN_FILE = {"exp2": "windows.csv", "exp1": "exp1_windows.csv",
-            "ifoc_fixed": "ifoc_fixed_windows.csv", "ifoc_adaptive": "ifoc_adaptive_windows.csv"}
+            "ifoc_fixed": "ifoc_fixed_windows.csv", "ifoc_adaptive": "ifoc_adaptive_windows.csv",
+            "ifoc11_fixed": "ifoc11_fixed_windows.csv", "ifoc11_adaptive": "ifoc11_adaptive_windows.csv"}
 RATED_TORQUE = 2.064
 GREY = "0.55"
 # The demo's set-up (tools/demo/demo.c, imsim's defaults and the paper's motor): the
@@ -39,6 +40,17 @@ FILTER_HZ = 100.0          # imest's front-end Butterworth
 ALIAS_ZONE_HZ = 200.0      # encoder pattern below this: R_S biased (tools/demo/README.md)
 POLE_PAIRS = 2
 LR_H = 0.2908
+# The IFOC pairs: the paper's motor (fig11) and the 11 kW drive at half load (fig12; imsim
+# preset 11kw, heating 6x faster over a sixth of the duration: tools/demo/demo.c).
+IFOC_PAIRS = [
+    dict(fixed="ifoc_fixed", adaptive="ifoc_adaptive", fig="fig11_ifoc_closed_loop.png",
+         rated=RATED_TORQUE, lr=LR_H, np=POLE_PAIRS, time_x=1.0,
+         title="the heat run (30 Hz / 850 r/min, 2.064 N m)", motor="the paper's motor"),
+    dict(fixed="ifoc11_fixed", adaptive="ifoc11_adaptive", fig="fig12_ifoc_11kw.png",
+         rated=72.0, lr=0.078331, np=2, time_x=6.0,
+         title="an 11 kW drive (rated speed, 36 N m = half load; heating 6x faster, time scaled)",
+         motor="the 11 kW drive at half load"),
+]
 
 # What each verdict means, for the summary (README, "When is a window valid").
 REASON_TEXT = {
@@ -459,7 +471,7 @@ def fig_exp1(out, wave, ident, exp1rows):
     return files, rel
 
 
-def detuning_ratio(a):
+def detuning_ratio(a, lr=LR_H, n_p=POLE_PAIRS):
     """T_e / T_e,ref of an IFOC whose T_R is off, in steady state with ideal current control.
 
     The controller commands i_d = psi_ref / M and i_q = T_ref L_R / (n_p M psi_ref) and the
@@ -468,11 +480,11 @@ def detuning_ratio(a):
     T_e / T_ref = k (1 + r^2) / (k^2 + r^2): above 1 while 1 < k < r^2, 1 at k = r^2, below
     1 beyond. Returns (ratio, k, r)."""
     k = a["ifoc_T_R_s"] / a["T_R_true_s"]
-    r = a["torque_ref_nm"] * LR_H / (POLE_PAIRS * a["psi_ref_wb"] ** 2)
+    r = a["torque_ref_nm"] * lr / (n_p * a["psi_ref_wb"] ** 2)
     return k * (1 + r ** 2) / (k ** 2 + r ** 2), k, r
 
 
-def torque_sign_change(a):
+def torque_sign_change(a, lr=LR_H, n_p=POLE_PAIRS):
     """First sign change (after start-up) of the 1-min smoothed torque error: (t_s, k, r^2)."""
     e = a["torque_nm"] - a["torque_ref_nm"]
     sel = np.isfinite(e) & (a["t_end_s"] > 60)
@@ -486,7 +498,7 @@ def torque_sign_change(a):
     if len(z) == 0:
         return None
     i = int(np.argmin(np.abs(a["t_end_s"] - tt[z[0]])))
-    _, k, r = detuning_ratio(a)
+    _, k, r = detuning_ratio(a, lr, n_p)
     return a["t_end_s"][i], float(k[i]), float(r[i] ** 2)
 
 
@@ -498,16 +510,17 @@ def sym_ylim(ax, ys, min_half):
     ax.set_ylim(min(lo - pad, -min_half), max(hi + pad, min_half))
 
 
-def fig_closed_loop(path, fx, ad):
+def fig_closed_loop(path, fx, ad, pair=IFOC_PAIRS[0]):
+    rated, tx = pair["rated"], pair["time_x"]
     fig, axs = plt.subplots(4, 1, figsize=(10, 11.5), sharex=True)
     # current relative to the tuned drive: the adaptive run's mean after start-up
     i0 = float(np.nanmean(ad["i_phase_rms_a"][ad["t_end_s"] > 5]))
     after = {}
     for a, name, col in ((fx, "IFOC, $T_R$ fixed at the cold value", "tab:red"),
                          (ad, "IFOC, $T_R$ from the estimator", "tab:green")):
-        t = a["t_end_s"] / 60.0
+        t = tx * a["t_end_s"] / 60.0
         sel = a["t_end_s"] > 5  # the start-up transient would dwarf the hour
-        te = 100.0 * (a["torque_nm"] - a["torque_ref_nm"]) / RATED_TORQUE
+        te = 100.0 * (a["torque_nm"] - a["torque_ref_nm"]) / rated
         fe = 100.0 * (a["psi_r_wb"] / a["psi_ref_wb"] - 1.0)
         di = 100.0 * (a["i_phase_rms_a"] / i0 - 1.0)
         axs[0].plot(t[sel], te[sel], lw=1.0, color=col, label=name)
@@ -515,28 +528,28 @@ def fig_closed_loop(path, fx, ad):
         axs[2].plot(t[sel], di[sel], lw=1.0, color=col, label=name)
         axs[3].plot(t, a["ifoc_T_R_s"], lw=1.0, color=col, label="controller's $T_R$: " + name.split(", ")[1])
         after[id(a)] = (te[sel], fe[sel], di[sel])
-    ratio, k, r = detuning_ratio(fx)
+    ratio, k, r = detuning_ratio(fx, pair["lr"], pair["np"])
     sel = fx["t_end_s"] > 5
-    axs[0].plot(fx["t_end_s"][sel] / 60.0,
-                (100.0 * fx["torque_ref_nm"] * (ratio - 1.0) / RATED_TORQUE)[sel], "k--", lw=1.0,
+    axs[0].plot(tx * fx["t_end_s"][sel] / 60.0,
+                (100.0 * fx["torque_ref_nm"] * (ratio - 1.0) / rated)[sel], "k--", lw=1.0,
                 label=r"steady-state detuning: $T_{ref}\,(k(1+r^2)/(k^2+r^2) - 1)$, "
                       r"$k = T_{R,ctrl}/T_R$, $r = i_q/i_d$")
-    sc = torque_sign_change(fx)
+    sc = torque_sign_change(fx, pair["lr"], pair["np"])
     if sc is not None:
-        axs[0].axvline(sc[0] / 60.0, color="0.4", lw=0.8, ls=":")
+        axs[0].axvline(tx * sc[0] / 60.0, color="0.4", lw=0.8, ls=":")
         # the data are above zero before the change and below after: the text goes below-left
-        axs[0].annotate(f"sign change at {sc[0] / 60:.1f} min:\n$k$ = {sc[1]:.3f} $\\approx$ $r^2$ = {sc[2]:.3f}",
-                        xy=(sc[0] / 60.0, 0), xytext=(-170, -50), textcoords="offset points", fontsize=8,
+        axs[0].annotate(f"sign change at {tx * sc[0] / 60:.1f} min:\n$k$ = {sc[1]:.3f} $\\approx$ $r^2$ = {sc[2]:.3f}",
+                        xy=(tx * sc[0] / 60.0, 0), xytext=(-170, -50), textcoords="offset points", fontsize=8,
                         arrowprops=dict(arrowstyle="->", color="0.3", lw=0.8),
                         bbox=dict(fc="white", ec="0.8", alpha=0.9))
-    axs[3].plot(ad["t_end_s"] / 60.0, ad["T_R_true_s"], "k-", lw=1.2, label="true $T_R$ (adaptive run)")
-    axs[3].plot(fx["t_end_s"] / 60.0, fx["T_R_true_s"], "k:", lw=1.2, label="true $T_R$ (fixed run)")
-    axs[0].set_ylabel("torque error\n$(T_e - T_{e,ref})$ / 2.064 N m [%]")
+    axs[3].plot(tx * ad["t_end_s"] / 60.0, ad["T_R_true_s"], "k-", lw=1.2, label="true $T_R$ (adaptive run)")
+    axs[3].plot(tx * fx["t_end_s"] / 60.0, fx["T_R_true_s"], "k:", lw=1.2, label="true $T_R$ (fixed run)")
+    axs[0].set_ylabel(f"torque error\n$(T_e - T_{{e,ref}})$ / {rated:g} N m [%]")
     axs[1].set_ylabel("rotor-flux error\n$|\\psi_R|/\\psi_{ref} - 1$ [%]")
     axs[2].set_ylabel(f"stator current\nchange [%] of {i0:.3f} A rms")
     axs[3].set_ylabel("$T_R$ [s]")
-    axs[3].set_xlabel("time [min]")
-    axs[0].set_title("Beyond the paper: the heat run (30 Hz / 850 r/min, 2.064 N m) under IFOC speed control\n"
+    axs[3].set_xlabel("time [min]" if tx == 1.0 else f"heating time [min] (= motor time x {tx:g})")
+    axs[0].set_title(f"Beyond the paper: {pair['title']} under IFOC speed control\n"
                      "(1-s window means from t = 5 s; the speed loop holds $T_e$ at the load, so the reference "
                      "absorbs the detuning)", fontsize=10)
     for ax in axs:
@@ -601,25 +614,52 @@ def encoder_section(res):
     ]
 
 
-def ifoc_section(fx, ad):
-    md = ["## Beyond the paper: IFOC heat run, controller T_R fixed vs from the estimator\n",
-          "Torque error = electromagnetic torque - controller's torque reference (1-s means), in % of "
-          "the rated 2.064 N m; flux error = |psi_R| / psi_ref - 1. 'whole run' = t > 5 s (after "
-          "start-up); 'last 5 min' = the end of the heat run. The controller's T_R follows every "
-          "valid window (imest-demo).\n",
-          "| run | span | mean abs torque err [% rated] | max abs torque err [% rated] | mean flux err % "
+def ifoc11_section(fx, ad, pair):
+    """The IFOC pair on the 11 kW drive: the table of ifoc_section and one summary line."""
+    md = [f"## Beyond the paper's motor: IFOC on {pair['motor']}, controller T_R fixed vs from the "
+          "estimator\n",
+          "imsim preset 11kw (8 kHz PWM drive with firmware timing, 16384-count encoder, 12-bit ADCs of "
+          "+-75 A), speed loop to rated speed from rest, 36 N m (half load) from 2.5 s; copper heating "
+          f"{pair['time_x']:g}x faster over 1/{pair['time_x']:g} of the duration, so the rotor warms as in "
+          "the heat run; the estimator as for the paper's motor with this motor's L_S, sigma and 8 kHz "
+          f"(fig12). Spans in motor time; torque error in % of the rated {pair['rated']:g} N m.\n"]
+    md += ifoc_table(fx, ad, pair["rated"], last_s=300.0 / pair["time_x"])
+    last = []
+    for a in (fx, ad):
+        sel = a["t_end_s"] > a["t_end_s"][-1] - 300.0 / pair["time_x"]
+        last.append(float(np.nanmean(np.abs(a["torque_nm"] - a["torque_ref_nm"])[sel])) * 100 / pair["rated"])
+    nv, n = int(ad["tr_valid"][ad["t_end_s"] > 5].sum()), int((ad["t_end_s"] > 5).sum())
+    md.append(f"ifoc11: mean |torque error| at the end {last[0]:.3f} % of rated with T_R fixed, "
+              f"{last[1]:.3f} % with T_R from imest; T_R valid in {nv} of {n} windows"
+              + (" (no valid window: the adaptive run keeps the cold T_R, as the fixed one)" if nv == 0 else "")
+              + ".\n")
+    return md
+
+
+def ifoc_table(fx, ad, rated, last_s=300.0):
+    md = ["| run | span | mean abs torque err [% rated] | max abs torque err [% rated] | mean flux err % "
           "| stator current [A rms] | controller T_R [s] | true T_R [s] | T_R valid windows |",
           "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
     for a, label in ((fx, "T_R fixed (cold)"), (ad, "T_R from imest")):
         tend = a["t_end_s"][-1]
         for span, sel in (("whole run", a["t_end_s"] > 5),
-                          ("last 5 min", a["t_end_s"] > max(tend - 300, 5))):
-            te = 100 * np.abs(a["torque_nm"] - a["torque_ref_nm"])[sel] / RATED_TORQUE
+                          (f"last {last_s / 60:.3g} min", a["t_end_s"] > max(tend - last_s, 5))):
+            te = 100 * np.abs(a["torque_nm"] - a["torque_ref_nm"])[sel] / rated
             fe = 100 * (a["psi_r_wb"] / a["psi_ref_wb"] - 1)[sel]
             md.append(f"| {label} | {span} | {np.nanmean(te):.3f} | {np.nanmax(te):.3f} | {np.nanmean(fe):+.2f} "
                       f"| {np.nanmean(a['i_phase_rms_a'][sel]):.3f} | {np.nanmean(a['ifoc_T_R_s'][sel]):.4f} "
                       f"| {np.nanmean(a['T_R_true_s'][sel]):.4f} | {int(a['tr_valid'][sel].sum())} / {int(sel.sum())} |")
     md.append("")
+    return md
+
+
+def ifoc_section(fx, ad):
+    md = ["## Beyond the paper: IFOC heat run, controller T_R fixed vs from the estimator\n",
+          "Torque error = electromagnetic torque - controller's torque reference (1-s means), in % of "
+          "the rated 2.064 N m; flux error = |psi_R| / psi_ref - 1. 'whole run' = t > 5 s (after "
+          "start-up); 'last 5 min' = the end of the heat run. The controller's T_R follows every "
+          "valid window (imest-demo).\n"]
+    md += ifoc_table(fx, ad, RATED_TORQUE)
     i0 = float(np.nanmean(ad["i_phase_rms_a"][ad["t_end_s"] > 5]))
     di = 100 * (fx["i_phase_rms_a"] / i0 - 1)
     te_ad = (100 * (ad["torque_nm"] - ad["torque_ref_nm"]) / RATED_TORQUE)[ad["t_end_s"] > 5]
@@ -790,9 +830,10 @@ def main(argv):
                  "T_R_s": fnum(ir["T_R_s"]), "R_S_ohm": fnum(ir["R_S_ohm"]), "source": ir["source"]}
         f, exp1_rel = fig_exp1(out, wave, ident, res["exp1"]["a"])
         figs = f + figs
-    if "ifoc_fixed" in res and "ifoc_adaptive" in res:
-        figs.append(os.path.join(out, "fig11_ifoc_closed_loop.png"))
-        fig_closed_loop(figs[-1], res["ifoc_fixed"]["a"], res["ifoc_adaptive"]["a"])
+    for pair in IFOC_PAIRS:
+        if pair["fixed"] in res and pair["adaptive"] in res:
+            figs.append(os.path.join(out, pair["fig"]))
+            fig_closed_loop(figs[-1], res[pair["fixed"]]["a"], res[pair["adaptive"]]["a"], pair)
 
     # ---------------- summary
     md.append("# imest demo: results\n")
@@ -887,10 +928,14 @@ def main(argv):
         md.append("")
     if "ifoc_fixed" in res and "ifoc_adaptive" in res:
         md += ifoc_section(res["ifoc_fixed"]["a"], res["ifoc_adaptive"]["a"])
+    p11 = IFOC_PAIRS[1]
+    if p11["fixed"] in res and p11["adaptive"] in res:
+        md += ifoc11_section(res[p11["fixed"]]["a"], res[p11["adaptive"]]["a"], p11)
     md.append("## Files\n")
     md.append("- `windows.csv`: exp. 2, one row per 1-s window (values as decoded from the CAN log; "
               "`via_can` = 1), truth, drive state; `exp1_windows.csv`, `ifoc_fixed_windows.csv`, "
-              "`ifoc_adaptive_windows.csv`: the same for the other runs")
+              "`ifoc_adaptive_windows.csv`, `ifoc11_fixed_windows.csv`, `ifoc11_adaptive_windows.csv`: "
+              "the same for the other runs")
     md.append("- `exp2_avg30.csv`, `exp2_avg120.csv`: 30-s / 120-s averages of the valid 1-s estimates")
     md.append("- figures: " + ", ".join(f"`{os.path.basename(f)}`" for f in figs))
     md.append("- `raw/`: CAN logs (`<exp>.candump.log`), imest-monitor output (`<exp>_monitor.csv`, "

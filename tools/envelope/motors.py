@@ -1,0 +1,127 @@
+"""The motors of the envelope benchmark and the supply voltage of each operating point.
+
+Each motor runs on the drive the simulator's presets model (PWM inverter, space-vector
+modulation, firmware timing, one sample per 8 kHz carrier period, 12-bit sensors with ranges of
+about 2.5x the rated peak current). Where a motor has no preset of its own it is given to
+imest-sim as overrides of the 4kw preset (its drive), with its own sensor ranges and bus.
+
+The supply of an operating point (frequency, load torque) is a sine of the voltage that keeps
+the rotor flux at its rated value: the ideal IR-compensated V/f of a drive. A plain linear V/f
+would weaken the field at low frequency (the stator resistance drop) and stall the small motors
+at 5 % of rated frequency under load.
+"""
+import cmath
+import math
+
+# name, kW, sim preset, extra imest-sim flags, rated V_ll [V] at rated f [Hz], rated torque [N m],
+# bus [V], source. Motor constants in the flags are the simulator's (L_S, L_R, sigma, R_S, T_R).
+MOTORS = [
+    dict(name="0.4kw", kw=0.37, preset="4kw",
+         flags="--pole-pairs 2 --ls 0.2908 --lr 0.2908 --sigma 0.096 --rs 5.04 --tr 0.12 "
+               "--j 1.2e-3 --b 1e-4 --i-range 6 --u-range 250",
+         vll=230.0, f=60.0, t_nm=2.064, vdc=340.0,
+         source="the paper's motor (Wang et al. 2007; J and b assumed as in sim/), on a 340 V bus"),
+    dict(name="2.2kw", kw=2.2, preset="4kw",
+         flags="--pole-pairs 2 --ls 0.245 --lr 0.224 --sigma 0.085714 --rs 3.7 --tr 0.106667 "
+               "--j 0.015 --b 9.7e-4 --i-range 18",
+         vll=390.0, f=50.0, t_nm=14.6, vdc=560.0,
+         source="2.2 kW, 400 V, 50 Hz, 5 A, 14.6 N m: the inverse-Gamma parameters of the "
+                "induction machine in the open-source drive simulator motulator (Aalto "
+                "University): R_s 3.7, R_R 2.1 ohm, L_sgm 21 mH, L_M 224 mH, J 0.015 kg m^2 "
+                "(b assumed 1 % of rated power)"),
+    dict(name="4kw", kw=4.0, preset="4kw", flags="", vll=390.0, f=50.0, t_nm=26.5, vdc=560.0,
+         source="sim preset 4kw (Simscape 5 HP 400 V 50 Hz)"),
+    dict(name="11kw", kw=11.0, preset="11kw", flags="", vll=390.0, f=50.0, t_nm=72.0, vdc=560.0,
+         source="sim preset 11kw (a set common in simulation studies; origin not traced)"),
+    dict(name="37kw", kw=37.0, preset="37kw", flags="", vll=390.0, f=50.0, t_nm=240.0, vdc=560.0,
+         source="sim preset 37kw (Simscape 50 HP 400 V 50 Hz)"),
+    dict(name="75kw", kw=75.0, preset="75kw", flags="", vll=390.0, f=50.0, t_nm=485.0, vdc=560.0,
+         source="sim preset 75kw (Simscape 100 HP 400 V 50 Hz), standing in for 55 kW"),
+]
+
+# Constants of the presets, as sim/src/motors.c converts them (T equivalent -> L_S, sigma, T_R).
+_PRESET = {
+    "4kw": (1.405, 1.395, 5.839e-3, 172.2e-3, 26.5, 4000.0),
+    "11kw": (0.2761, 0.1645, 2.191e-3, 76.14e-3, 72.0, 11000.0),
+    "37kw": (0.08233, 0.0503, 0.724e-3, 27.11e-3, 240.0, 37000.0),
+    "75kw": (0.03552, 0.02092, 0.335e-3, 15.1e-3, 485.0, 75000.0),
+}
+
+
+def _flag(flags, name):
+    toks = flags.split()
+    return float(toks[toks.index(name) + 1]) if name in toks else None
+
+
+def constants(m):
+    """Motor constants (n_p, L_S, L_R, sigma, R_S, T_R, b) of a motor of MOTORS."""
+    if m["flags"]:
+        f = m["flags"]
+        return dict(np=int(_flag(f, "--pole-pairs")), ls=_flag(f, "--ls"), lr=_flag(f, "--lr"),
+                    sigma=_flag(f, "--sigma"), rs=_flag(f, "--rs"), tr=_flag(f, "--tr"),
+                    b=_flag(f, "--b"))
+    rs, rr, lls, lm, t_nm, p_w = _PRESET[m["preset"]]
+    l = lm + lls
+    wn = p_w / t_nm
+    return dict(np=2, ls=l, lr=l, sigma=1.0 - lm * lm / (l * l), rs=rs, tr=l / rr,
+                b=0.01 * p_w / (wn * wn))
+
+
+def _point(c, psi, f_hz, load_nm, phasors=False):
+    """Stator voltage (alpha-beta amplitude = V_ll rms), current and speed of the steady state
+    with rotor flux psi, electrical frequency f_hz and load torque load_nm (friction added)."""
+    we = 2.0 * math.pi * f_hz
+    m_h = math.sqrt((1.0 - c["sigma"]) * c["ls"] * c["lr"])
+    wm = we / c["np"]
+    for _ in range(50):  # T_e = load + b w: fixed point in the speed (b is tiny)
+        te = load_nm + c["b"] * wm
+        wsl = te * c["lr"] / (c["np"] * psi * psi * c["tr"])
+        wm_new = (we - wsl) / c["np"]
+        if abs(wm_new - wm) < 1e-12 * max(1.0, abs(wm)):
+            break
+        wm = wm_new
+    i = psi * (1.0 + 1j * wsl * c["tr"]) / m_h
+    # u = sigma L_S di/dt + R_S i + (M/L_R) dpsi/dt in the stator frame (steady rotation at we):
+    # the stator equation of the model, di/dt = u/(sigma L_S) - gamma i + beta (1/T_R - j n w) psi
+    sls = c["sigma"] * c["ls"]
+    gamma = c["rs"] / sls + (1.0 - c["sigma"]) / (c["sigma"] * c["tr"])
+    beta = m_h / (sls * c["lr"])
+    u = sls * (1j * we * i + gamma * i - beta * (1.0 / c["tr"] - 1j * c["np"] * wm) * psi)
+    return (u, i, wm) if phasors else (abs(u), abs(i), wm)
+
+
+def rated_flux(m):
+    """Rotor flux of the motor at its rated voltage, frequency and torque (bisection)."""
+    c = constants(m)
+    lo, hi = 1e-3, 10.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        v, _, _ = _point(c, mid, m["f"], m["t_nm"])
+        lo, hi = (mid, hi) if v < m["vll"] else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def operating_point(m, f_pct, load_pct, inv=None, vdc=560.0, f_carrier=8000.0):
+    """(f_hz, V_ll, load_nm, i_ab, speed_rad_s) at f_pct % of rated frequency and load_pct % of
+    rated torque, with the rotor flux at its rated value; i_ab is the alpha-beta current
+    amplitude (sqrt 3 x the phase rms).
+
+    With inv (dead_time, v_switch, r_switch, v_diode, r_diode) the commanded voltage also makes
+    up the inverter's mean voltage error, as a drive that holds its flux does: per leg a
+    square wave of t_d f_c V_dc + the drop, in phase with the current, whose fundamental is
+    4/pi of it (sqrt(3/2) x that in alpha-beta), plus the slope times the current. Without
+    it a 3 us dead time stalls the small motors at 10 Hz under full load."""
+    c = constants(m)
+    psi = rated_flux(m)
+    f_hz = m["f"] * f_pct / 100.0
+    load = m["t_nm"] * load_pct / 100.0
+    u, i, wm = _point(c, psi, f_hz, load, phasors=True)
+    if inv:
+        e = inv["dead_time"] * f_carrier * vdc + 0.5 * (inv["v_switch"] + inv["v_diode"])
+        r = 0.5 * (inv["r_switch"] + inv["r_diode"])
+        u = u + (math.sqrt(1.5) * 4.0 / math.pi * e / abs(i) + r) * i
+    return f_hz, abs(u), load, abs(i), wm
+
+
+def rated_current(m):
+    return operating_point(m, 100.0, 100.0)[3]

@@ -1,0 +1,94 @@
+"""The sampling design of the envelope benchmark: which operating points are simulated.
+
+A full factorial (6 motors x 8 frequencies x 6 loads x 3 sensor sets x 4 encoders x inputs) is
+about 7000 recordings; the design keeps what the goals need:
+
+* grid: every motor x frequency (5..100 % of rated) x load (10..150 % of rated torque) with the
+  goal sensors (12-bit ADCs with 1 LSB noise, 16384-count encoder, phase-voltage input). Its
+  part with load >= 25 % and frequency >= 15 % is the goal region, sampled on every point.
+* sweeps: one dimension at a time away from the goal sensors (ideal or 16-bit ADCs; 1024, 4096
+  or 65536 counts; the duty-cycle input with an ideal inverter and with dead time and device
+  drops whose model is given), each on a sub-grid of every motor x 4 frequencies x 3 loads
+  that reaches the envelope's corners (5 % frequency, 10 % load).
+
+The reduced form (CTest) is a handful of points from both.
+"""
+import motors
+
+FREQS = [5, 10, 15, 25, 40, 60, 80, 100]      # % of rated electrical frequency
+LOADS = [10, 25, 50, 75, 100, 150]            # % of rated torque
+SWEEP_FREQS = [5, 15, 40, 100]
+SWEEP_LOADS = [10, 25, 100]
+GOAL = dict(sensors="12bit", encoder=16384, input="phase")
+
+# One-at-a-time variants around the goal sensors: (family, changes)
+SWEEPS = [
+    ("sensors_ideal", dict(sensors="ideal")),
+    ("sensors_16bit", dict(sensors="16bit")),
+    ("encoder_1024", dict(encoder=1024)),
+    ("encoder_4096", dict(encoder=4096)),
+    ("encoder_65536", dict(encoder=65536)),
+    ("duty_ideal", dict(input="duty")),
+    ("duty_inverter", dict(input="duty_inv")),
+]
+
+# Dead time and device drops of the duty_inv variant (an IGBT inverter), given to the estimator.
+INVERTER = dict(dead_time=2e-6, v_switch=1.0, r_switch=0.02, v_diode=0.8, r_diode=0.01)
+
+
+def in_goal(p):
+    return (p["sensors"] == GOAL["sensors"] and p["encoder"] == GOAL["encoder"] and
+            p["input"] == GOAL["input"] and p["load_pct"] >= 25 and p["f_pct"] >= 15)
+
+
+def _point(family, m, f_pct, load_pct, **kw):
+    p = dict(family=family, motor=m["name"], f_pct=f_pct, load_pct=load_pct)
+    p.update(GOAL)
+    p.update(kw)
+    return p
+
+
+def design(full=True):
+    """List of operating points (dicts), each a recording."""
+    pts = []
+    if full:
+        for m in motors.MOTORS:
+            for f in FREQS:
+                for ld in LOADS:
+                    pts.append(_point("grid", m, f, ld))
+        for fam, ch in SWEEPS:
+            for m in motors.MOTORS:
+                for f in SWEEP_FREQS:
+                    for ld in SWEEP_LOADS:
+                        pts.append(_point(fam, m, f, ld, **ch))
+    else:
+        mm = {m["name"]: m for m in motors.MOTORS}
+        for name in ("0.4kw", "4kw", "11kw", "37kw", "75kw"):
+            pts.append(_point("grid", mm[name], 60, 50))
+        pts.append(_point("grid", mm["2.2kw"], 100, 100))
+        pts.append(_point("grid", mm["4kw"], 5, 10))
+        pts.append(_point("grid", mm["37kw"], 15, 25))
+        pts.append(_point("encoder_1024", mm["0.4kw"], 40, 100, encoder=1024))
+        pts.append(_point("encoder_4096", mm["11kw"], 100, 100, encoder=4096))
+        pts.append(_point("duty_inverter", mm["4kw"], 40, 25, input="duty_inv"))
+    # drop points the motor cannot run at: slip above the supply frequency (the rotor would
+    # turn backwards: small motors at 5 % frequency and high load)
+    out = []
+    for k, p in enumerate(pts):
+        m = next(x for x in motors.MOTORS if x["name"] == p["motor"])
+        inv = INVERTER if p["input"] == "duty_inv" else None  # the drive makes up its error
+        f_hz, vll, load, i_ab, wm = motors.operating_point(m, p["f_pct"], p["load_pct"], inv, m["vdc"])
+        if wm <= 0.0:
+            continue
+        p.update(f_hz=f_hz, vll=vll, load_nm=load, speed_rad_s=wm, goal=in_goal(p))
+        p["name"] = "{motor}_f{f_pct}_l{load_pct}_{sensors}_e{encoder}_{input}".format(**p)
+        out.append(p)
+    # one recording per name (a sweep point equal to a grid point is simulated once)
+    seen, uniq = set(), []
+    for p in out:
+        if p["name"] not in seen:
+            seen.add(p["name"])
+            uniq.append(p)
+    for k, p in enumerate(uniq):
+        p["seed"] = 1000 + k
+    return uniq

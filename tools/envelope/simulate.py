@@ -1,0 +1,131 @@
+"""One recording of the envelope benchmark: simulate it, replay it, average the truth per window.
+
+The simulator writes a CSV to a temporary file; imest-replay reads it exactly as a user's log;
+an awk pass averages the simulator's truth columns over the replay's windows (window k = data
+rows k*N .. k*N+N-1, N samples per window). The CSV is deleted afterwards.
+"""
+import os
+import subprocess
+
+import motors
+import points
+
+FS_HZ = 8000.0  # the drive presets: one sample per 8 kHz carrier period
+
+TRUTH_AWK = r"""
+NR == 1 { for (j = 1; j <= NF; j++) col[$j] = j; next }
+{ r = NR - 2; k = int(r / N); n[k]++;
+  tr[k] += $col["T_R_true_s"]; rs[k] += $col["R_S_true_ohm"];
+  w[k] += $col["speed_rad_s"]; te[k] += $col["torque_nm"]; ld[k] += $col["load_nm"];
+  if (k > kmax) kmax = k }
+END { print "seq,tr_true_s,rs_true_ohm,speed_rad_s,torque_nm,load_nm,rows";
+      for (k = 0; k <= kmax; k++) if (n[k] == N)
+        printf "%d,%.9g,%.9g,%.7g,%.7g,%.7g,%d\n", k, tr[k]/n[k], rs[k]/n[k], w[k]/n[k],
+               te[k]/n[k], ld[k]/n[k], n[k] }
+"""
+
+
+def motor_of(p):
+    return next(m for m in motors.MOTORS if m["name"] == p["motor"])
+
+
+def sim_args(p, duration_s):
+    m = motor_of(p)
+    # the bus: the motor's, raised where the point needs more than the linear range (0.97 of
+    # V_dc / sqrt 2 with space-vector modulation): 150 % load at rated frequency
+    vdc = max(m["vdc"], p["vll"] * 2 ** 0.5 / 0.97)
+    a = ["--preset", m["preset"]] + m["flags"].split()
+    a += ["--no-thermal", "--start", "steady", "--vdc", f"{vdc:.1f}",
+          "--freq", f"{p['f_hz']:.6g}", "--vll", f"{p['vll']:.6g}", "--load-nm", f"{p['load_nm']:.6g}",
+          "--duration", f"{duration_s:g}", "--seed", str(p["seed"]),
+          "--encoder-counts", str(p["encoder"]), "--no-progress"]
+    if p["sensors"] == "ideal":
+        a.append("--ideal-sensors")
+    elif p["sensors"] == "16bit":
+        a += ["--adc-bits", "16"]
+    if p["input"] == "duty_inv":
+        a += inverter_flags(points.INVERTER)
+    return a
+
+
+def inverter_flags(inv):
+    """--dead-time ... --r-diode: the same flags for imest-sim (the inverter) and imest-replay
+    (its model)."""
+    return ["--dead-time", f"{inv['dead_time']:.6g}", "--v-switch", f"{inv['v_switch']:.6g}",
+            "--r-switch", f"{inv['r_switch']:.6g}", "--v-diode", f"{inv['v_diode']:.6g}",
+            "--r-diode", f"{inv['r_diode']:.6g}"]
+
+
+def replay_args(p, extra=()):
+    c = motors.constants(motor_of(p))
+    a = ["--pole-pairs", str(c["np"]), "--ls", f"{c['ls']:.7g}", "--sigma", f"{c['sigma']:.7g}",
+         "--from-rest", "no", "--quiet"]
+    if p["input"] == "phase":
+        # the phase voltage of the simulated drive is the volt-seconds of the sample period
+        # that just ended: half a sample behind the currents
+        a += ["--u-delay", f"{0.5 / FS_HZ:.9g}"]
+    else:
+        inv = points.INVERTER if p["input"] == "duty_inv" else dict.fromkeys(points.INVERTER, 0.0)
+        a += ["--voltage", "duty"] + inverter_flags(inv)
+    return a + list(extra)
+
+
+def simulate(sim, args, csv_path, lf):
+    """imest-sim ARGS --out CSV; returns an error message or None."""
+    r = subprocess.run([sim] + args + ["--out", csv_path], stdout=lf, stderr=lf)
+    return None if r.returncode == 0 else f"imest-sim failed ({r.returncode})"
+
+
+def replay_to(replay, args, csv_path, out_path, lf):
+    """imest-replay ARGS CSV > OUT; returns an error message or None."""
+    with open(out_path, "w") as out:
+        r = subprocess.run([replay] + args + [csv_path], stdout=out, stderr=lf)
+    return None if r.returncode == 0 else f"imest-replay failed ({r.returncode})"
+
+
+def truth_to(csv_path, out_path, lf):
+    """The simulator's truth averaged over each 1-s window of CSV, into OUT."""
+    with open(out_path, "w") as out:
+        r = subprocess.run(["awk", "-F,", "-v", f"N={int(round(FS_HZ))}", TRUTH_AWK, csv_path],
+                           stdout=out, stderr=lf)
+    return None if r.returncode == 0 else "truth averaging failed"
+
+
+NOT_HELD = "not held"  # run_point's answer when the motor left its operating point
+
+
+def held(p, truth_path):
+    """Whether the recording kept its operating point: every window's mean speed positive and
+    within 20 % of synchronous speed of the planned one. A drive that stalls (a small motor at
+    5 % frequency under full load with dead time: the rotor reverses and the load runs it away)
+    is not an operating point to estimate at."""
+    m = motor_of(p)
+    w_sync = 2.0 * 3.141592653589793 * p["f_hz"] / motors.constants(m)["np"]
+    with open(truth_path) as f:
+        next(f)
+        speeds = [float(line.split(",")[3]) for line in f if line.strip()]
+    return bool(speeds) and all(w > 0.0 and abs(w - p["speed_rad_s"]) <= 0.2 * w_sync for w in speeds)
+
+
+def run_point(p, sim, replay, work, duration_s, extra_replay=(), keep=False):
+    """Simulate and replay one point into work/<name>.{replay,truth}.csv; returns an error
+    message, NOT_HELD (nothing replayed), or None."""
+    name = p["name"]
+    csv_path = os.path.join(work, name + ".sim.csv")
+    log = os.path.join(work, name + ".log")
+    truth = os.path.join(work, name + ".truth.csv")
+    with open(log, "w") as lf:
+        err = simulate(sim, sim_args(p, duration_s), csv_path, lf) or truth_to(csv_path, truth, lf)
+        if not err and not held(p, truth):
+            for path in (truth, os.path.join(work, name + ".replay.csv")):
+                if os.path.exists(path):
+                    os.remove(path)
+            err = NOT_HELD
+        elif not err:
+            err = replay_to(replay, replay_args(p, extra_replay), csv_path,
+                            os.path.join(work, name + ".replay.csv"), lf)
+    if err and err != NOT_HELD:
+        return f"{err}, see {log}"
+    if not keep and os.path.exists(csv_path):
+        os.remove(csv_path)
+    return err
