@@ -142,10 +142,15 @@ void bg_noise_estimate(const imest_t *s, const imest_window_t *w, const bg_windo
 static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
 
 /* The bias entry of ISR columns i, j (0..7, 7 = y). */
-static double bias_at(const bg_noise_t *nz, unsigned int i, unsigned int j)
+static float bias_f(const bg_noise_t *nz, unsigned int i, unsigned int j)
 {
   const unsigned int lo = i < j ? i : j, hi = i < j ? j : i;
-  return (double)nz->bias[IMEST_ACC_INDEX(lo, hi)];
+  return nz->bias[IMEST_ACC_INDEX(lo, hi)];
+}
+
+static double bias_at(const bg_noise_t *nz, unsigned int i, unsigned int j)
+{
+  return (double)bias_f(nz, i, j);
 }
 
 static void apply(bg_sums_t *sm, const bg_noise_t *nz, double f, double m)
@@ -196,14 +201,18 @@ void bg_noise_subtract(bg_sums_t *sums, bg_noise_t *nz, double m)
 
 double bg_noise_e(const bg_noise_t *nz, const double k[8], double m)
 {
-  /* W3 K3 + W4 K4 = W4 (K4 - m K3): the 7-column coefficients */
-  const double c[7] = {k[0], k[1], k[3] - m * k[2], k[4], k[5], k[6], k[7]};
-  double e = bias_at(nz, 7u, 7u);
+  /* W3 K3 + W4 K4 = W4 (K4 - m K3): the 7-column coefficients. In float32
+   * (the bias is float32; the result bounds and weighs, it is not
+   * subtracted): a third of the soft-double work of a solve otherwise. */
+  const float c[7] = {(float)k[0], (float)k[1], (float)(k[3] - m * k[2]), (float)k[4], (float)k[5],
+                      (float)k[6], (float)k[7]};
+  float e = bias_f(nz, 7u, 7u);
   for (unsigned int i = 0; i < 7u; ++i) {
-    e -= 2.0 * c[i] * bias_at(nz, i, 7u);
-    for (unsigned int j = 0; j < 7u; ++j) e += c[i] * c[j] * bias_at(nz, i, j);
+    float row = -2.0f * bias_f(nz, i, 7u);
+    for (unsigned int j = 0; j < 7u; ++j) row += c[j] * bias_f(nz, i, j);
+    e += c[i] * row;
   }
-  return e;
+  return (double)e;
 }
 
 double bg_noise_e_at(const bg_noise_t *nz, double k1, double k2, double m)

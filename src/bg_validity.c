@@ -110,14 +110,15 @@ static void systematic_bounds(const imest_t *s, const op_point_t *op, float slip
   const float k = we * ls * slip_rate * (1.0f - sg) / (den * den);
   const float dr = k * (1.0f - a * a), di = k * (-2.0f * a);
   const float tau = 2.0f * s->timing_uncertainty_s;
-  const float dzr = fabsf(we) * tau * fabsf(zi), dzi = fabsf(we) * tau * fabsf(zr);
+  const float t_pwm = 1.0f / s->pwm_hz;
+  const float share = (s->duty_input && s->duty.zoh > 0.0f) ? 0.3f : 1.0f;
+  const float eps = share * fabsf(we) * t_pwm * t_pwm / (12.0f * sg * ls);
+  const float dzr = fabsf(we) * tau * fabsf(zi) + eps * 2.0f * fabsf(zr * zi);
+  const float dzi = fabsf(we) * tau * fabsf(zr) + eps * fabsf(zr * zr - zi * zi);
   const float dt = fabsf(di) > 0.0f ? dzi / fabsf(di) : INFINITY;
   *tr_rel = dt / tr;
   const float dr_volt = dv_v < 0.0f ? INFINITY : (4.0f / 3.14159265f) * dv_v / op->i_pk;
-  const float t_pwm = 1.0f / s->pwm_hz;
-  const float share = (s->duty_input && s->duty.zoh > 0.0f) ? 0.3f : 1.0f;
-  const float dr_stair = share * 2.0f * (fabsf(we) * t_pwm * t_pwm / (12.0f * sg * ls)) * fabsf(zr * zi);
-  *rs_rel = (dzr + fabsf(dr) * dt + dr_volt + dr_stair) / rs;
+  *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs;
 }
 
 /* The uncertainty of the voltage's fundamental per phase [V]: the inverter
@@ -226,25 +227,31 @@ void bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, 
   if (status == IMEST_REASON_NONE && !(isfinite(r->tr_s) && isfinite(r->rs_ohm) && isfinite(r->e_i)))
     status = IMEST_REASON_NUMERIC;
 
-  /* R_S: T_R's verdict, then its own error bound: the voltage's uncertainty
-   * (the inverter model's, or none known), the timing's, the current
-   * sensors' gain mismatch (|E| |Z| / R_S, measured: the paper motor, 1 %
-   * between two sensors, R_S -3.5 %). */
-  int rs_status = status;
+  /* The systematic bounds: T_R's (the staircase, the timing) against
+   * tr_tolerance; then R_S: T_R's verdict, then its own bound: the
+   * voltage's uncertainty (the inverter model's, or none known), the
+   * timing's, the staircase's, the current sensors' gain mismatch (|E| |Z| /
+   * R_S, measured: the paper motor, 1 % between two sensors, R_S -3.5 %). */
   const float mism = gain_mismatch(w, sm);
   if (mism > 0.002f) r->flags |= IMEST_FLAG_GAIN_MISMATCH;
+  float tr_b = INFINITY, rs_b = INFINITY, g_b = 0.0f;
   if (have && isfinite(r->rs_ohm) && r->rs_ohm > 0.0) {
     const float rs = (float)r->rs_ohm;
-    float tr_b, rs_b;
     systematic_bounds(s, &op, (float)st->slip_rate, (float)r->tr_s, rs, voltage_uncertainty(s, &op), &tr_b,
                       &rs_b);
-    const float g_b = mism * op.z_ohm / rs;
+    g_b = mism * op.z_ohm / rs;
     r->tr_bound_rel = (double)tr_b;
     r->rs_bound_rel = (double)(rs_b + g_b);
-    if (rs_status == IMEST_REASON_NONE && !(r->rs_bound_rel <= (double)s->rs_tolerance))
-      rs_status = (g_b > rs_b) ? IMEST_REASON_GAIN_MISMATCH : IMEST_REASON_RS_UNCERTAIN;
   }
-
+  /* The bounds are steady-state figures: T_R's is judged only below the
+   * pull-out slip (a sigma < 1), where a drive runs steadily; beyond it the
+   * window is a transient (a run-up) whose dynamics determine T_R. */
+  const float a_slip = (float)st->slip_rate * (float)r->tr_s * s->sigma;
+  if (status == IMEST_REASON_NONE && a_slip < 1.0f && !(tr_b <= s->tr_tolerance))
+    status = IMEST_REASON_TR_UNCERTAIN;
+  int rs_status = status;
+  if (rs_status == IMEST_REASON_NONE && !(rs_b + g_b <= s->rs_tolerance))
+    rs_status = (g_b > rs_b) ? IMEST_REASON_GAIN_MISMATCH : IMEST_REASON_RS_UNCERTAIN;
   r->tr_reason = status;
   r->tr_valid = (status == IMEST_REASON_NONE);
   r->rs_reason = rs_status;

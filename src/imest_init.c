@@ -47,6 +47,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->inverter.i_band_a = 0.0f;
   cfg->inverter.uncertainty = -1.0f; /* unknown until the user (or commissioning) says */
   cfg->rs_tolerance = 0.05f;
+  cfg->tr_tolerance = 0.02f;
   cfg->u_uncertainty_v = 0.0f;
   cfg->timing_uncertainty_s = 1.0e-6f;
   cfg->rs_nominal_ohm = 0.0f;
@@ -102,6 +103,7 @@ static const check_t k_checks[] = {
     CHK(inverter.i_band_a, C_NONNEG, 0.0f, 0.0f),
     CHK(inverter.uncertainty, C_ANY, 0.0f, 0.0f),
     CHK(rs_tolerance, C_POS, 0.0f, 0.0f),
+    CHK(tr_tolerance, C_POS, 0.0f, 0.0f),
     CHK(u_uncertainty_v, C_NONNEG, 0.0f, 0.0f),
     CHK(timing_uncertainty_s, C_NONNEG, 0.0f, 0.0f),
     CHK(rs_nominal_ohm, C_NONNEG, 0.0f, 0.0f),
@@ -337,6 +339,7 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   s->min_current_a = cfg->min_current_a;
   s->min_slip_ratio = cfg->min_slip_ratio;
   s->rs_tolerance = cfg->rs_tolerance;
+  s->tr_tolerance = cfg->tr_tolerance;
   s->u_uncertainty_v = cfg->u_uncertainty_v;
   s->timing_uncertainty_s = cfg->timing_uncertainty_s;
   s->rs_nominal_ohm = cfg->rs_nominal_ohm;
@@ -391,6 +394,7 @@ const char *imest_reason_name(int reason)
   case IMEST_REASON_CONSTANTS_MISMATCH: return "constants_mismatch";
   case IMEST_REASON_RS_UNCERTAIN: return "rs_uncertain";
   case IMEST_REASON_GAIN_MISMATCH: return "gain_mismatch";
+  case IMEST_REASON_TR_UNCERTAIN: return "tr_uncertain";
   default: return "unknown";
   }
 }

@@ -129,7 +129,10 @@ typedef enum {
   /* R_S only (T_R may still be valid): */
   /** R_S's error bound (inverter voltage error, timing, noise) exceeds rs_tolerance */
   IMEST_REASON_RS_UNCERTAIN = 25,
-  IMEST_REASON_GAIN_MISMATCH = 26 /**< the current sensors' gains differ by more than R_S tolerates */
+  IMEST_REASON_GAIN_MISMATCH = 26, /**< the current sensors' gains differ by more than R_S tolerates */
+  /** T_R's error bound (the PWM staircase, timing) exceeds tr_tolerance: light load at high
+   *  speed, where T_R is weakly coupled to the data (R_S then refused too) */
+  IMEST_REASON_TR_UNCERTAIN = 27
 } imest_reason_t;
 
 /** Short lower-case name of a reason ("ok", "warmup", "zero_slip", ...). */
@@ -257,6 +260,7 @@ typedef struct {
    *  current; rated load is about 1) */
   float min_slip_ratio;
   float rs_tolerance; /**< R_S is valid only if its error bound is within this, relative (default 0.05) */
+  float tr_tolerance; /**< T_R is valid only if its error bound is within this, relative (default 0.02) */
   /** phase-voltage input: uncertainty of the measured voltage's fundamental [V] (default 0: measured
    *  voltages are trusted) */
   float u_uncertainty_v;
@@ -473,7 +477,7 @@ typedef struct {
   /* background-only state */
   float sigma, ls_h, tr_nominal_s, tr_min_s, tr_max_s, rs_min_ohm, rs_max_ohm;
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
-  float rs_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
+  float rs_tolerance, tr_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
   uint32_t tr_nominal_known;
   uint32_t ls_check;         /* L_S measured at no load: 0 not yet, 1 agrees, 2 differs (latched) */
   imest_inverter_t inverter; /* as configured: the R_S verdict weighs its uncertainty */

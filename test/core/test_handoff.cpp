@@ -169,6 +169,42 @@ TEST(Handoff, NonFiniteSampleInvalidatesItsWindowAndRecovers)
   if (r.valid) EXPECT_TRUE(std::isfinite(r.tr_s));
 }
 
+// The duty-cycle input: a NaN, Inf or absurd duty on one leg, or a NaN bus
+// voltage, is an input fault of its window (isr_step's plausibility test of
+// the alpha/beta voltage), and the next window is clean.
+TEST(Handoff, BadDutyOrBusVoltageInvalidatesItsWindow)
+{
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  struct Bad {
+    float d, vdc;
+  };
+  for (const Bad b : {Bad{nan, 560.0f}, Bad{inf, 560.0f}, Bad{-1.0e6f, 560.0f}, Bad{0.5f, nan}}) {
+    SCOPED_TRACE(testing::Message() << "duty " << b.d << ", v_dc " << b.vdc);
+    imest_config_t cfg = small_config();
+    cfg.start_at_rest = 1;
+    static imest_t s;
+    imest_result_t r;
+    ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
+    // a rotating voltage and current at 30 Hz, as feed() (no physics needed)
+    auto sample = [&](int k, bool fault) {
+      const float ph = 2 * (float)M_PI * 30.0f * (float)k / 4000.0f;
+      const float d[3] = {fault ? b.d : 0.5f + 0.2f * std::cos(ph), 0.5f + 0.2f * std::cos(ph - 2.0944f),
+                          0.5f + 0.2f * std::cos(ph + 2.0944f)};
+      const float i[3] = {std::cos(ph - 0.5f), std::cos(ph - 2.6f), std::cos(ph + 1.6f)};
+      imest_isr_duty(&s, d, fault ? b.vdc : 560.0f, i, std::fmod(0.5f * ph, 6.2831853f));
+    };
+    for (int k = 0; k < 400; ++k) sample(k, k == 150);
+    ASSERT_EQ(imest_background(&s, &r), 1);
+    EXPECT_EQ(r.status, IMEST_REASON_INPUT_FAULT);
+    EXPECT_TRUE(r.flags & IMEST_FLAG_INPUT_FAULT);
+    EXPECT_FALSE(r.valid);
+    for (int k = 400; k < 800; ++k) sample(k, false);
+    ASSERT_EQ(imest_background(&s, &r), 1);
+    EXPECT_FALSE(r.flags & IMEST_FLAG_INPUT_FAULT);
+  }
+}
+
 TEST(Handoff, EncoderJumpAndSaturationAreFlagged)
 {
   imest_config_t cfg = small_config();

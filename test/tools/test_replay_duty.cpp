@@ -231,7 +231,7 @@ TEST(ReplayDuty, PhaseInputIsTheDefaultAndUnchanged)
   EXPECT_EQ(a.out, c.out);
   for (const char *opt :
        {"--dead-time 1e-6", "--v-switch 1", "--r-switch 0.01", "--v-diode 0.8", "--r-diode 0.01",
-        "--i-band 1", "--pwm-hz 8000", "--pwm-timing last", "--inverter-uncertainty 0.1"}) {
+        "--i-band 1", "--pwm-timing last", "--inverter-uncertainty 0.1"}) {
     const Out o = replay(p, opt);
     EXPECT_EQ(o.code, 2) << opt;
     EXPECT_NE(o.err.find("give --voltage duty"), std::string::npos) << opt << ": " << o.err;

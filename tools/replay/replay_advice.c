@@ -135,6 +135,11 @@ const char *replay_remedy(int status)
            "column). With --voltage duty give the inverter's numbers (--dead-time, --v-switch, "
            "--v-diode ...) and how well they are known (--inverter-uncertainty); check "
            "--pwm-timing and --u-delay";
+  case IMEST_REASON_TR_UNCERTAIN:
+    return "T_R's error bound exceeds --tr-tolerance: light load at high speed, where the "
+           "PWM staircase's aliased current (or the timing) moves T_R; a load of 25 % or more, "
+           "or a lower speed, gives valid windows. With measured voltages from a PWM faster "
+           "than the samples give its rate with --pwm-hz";
   case IMEST_REASON_GAIN_MISMATCH:
     return "the three current sensors' gains differ by more than R_S tolerates: calibrate them";
   default: return NULL;

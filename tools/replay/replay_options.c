@@ -43,13 +43,13 @@ static void usage(FILE *o)
              "                      --pwm-timing accounts for; negative: it leads; |S| <= 1/fs\n"
              "                      (e.g. 50e-6 for phase voltages taken as the volt-seconds of\n"
              "                      the PWM period that just ended at 10 kHz)\n"
+             "  --pwm-hz HZ         carrier frequency when it is faster than the sample rate\n"
+             "                      (default: the sample rate, one sample per period)\n"
              "duty cycles and the inverter (--voltage duty only):\n"
              "  --pwm-timing next|centred|last  when row k's duties apply: next = during\n"
              "                      [t_k, t_k+1) (default: computed one ISR earlier, loaded at\n"
              "                      the carrier valley where sample k is taken); centred =\n"
              "                      [t_k - T/2, t_k + T/2); last = [t_k-1, t_k)\n"
-             "  --pwm-hz HZ         carrier frequency when it is faster than the sample rate\n"
-             "                      (default: the sample rate, one sample per period)\n"
              "  --dead-time S       effective dead time, switching delays included [s]\n"
              "  --v-switch V        switch (IGBT, MOSFET) threshold voltage [V]\n"
              "  --r-switch OHM      switch slope resistance [ohm]\n"
@@ -80,6 +80,8 @@ static void usage(FILE *o)
              "                      (default 0: unknown)\n"
              "  --rs-tolerance X    R_S is valid only if its error bound is within this,\n"
              "                      relative (default 0.05)\n"
+             "  --tr-tolerance X    T_R is valid only if its error bound is within this,\n"
+             "                      relative (default 0.02)\n"
              "  --timing-uncertainty S  uncertainty of the voltage/current alignment after\n"
              "                      --pwm-timing and --u-delay [s] (default 2e-6)\n"
              "  --speed-limit RAD_S an angle step faster than this is an encoder fault\n"
@@ -133,8 +135,9 @@ static const struct {
     {"--angle-observer-hz", "angle_observer_hz", offsetof(imest_config_t, angle_observer_hz), FOR_ANY},
     {"--rs", "rs_nominal_ohm", offsetof(imest_config_t, rs_nominal_ohm), FOR_ANY},
     {"--rs-tolerance", "rs_tolerance", offsetof(imest_config_t, rs_tolerance), FOR_ANY},
+    {"--tr-tolerance", "tr_tolerance", offsetof(imest_config_t, tr_tolerance), FOR_ANY},
     {"--timing-uncertainty", "timing_uncertainty_s", offsetof(imest_config_t, timing_uncertainty_s), FOR_ANY},
-    {"--pwm-hz", "pwm_hz", offsetof(imest_config_t, pwm_hz), FOR_DUTY},
+    {"--pwm-hz", "pwm_hz", offsetof(imest_config_t, pwm_hz), FOR_ANY},
     {"--inverter-uncertainty", "inverter.uncertainty", offsetof(imest_config_t, inverter.uncertainty),
      FOR_DUTY},
     {"--dead-time", "inverter.dead_time_s", offsetof(imest_config_t, inverter.dead_time_s), FOR_INVERTER},
