@@ -235,6 +235,7 @@ static void design_duty(imest_duty_model_t *d, const imest_config_t *cfg)
   /* the current ripple's peak at 50 % duty, V_dc / (8 sigma L_S f_pwm) per
    * carrier period: where the sign of the error is decided inside the period */
   d->band2 = v->i_band_a * v->i_band_a;
+  d->vdc2_w = 12.0f / (cfg->u_absurd_v * cfg->u_absurd_v);
   d->band_per_v = v->i_band_a > 0.0f ? 0.0f : 1.0f / (8.0f * cfg->sigma * cfg->ls_h * fpwm);
   /* the staircase's images alias into the samples when the steps' edges are
    * the sample instants (NEXT_PERIOD; docs/METHOD.md §17) */

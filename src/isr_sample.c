@@ -292,9 +292,10 @@ int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float
   const imest_real_t vb = isr_duty_leg(m, &k, &s->dleg[1], db, ib, &step[1]);
   const imest_real_t vc = isr_duty_leg(m, &k, &s->dleg[2], dc, ic, &step[2]);
   /* the ADC limit applies to the currents; the duties and the bus voltage
-   * only have to be numbers (one test catches NaN, Inf or absurd duties) */
+   * only have to be numbers: one test catches NaN, Inf or absurd duties and
+   * a bus voltage near u_absurd_v (both weighted into one sum of squares) */
   const int in_range = (isr_abs(ia) < s->i_lim) & (isr_abs(ib) < s->i_lim) & (isr_abs(ic) < s->i_lim) &
-                       ((da * da + db * db) + dc * dc < RL(12)) & isr_within(vdc, s->u_abs);
+                       (((da * da + db * db) + dc * dc) + m->vdc2_w * (vdc * vdc) < RL(12));
   const imest_real_t u[3] = {va, vb, vc}, i[3] = {ia, ib, ic};
   imest_real_t ua, ub, ia_ab, ib_ab, sa, sb;
   isr_clarke(u, &ua, &ub); /* the zero sequence (the legs' common part) drops out */

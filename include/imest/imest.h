@@ -408,6 +408,7 @@ typedef struct {
   imest_real_t dv, dr;        /**< switch minus diode: threshold [V] and slope [ohm] */
   imest_real_t band2;         /**< i_band^2 of a fixed zero-crossing band [A^2] (0: from the ripple) */
   imest_real_t band_per_v;    /**< i_band / V_dc from the current ripple [A/V] (0: fixed band) */
+  imest_real_t vdc2_w;        /**< 12 / u_absurd_v^2: the bus voltage's weight in the absurdity test */
   imest_real_t zoh; /**< T / (12 sigma L_S): the staircase's aliased share of a sampled current [A/V] */
 } imest_duty_model_t;
 

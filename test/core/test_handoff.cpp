@@ -169,8 +169,8 @@ TEST(Handoff, NonFiniteSampleInvalidatesItsWindowAndRecovers)
   if (r.valid) EXPECT_TRUE(std::isfinite(r.tr_s));
 }
 
-// The duty-cycle input: a NaN, Inf or absurd duty on one leg, or a NaN bus
-// voltage, is an input fault of its window (isr_step's plausibility test of
+// The duty-cycle input: a NaN, Inf or absurd duty on one leg, or a NaN or
+// absurd bus voltage, is a fault of its window (isr_step's plausibility test of
 // the alpha/beta voltage), and the next window is clean.
 TEST(Handoff, BadDutyOrBusVoltageInvalidatesItsWindow)
 {
@@ -179,7 +179,8 @@ TEST(Handoff, BadDutyOrBusVoltageInvalidatesItsWindow)
   struct Bad {
     float d, vdc;
   };
-  for (const Bad b : {Bad{nan, 560.0f}, Bad{inf, 560.0f}, Bad{-1.0e6f, 560.0f}, Bad{0.5f, nan}}) {
+  for (const Bad b :
+       {Bad{nan, 560.0f}, Bad{inf, 560.0f}, Bad{-1.0e6f, 560.0f}, Bad{0.5f, nan}, Bad{0.5f, 2.0e5f}}) {
     SCOPED_TRACE(testing::Message() << "duty " << b.d << ", v_dc " << b.vdc);
     imest_config_t cfg = small_config();
     cfg.start_at_rest = 1;
@@ -196,12 +197,15 @@ TEST(Handoff, BadDutyOrBusVoltageInvalidatesItsWindow)
     };
     for (int k = 0; k < 400; ++k) sample(k, k == 150);
     ASSERT_EQ(imest_background(&s, &r), 1);
-    EXPECT_EQ(r.status, IMEST_REASON_INPUT_FAULT);
-    EXPECT_TRUE(r.flags & IMEST_FLAG_INPUT_FAULT);
+    // a bus voltage beyond u_absurd_v that leaves the line voltages plausible
+    // reads as a sample at the limit
+    const bool at_limit = std::isfinite(b.d) && std::isfinite(b.vdc) && b.vdc > 1.0e5f;
+    EXPECT_EQ(r.status, at_limit ? IMEST_REASON_ADC_SATURATION : IMEST_REASON_INPUT_FAULT);
+    EXPECT_TRUE(r.flags & (at_limit ? IMEST_FLAG_ADC_SAT : IMEST_FLAG_INPUT_FAULT));
     EXPECT_FALSE(r.valid);
     for (int k = 400; k < 800; ++k) sample(k, false);
     ASSERT_EQ(imest_background(&s, &r), 1);
-    EXPECT_FALSE(r.flags & IMEST_FLAG_INPUT_FAULT);
+    EXPECT_FALSE(r.flags & (IMEST_FLAG_INPUT_FAULT | IMEST_FLAG_ADC_SAT));
   }
 }
 
