@@ -83,16 +83,24 @@ typedef struct {
   imest_comm_result_t r;
 } demo_constants_t;
 
-enum { EXP1 = 0, EXP2 = 1, IFOC_FIXED = 2, IFOC_ADAPTIVE = 3, IFOC11_FIXED = 4, IFOC11_ADAPTIVE = 5, NEXP = 6 };
+enum {
+  EXP1 = 0,
+  EXP2 = 1,
+  IFOC_FIXED = 2,
+  IFOC_ADAPTIVE = 3,
+  IFOC11_FIXED = 4,
+  IFOC11_ADAPTIVE = 5,
+  NEXP = 6
+};
 static const char *const k_exp_name[NEXP] = {"exp1",          "exp2",         "ifoc_fixed",
                                              "ifoc_adaptive", "ifoc11_fixed", "ifoc11_adaptive"};
 
 /* The 11 kW pair: half load, heating sped up so that a sixth of the heat run's motor time
    covers the same heating (its rotor's thermal time constant is 2100 s). */
-#define IFOC11_LOAD_REL    0.5
-#define IFOC11_THERMAL_X   6.0
-#define IS_IFOC11(id)      ((id) == IFOC11_FIXED || (id) == IFOC11_ADAPTIVE)
-#define IS_ADAPTIVE(id)    ((id) == IFOC_ADAPTIVE || (id) == IFOC11_ADAPTIVE)
+#define IFOC11_LOAD_REL  0.5
+#define IFOC11_THERMAL_X 6.0
+#define IS_IFOC11(id)    ((id) == IFOC11_FIXED || (id) == IFOC11_ADAPTIVE)
+#define IS_ADAPTIVE(id)  ((id) == IFOC_ADAPTIVE || (id) == IFOC11_ADAPTIVE)
 
 /* ------------------------------------------------------------------------- */
 /* Per-window truth and drive state                                           */
@@ -221,7 +229,8 @@ static void sim_config(int id, unsigned long seed, imsim_config_t *c)
     c->load_nm = IFOC11_LOAD_REL * c->rated_torque_nm;
     c->thermal_speedup = IFOC11_THERMAL_X;
     /* offsets as below, scaled to its 75 A range */
-    for (int k = 0; k < 3; ++k) c->i_offset_a[k] = (k == 0 ? 0.040 : k == 1 ? -0.025 : 0.010) * c->i_range_a / 20.0;
+    for (int k = 0; k < 3; ++k)
+      c->i_offset_a[k] = (k == 0 ? 0.040 : k == 1 ? -0.025 : 0.010) * c->i_range_a / 20.0;
     c->seed = seed + (unsigned long)id;
     return;
   }
@@ -796,7 +805,7 @@ static int start_jobs(const options_t *o, const demo_constants_t *k, job_t jobs[
     jobs[e].id = e;
     jobs[e].opt = o;
     jobs[e].k = k;
-    jobs[e].duration_s = e == EXP1        ? o->exp1_duration_s
+    jobs[e].duration_s = e == EXP1      ? o->exp1_duration_s
                          : IS_IFOC11(e) ? fmax(o->duration_s / IFOC11_THERMAL_X, 10.0)
                                         : o->duration_s;
     jobs[e].fs_hz = IS_IFOC11(e) ? 8000.0 : 4000.0; /* progress only; job_open sets total */
