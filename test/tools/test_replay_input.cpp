@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <regex>
 #include <set>
 #include <string>
@@ -321,4 +322,74 @@ TEST(ReplayInput, ExtendedCanIdIsAccepted)
   const Out o = replay(base(), "--can-id 0x18FF5000 --candump " + log);
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_NE(slurp(log).find(" 18FF5000#"), std::string::npos) << slurp(log).substr(0, 200);
+}
+
+// The first-day mistakes (encoder backwards, phases b and c swapped, the
+// electrical angle, n_p 1 for 2, currents in mA, line-to-line voltages, the
+// current sign): never a valid window. Either replay refuses the record with
+// the cause, or every window is refused (wiring_mismatch for most).
+TEST(ReplayInput, WiringMistakesNeverGiveAValidWindow)
+{
+  const std::string m = " --pole-pairs 2 --ls 0.2908 --sigma 0.096 ";
+  struct Case {
+    const char *name;
+    std::function<bool(std::vector<std::string> &, long)> edit;
+    std::string motor;
+  };
+  auto scale = [](std::vector<std::string> &f, int j, double k) { f[j] = fmt("%.12g", k * std::stod(f[j])); };
+  const std::vector<Case> cases = {
+      {"encoder_backwards.csv", [&](std::vector<std::string> &f, long) { return scale(f, 7, -1), true; }, m},
+      {"swap_bc.csv",
+       [](std::vector<std::string> &f, long) {
+         std::swap(f[2], f[3]);
+         std::swap(f[5], f[6]);
+         return true;
+       },
+       m},
+      {"electrical.csv", [&](std::vector<std::string> &f, long) { return scale(f, 7, 2), true; }, m},
+      {"milliamps.csv",
+       [&](std::vector<std::string> &f, long) {
+         for (int j = 4; j <= 6; ++j) scale(f, j, 1000);
+         return true;
+       },
+       m},
+      {"line_to_line.csv",
+       [](std::vector<std::string> &f, long) {
+         const double a = std::stod(f[1]), b = std::stod(f[2]), c = std::stod(f[3]);
+         f[1] = fmt("%.9g", a - b);
+         f[2] = fmt("%.9g", b - c);
+         f[3] = fmt("%.9g", c - a);
+         return true;
+       },
+       m},
+      {"current_sign.csv",
+       [&](std::vector<std::string> &f, long) {
+         for (int j = 4; j <= 6; ++j) scale(f, j, -1);
+         return true;
+       },
+       m},
+      {"pole_pairs_1.csv", [](std::vector<std::string> &, long) { return true; },
+       " --pole-pairs 1 --ls 0.2908 --sigma 0.096 "},
+  };
+  for (const Case &c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string p = rewrite(base8(), c.name, c.edit);
+    const Out o = run(std::string(REPLAY_BIN) + c.motor + p);
+    EXPECT_TRUE(o.code == 0 || o.code == 1) << o.err;
+    EXPECT_EQ(valid_windows(o), 0) << o.out;
+    EXPECT_EQ(tr_valid_windows(o), 0) << o.out;
+    if (o.code == 1) EXPECT_TRUE(has(o, "theta")) << o.err; // refused, naming the angle against the field
+  }
+}
+
+// L_S 10 % high fits a loaded motor as well as the true one (T_R +11 %,
+// R_S -42 %: a consistent family of constants); the nominal R_S (data sheet or
+// commissioning) tells them apart.
+TEST(ReplayInput, LsTenPercentHighIsConstantsMismatchGivenTheNominalRs)
+{
+  const Out o =
+      run(std::string(REPLAY_BIN) + " --pole-pairs 2 --ls 0.3199 --sigma 0.096 --rs 5.04 " + base8());
+  EXPECT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(tr_valid_windows(o), 0) << o.out;
+  EXPECT_TRUE(has(o, "most are constants_mismatch")) << o.err;
 }
