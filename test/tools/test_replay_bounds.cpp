@@ -131,3 +131,24 @@ TEST(ReplayBounds, CombinedWindowsDeliverTrWhereOneWindowCannot)
   }
   EXPECT_GE(combined_valid, 1) << o.out;
 }
+
+// A current sensor reading 2 % high (three sensors): the zero sequence shows
+// it; R_S (-8 %) is refused as gain_mismatch, T_R stays valid and within 1 %.
+TEST(ReplayBounds, GainMismatchRefusesRsNotTr)
+{
+  const std::string &csv =
+      sim_csv("exp2_gain.csv", "--preset exp2 --duration 6 --supply vf --seed 5 --i-gain-err 0.02,0,0");
+  const Out o = run(std::string(REPLAY_BIN) + " --pole-pairs 2 --ls 0.2908 --sigma 0.096 " + csv);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto r = rows(o.out);
+  const int tr = col(r, "T_R_s"), tv = col(r, "tr_valid"), rv = col(r, "rs_valid"), why = col(r, "rs_reason");
+  int tr_ok = 0;
+  for (size_t k = 1; k < r.size(); ++k) {
+    EXPECT_EQ(r[k][rv], "0") << o.out;
+    if (r[k][tv] != "1") continue;
+    ++tr_ok;
+    EXPECT_EQ(r[k][why], "gain_mismatch") << o.out;
+    EXPECT_NEAR(std::stod(r[k][tr]) / 0.12, 1.0, 0.01) << o.out;
+  }
+  EXPECT_GE(tr_ok, 3) << o.out;
+}
