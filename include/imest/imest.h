@@ -234,7 +234,10 @@ typedef struct {
   int start_at_rest;
 
   /* Duty-cycle input (imest_isr_duty). */
-  float pwm_hz;                  /**< carrier frequency [Hz] (default 0: fs_hz, one sample per period) */
+  /** carrier frequency [Hz] (default 0: fs_hz, one sample per period). Both inputs: the PWM
+   *  staircase's share of the T_R and R_S error bounds scales with its period squared (a fast carrier:
+   *  its rate; a sine source: a rate far above fs_hz) */
+  float pwm_hz;
   imest_pwm_timing_t pwm_timing; /**< when the duties passed with a sample apply (default NEXT_PERIOD) */
   imest_inverter_t inverter;     /**< the inverter's voltage error (default: unknown) */
 
