@@ -51,6 +51,7 @@ int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *
   out->hessian_pd = 0;
   out->pe_k1 = out->pe_k2 = nan;
   out->pe_quad[0] = out->pe_quad[1] = nan;
+  out->noise_e_k = 0.0;
   out->scale_s = out->scale_g = out->scale_c = nan;
   out->pe_flags = 0;
   out->work = 0;
@@ -95,9 +96,9 @@ int bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_out_t *
    * the selected K, not at the centring (far from the solution the latter
    * can be much smaller, and a negative compensated E then reads as an
    * exact fit: pe 0). */
+  if (in->noise) out->noise_e_k = bg_noise_e_at(in->noise, c->k1, c->k2, in->noise_m);
   bg_solve_cfg_t qcfg = *cfg;
-  if (in->noise && in->noise_f > 0.0)
-    qcfg.e_noise = fmax(cfg->e_noise, in->noise_f * bg_noise_e_at(in->noise, c->k1, c->k2, in->noise_m));
+  if (in->noise && in->noise_f > 0.0) qcfg.e_noise = fmax(cfg->e_noise, in->noise_f * out->noise_e_k);
   stats->quality_evals = bg_quality(&t, &qcfg, c, out);
   out->work += stats->quality_evals;
 

@@ -77,6 +77,7 @@ typedef struct {
   int hessian_pd;
   double pe_k1, pe_k2;              /* parametric error indices (absolute), docs/METHOD.md §7, of E_w */
   double pe_quad[2];                /* quadratic approximations sqrt(0.5 E (H^-1)_ii) */
+  double noise_e_k;                 /* the noise's E_p^2 at the minimiser, bg_noise_e (0: no in->noise) */
   double scale_s, scale_g, scale_c; /* the power-of-two scalings used */
   unsigned int pe_flags;            /* BG_PE_FLAG_* (bg_quality.h): how the PE indices were obtained */
   unsigned int work;                /* iterations used (Sturm evaluations + bisection + polish +

@@ -102,8 +102,7 @@ int imest_background(imest_t *s, imest_result_t *out)
     out->k2 = so.k2;
     /* E and E_I of the data as measured (the noise's part added back), and the
      * part the noise explains */
-    const double k1 = so.k1, k2 = so.k2;
-    const double e_noise = fmax(0.0, bg_noise_e_at(&nz, k1, k2, m)) * noise_share;
+    const double e_noise = fmax(0.0, so.noise_e_k) * noise_share; /* bg_solve's, at this K */
     out->e = so.e + nz.scale * e_noise;
     out->e_i = sqrt(out->e / ry_all);
     out->e_i_noise = sqrt(e_noise / ry_all);

@@ -21,13 +21,6 @@ const std::string kSim =
     "--freq 60 --vll 230 --duration 4 --ideal-sensors --encoder-counts 16384 --no-progress";
 const std::string kReplay = " --pole-pairs 2 --ls 0.2908 --sigma 0.096 --from-rest no --u-delay 62.5e-6 ";
 
-int col(const std::vector<std::vector<std::string>> &r, const std::string &name)
-{
-  for (size_t j = 0; !r.empty() && j < r[0].size(); ++j)
-    if (r[0][j] == name) return (int)j;
-  return -1;
-}
-
 struct Tally {
   int windows = 0, tr_valid = 0, tr_valid_wrong = 0, tr_uncertain = 0;
 };

@@ -30,14 +30,6 @@ Out duty(const std::string &file, const std::string &extra = "")
   return run(std::string(REPLAY_BIN) + kMotor4kw + "--voltage duty " + extra + " " + file);
 }
 
-// A column's index by its header name (-1 if absent).
-int col(const std::vector<std::vector<std::string>> &r, const std::string &name)
-{
-  for (size_t j = 0; !r.empty() && j < r[0].size(); ++j)
-    if (r[0][j] == name) return (int)j;
-  return -1;
-}
-
 // Mean of a truth column over the rows of each window (t_end - window, t_end].
 std::vector<double> truth_per_window(const std::string &csv, const std::string &name,
                                      const std::vector<double> &t_end, double window_s)

@@ -93,6 +93,14 @@ inline std::vector<std::vector<std::string>> rows(const std::string &csv)
   return r;
 }
 
+// A column's index by its header name in rows() (-1 if absent).
+inline int col(const std::vector<std::vector<std::string>> &r, const std::string &name)
+{
+  for (size_t j = 0; !r.empty() && j < r[0].size(); ++j)
+    if (r[0][j] == name) return (int)j;
+  return -1;
+}
+
 // A copy of a CSV recording with each data row (its fields, its 0-based
 // index) rewritten, or left out where fn returns false; the header is kept.
 inline std::string rewrite(const std::string &src, const std::string &name,
