@@ -173,9 +173,9 @@ typedef enum {
  *      e(i, d) = s(i) * [ t_d f_pwm V_dc + V_d0 + r_d |i| + d_c ((V_sw0 - V_d0) + (r_sw - r_d) |i|) ]
  *
  *  with d_c the share of the period the active switch conducts (d for i > 0, 1 - d
- *  for i < 0) and s(i) the sign of i made linear over |i| < i_band_a (the current
- *  ripple crosses zero inside the period there, so the error fades rather than
- *  jumping). All zero: an ideal (or fully compensated) inverter. The library's
+ *  for i < 0) and s(i) = i / sqrt(i^2 + i_band_a^2) the sign of i faded over about
+ *  |i| < i_band_a (the current ripple crosses zero inside the period there, so the
+ *  error fades rather than jumping). All zero: an ideal (or fully compensated) inverter. The library's
  *  standstill commissioning measures these numbers. */
 typedef struct {
   float dead_time_s;  /**< effective dead time, switching delays included [s] */
