@@ -130,8 +130,9 @@ typedef enum {
   /** R_S's error bound (inverter voltage error, timing, noise) exceeds rs_tolerance */
   IMEST_REASON_RS_UNCERTAIN = 25,
   IMEST_REASON_GAIN_MISMATCH = 26, /**< the current sensors' gains differ by more than R_S tolerates */
-  /** T_R's error bound (the PWM staircase, timing) exceeds tr_tolerance: light load at high
-   *  speed, where T_R is weakly coupled to the data (R_S then refused too) */
+  /** T_R's error bound (the PWM staircase, timing, with the duty-cycle input the inverter
+   *  model's uncertainty) exceeds tr_tolerance: light load, where T_R is weakly coupled to the
+   *  data (R_S then refused too) */
   IMEST_REASON_TR_UNCERTAIN = 27
 } imest_reason_t;
 
