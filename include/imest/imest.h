@@ -188,7 +188,9 @@ typedef struct {
    *  L_S f_pwm)) */
   float i_band_a;
   /** relative uncertainty of this model's error (e.g. 0.2 for 20 %); negative: the error is unknown
-   *  (default), so R_S is never valid with the duty-cycle input */
+   *  (default), so R_S is never valid with the duty-cycle input. R_S's bound takes it as stated;
+   *  T_R's takes at least 0.2 (the error's shape near the zero crossings is not the model's even
+   *  when its numbers are exact; docs/METHOD.md §18.1) */
   float uncertainty;
 } imest_inverter_t;
 
