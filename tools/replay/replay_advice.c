@@ -138,10 +138,11 @@ const char *replay_remedy(int status)
   case IMEST_REASON_TR_UNCERTAIN:
     return "T_R's error bound exceeds --tr-tolerance: light load at high speed, where the "
            "PWM staircase's aliased current (or the timing) moves T_R; a load of 25 % or more, "
-           "or a lower speed, gives valid windows. With --voltage duty at light load the "
-           "inverter model's uncertainty bounds T_R too: a model measured well (commissioning) "
-           "and a smaller --inverter-uncertainty. With measured voltages from a PWM faster "
-           "than the samples give its rate with --pwm-hz";
+           "or a lower speed, gives valid windows. With --voltage duty the inverter's voltage "
+           "error bounds T_R too (its harmonics, at least 20 % of the modelled error): more "
+           "load, or a smaller error (shorter dead time, lower drops), gives valid windows. "
+           "With measured voltages from a PWM faster than the samples give its rate with "
+           "--pwm-hz";
   case IMEST_REASON_GAIN_MISMATCH:
     return "the three current sensors' gains differ by more than R_S tolerates: calibrate them";
   default: return NULL;
