@@ -34,7 +34,9 @@ typedef struct {
   float i_pk;  /* peak phase current of the fundamental [A] */
 } op_point_t;
 
-#define TWO_PI_F 6.2831853f
+#define TWO_PI_F       6.2831853f
+/* a sign-type error dV has the fundamental (4/pi) dV */
+#define FOUR_OVER_PI_F (4.0f / 3.14159265f)
 
 static void operating_point(const imest_t *s, const bg_window_stats_t *st, const bg_sums_t *sm, uint32_t nreg,
                             op_point_t *op)
@@ -83,16 +85,18 @@ static int wiring_mismatch(const imest_t *s, const op_point_t *op)
 
 /* The uncertainty of the voltage's fundamental per phase [V]: the inverter
  * model's error at this current times its relative uncertainty (duty input),
- * or u_uncertainty_v (measured voltages); negative: unknown. */
+ * or u_uncertainty_v (measured voltages); negative: unknown. *shape_v: the
+ * uncertainty whose harmonics T_R sees (duty input with a known uncertainty;
+ * else 0). */
 static float voltage_uncertainty(const imest_t *s, const op_point_t *op, float *shape_v)
 {
   *shape_v = 0.0f;
   if (!s->duty_input) return s->u_uncertainty_v;
   const imest_inverter_t *v = &s->inverter;
+  if (v->uncertainty < 0.0f) return -1.0f;
   const float a = op->i_pk;
   const float e = fabsf(v->dead_time_s * s->pwm_hz * (float)s->vdc_prev + v->v_diode_v + v->r_diode_ohm * a +
                         0.5f * ((v->v_switch_v - v->v_diode_v) + (v->r_switch_ohm - v->r_diode_ohm) * a));
-  if (v->uncertainty < 0.0f) return -1.0f;
   const float dv = v->uncertainty * e;
   /* the error's shape near the zero crossings (the ripple's, the devices'
    * capacitances) is not known to better than 20 % of it even when every
@@ -145,11 +149,11 @@ static void systematic_bounds(const imest_t *s, const op_point_t *op, float slip
   const float share = (s->duty_input && s->duty.zoh > 0.0f) ? 0.3f : 1.0f;
   const float eps = share * fabsf(we) * t_pwm * t_pwm / (12.0f * sg * ls);
   const float dzr = fabsf(we) * tau * fabsf(zi) + eps * 2.0f * fabsf(zr * zi);
-  const float harm = 0.5f * (4.0f / 3.14159265f) * harm_v / op->i_pk;
+  const float harm = 0.5f * FOUR_OVER_PI_F * harm_v / op->i_pk;
   const float dzi = fabsf(we) * tau * fabsf(zr) + eps * fabsf(zr * zr - zi * zi) + harm;
   const float dt = fabsf(di) > 0.0f ? dzi / fabsf(di) : INFINITY;
   *tr_rel = dt / tr;
-  const float dr_volt = dv_v < 0.0f ? INFINITY : (4.0f / 3.14159265f) * dv_v / op->i_pk;
+  const float dr_volt = dv_v < 0.0f ? INFINITY : FOUR_OVER_PI_F * dv_v / op->i_pk;
   *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs;
 }
 
