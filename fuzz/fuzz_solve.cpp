@@ -1,4 +1,4 @@
-// Fuzz the background solve (internal bg_solve) with arbitrary window sums:
+// Fuzz the background solve (internal imest__bg_solve) with arbitrary window sums:
 // the input bytes are the 73 doubles of R_W, R_Wy, R_y (NaN, Inf, huge,
 // denormal ...), optionally followed by the 5 doubles of the solve config.
 // Property (test/robustness/solve_property.h): it returns within the
@@ -32,7 +32,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     s.rwy[2] = -m * s.rwy[3];
   }
   bg_solve_cfg_t cfg{};
-  cfg.weight_c = (mode & 4) ? bg_solve_weight_c(&s) : 0.0;
+  cfg.weight_c = (mode & 4) ? imest__bg_solve_weight_c(&s) : 0.0;
   cfg.sigma = 0.096;
   cfg.ls_h = 0.2908;
   cfg.tr_nominal_s = 0.1;
@@ -48,7 +48,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   }
   bg_solve_out_t out;
   std::memset(&out, 0xA5, sizeof out);
-  const int rc = bg_solve(&s, &cfg, &out);
+  const int rc = imest__bg_solve(&s, &cfg, &out);
   if (const char *bad = solve_property(rc, &cfg, &out)) fuzz::fail(bad);
   return 0;
 }

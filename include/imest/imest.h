@@ -81,6 +81,8 @@
 
 #include <stdint.h>
 
+#include "imest/imest_version.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -224,7 +226,7 @@ typedef struct {
    *  leaves the motor's equations intact at constant speed; see README "Method" (sensor offsets).
    *  The first start (unless start_at_rest) waits 5 time constants more for it: 0.8 s at 1 Hz. */
   /** natural frequency [Hz] of the tracking observer between the encoder and the rotation
-   *  (src/isr_angle.h), engaged while the speed is steady: it attenuates an encoder's
+   *  (src/estimator/isr/isr_angle.h), engaged while the speed is steady: it attenuates an encoder's
    *  quantisation steps above this (1024 counts, paper motor at 30 Hz: R_S +6.6 % -> -0.02 %)
    *  (default 0: filter_hz / 4; negative: off, the encoder angle as it is; at most fs_hz / 4) */
   float angle_observer_hz;
@@ -351,151 +353,8 @@ typedef struct {
   double roots_k2[IMEST_MAX_ROOTS]; /**< the positive roots, ascending */
 } imest_result_t;
 
-/* ----------------------------------------------------------------------------
- * Instance (caller-owned storage; every field is private to the library)
- * ------------------------------------------------------------------------- */
-
-/** Arithmetic type of the ISR path: float32. */
-typedef float imest_real_t;
-
-/** Number of accumulated entries: 28 of R_W (7 columns), 7 of R_Wy, 1 of R_y,
- *  the rotation of the rotor-frame current (sum of i x di/dt: slip excitation),
- *  the white-noise evidence of the currents and voltages (sums of squared third
- *  differences), and the zero sequence of the phase currents (its correlation
- *  with i_alpha and i_beta, and its square: current-sensor gain mismatch). */
-#define IMEST_NACC        42
-/** Indices of the entries after the 36 of [W e]'[W e]. */
-#define IMEST_ACC_ROT     36u
-#define IMEST_ACC_NOISE_I 37u
-#define IMEST_ACC_NOISE_U 38u
-#define IMEST_ACC_I0A     39u
-#define IMEST_ACC_I0B     40u
-#define IMEST_ACC_UU      41u
-
-/** One window's sums, as handed from the ISR to the background. */
-typedef struct {
-  imest_real_t sum[IMEST_NACC]; /**< folded block sums */
-  imest_real_t blk[IMEST_NACC]; /**< the current (unfolded) block of each entry */
-  imest_real_t c0[7];           /**< centring vector used for this window (y - W c0 accumulated) */
-  imest_real_t rot;             /**< sum of the angle steps of the used samples [rad] */
-  uint32_t seq;
-  uint32_t samples;
-  uint32_t used; /**< samples that passed (not warm-up, not faulty) */
-  uint32_t nreg; /**< regressor samples in the sums (every second used sample) */
-  uint32_t flags;
-} imest_window_t;
-
-/** Butterworth-3 as a first-order and a second-order section (transposed DF-II).
- *  Bilinear low-pass sections have binomial numerators, so only their gains
- *  are stored. */
-typedef struct {
-  imest_real_t b0, a1;     /**< section 1: b0 (1 + z^-1) / (1 + a1 z^-1) */
-  imest_real_t c0, d1, d2; /**< section 2: c0 (1 + 2 z^-1 + z^-2) / (1 + d1 z^-1 + d2 z^-2) */
-} imest_bw3_t;
-
-/** Filter state of one channel: 3 section states and the last two outputs. */
-typedef struct {
-  imest_real_t s1, s2a, s2b;
-  imest_real_t y1, y2; /**< x_f[n-1], x_f[n-2] */
-} imest_chan_t;
-
-/** 2nd-order analog anti-alias model applied to the speed channel (bilinear:
- *  c0 (1 + 2 z^-1 + z^-2) / (1 + d1 z^-1 + d2 z^-2)). */
-typedef struct {
-  imest_real_t c0, d1, d2;
-} imest_sos_t;
-
-/** Constants of the duty-cycle input (imest_isr_duty): how the two periods
- *  around a sample are weighted, and the inverter model per leg. */
-typedef struct {
-  imest_real_t w_prev, w_now; /**< weights of the previous and this call's leg voltages */
-  imest_real_t td_f;          /**< dead time x carrier frequency */
-  imest_real_t v_d, r_d;      /**< diode threshold [V] and slope [ohm] */
-  imest_real_t dv, dr;        /**< switch minus diode: threshold [V] and slope [ohm] */
-  imest_real_t band2;         /**< i_band^2 of a fixed zero-crossing band [A^2] (0: from the ripple) */
-  imest_real_t band_per_v;    /**< i_band / V_dc from the current ripple [A/V] (0: fixed band) */
-  imest_real_t vdc2_w;        /**< 12 / u_absurd_v^2: the bus voltage's weight in the absurdity test */
-  imest_real_t zoh; /**< T / (12 sigma L_S): the staircase's aliased share of a sampled current [A/V] */
-} imest_duty_model_t;
-
-/** Angle tracking observer between the encoder and the rotation (src/isr_angle.h). */
-typedef struct {
-  imest_real_t k1, k2, k3;   /**< gains per sample */
-  imest_real_t d;            /**< estimated angle minus encoder angle [rad] */
-  imest_real_t dth;          /**< estimated angle step per sample [rad] */
-  imest_real_t ddth;         /**< estimated change of the step per sample [rad] */
-  volatile uint32_t engaged; /**< set by the background at a steady speed (0: the encoder as it is) */
-  uint32_t enabled;          /**< configured (angle_observer_hz >= 0) */
-} imest_angle_t;
-
-/** Consecutive windows' sums combined by the background (src/bg_combine.c). */
-typedef struct {
-  double rw[36]; /**< upper triangle of the 8x8 R_W (K form) */
-  double rwy[8], rwe[8];
-  double ry, ree;
-  double e_c0;      /**< the noise's E at the centring, summed */
-  double ry_raw;    /**< R_y before the noise compensation, summed */
-  float c0[8];      /**< the centring of the last window */
-  uint32_t n;       /**< windows combined (0: none) */
-  uint32_t samples; /**< their samples */
-  uint32_t centred; /**< every window had the same centring: rwe, ree hold */
-} imest_combo_t;
-
-/** Estimator instance. All fields are private; sizes are what the ISR needs. */
-typedef struct {
-  /* constants derived at init */
-  imest_real_t fs, inv2t, invt2;                    /* fs, 1/(2T), 1/T^2 */
-  imest_real_t n, m, inv_s;                         /* n_p, M*beta, 1/(sigma L_S) */
-  imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max; /* dth_max: largest angle step [rad] */
-  uint32_t window_n, warmup_n;
-  uint32_t warmup_fault_n; /* samples the filters settle after a fault */
-  uint32_t aa_on;          /* anti-alias model in use */
-  imest_bw3_t bw;
-  imest_sos_t aa;
-  imest_real_t dly_i;      /* voltage lags: currents and angle delayed by this fraction of a sample */
-  imest_real_t dly_u;      /* voltage leads: voltage delayed by this fraction of a sample */
-  imest_real_t dcb_a;      /* offset high-pass: mean-tracking gain per sample */
-  imest_duty_model_t duty; /* duty-cycle input */
-  /* ISR state: the filter of each channel */
-  imest_chan_t f_ux, f_uy, f_ix, f_iy, f_w;
-  imest_real_t aa_s1, aa_s2;     /* anti-alias model state (speed) */
-  imest_real_t off_ua, off_ub;   /* tracked offsets of u_alpha, u_beta [V] */
-  imest_real_t off_ia, off_ib;   /* tracked offsets of i_alpha, i_beta [A] */
-  imest_real_t ia1, dia1, d2ia1; /* last i_alpha and its last two differences (noise, delay) */
-  imest_real_t ua1, dua1, d2ua1; /* the same for u_alpha */
-  imest_real_t ib1, ub1;         /* last i_beta, u_beta (delays) */
-
-  imest_real_t wr_prev;        /* previous raw speed (delay) */
-  imest_real_t th_prev;        /* previous mechanical angle (as given) */
-  imest_angle_t obs;           /* angle observer */
-  imest_real_t zx[8], zy[8];   /* the regressor of an even sample, summed in two calls */
-  uint32_t zpend;              /* zx, zy wait for the second half of their sums */
-  imest_real_t dleg[3];        /* duty input: previous call's duties */
-  imest_real_t vdc_prev;       /* duty input: previous call's bus voltage [V] */
-  uint32_t k;                  /* sample index in the current window */
-  uint32_t warm;               /* warm-up samples still to discard */
-  uint32_t seq;                /* sequence number of the window being filled */
-  uint32_t started;            /* first sample seen */
-  volatile uint32_t published; /* ISR -> background: count of buffers handed over; the
-                                            ISR fills win[published & 1] */
-  volatile uint32_t released;  /* background -> ISR: count of buffers released */
-  volatile uint32_t overruns;  /* windows dropped */
-  imest_window_t win[2];
-  /* background-only state */
-  float sigma, ls_h, tr_nominal_s, tr_min_s, tr_max_s, rs_min_ohm, rs_max_ohm;
-  float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
-  float rs_tolerance, tr_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
-  uint32_t tr_nominal_known;
-  uint32_t ls_check;         /* L_S measured at no load: 0 not yet, 1 agrees, 2 differs (latched) */
-  imest_inverter_t inverter; /* as configured: the R_S verdict weighs its uncertainty */
-  float pwm_hz;
-  uint32_t duty_input; /* the last window was fed by imest_isr_duty */
-  float noise_g[6];    /* the front end's noise gains (bg_noise.h) */
-  float w_prev_rad_s;  /* the previous window's mean speed (angle observer) */
-  uint32_t w_prev_valid;
-  imest_combo_t combo;    /* windows combined where one has too little information */
-  float last_k1, last_k2; /* last valid estimate: centring of later windows */
-} imest_t;
+/* The instance's layout (private; public for static allocation). */
+#include "imest/imest_instance.h"
 
 /* ----------------------------------------------------------------------------
  * API

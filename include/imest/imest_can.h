@@ -30,7 +30,7 @@
  *   56..63 CRC-8 SAE J1850 over [frame index, bytes 0..6].
  *
  * Where each signal sits is one table (imest_can_signal_table(), in
- * src/can_signals.c) that drives packing, decoding and the saturation bits;
+ * src/can/can_signals.c) that drives packing, decoding and the saturation bits;
  * tools/imest.dbc describes the same layout for CAN tools and test/can proves
  * the two equal, signal by signal. Layout and reasoning: port/README.md.
  *

@@ -2,7 +2,7 @@
 """tools/imest.dbc against the C codec, in two ways:
 
 1. Structure: the C signal table (imest-can-selftest --table, i.e.
-   src/can_signals.c) and the DBC (loaded with python3-canmatrix) must
+   src/can/can_signals.c) and the DBC (loaded with python3-canmatrix) must
    describe the same signals: frame, start bit, length, byte order,
    signedness / float, factor, offset, min/max, not-available and enum value
    tables (reason names = imest_reason_name()). Mutated copies of the DBC

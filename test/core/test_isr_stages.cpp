@@ -28,7 +28,7 @@ TEST(IsrTransform, SinCosWithin1p5e6OverSeveralTurns)
 TEST(IsrTransform, WrapPiKeepsAngleModulo2Pi)
 {
   for (double x : {-100.0, -7.0, -3.2, -0.1, 0.0, 0.1, 3.2, 7.0, 100.0, 1000.0}) {
-    const double w = isr_wrap_pi((float)x);
+    const double w = imest__wrap_pi((float)x);
     EXPECT_LE(std::fabs(w), M_PI + 1e-5) << x;
     EXPECT_NEAR(std::remainder(w - x, 2 * M_PI), 0.0, 1e-4) << x;
   }
@@ -42,7 +42,7 @@ TEST(IsrTransform, ClarkeIsPowerInvariant)
     const float x[3] = {(float)(a * std::cos(ph)), (float)(a * std::cos(ph - 2 * M_PI / 3)),
                         (float)(a * std::cos(ph + 2 * M_PI / 3))};
     float xa, xb;
-    isr_clarke(x, &xa, &xb);
+    imest__clarke(x, &xa, &xb);
     EXPECT_NEAR(xa, 230 * std::cos(ph), 1e-3);
     EXPECT_NEAR(xb, 230 * std::sin(ph), 1e-3);
   }

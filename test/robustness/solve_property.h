@@ -9,7 +9,7 @@
 
 #include "bg_solve.h" /* with bg_bounds.h: BG_SOLVE_WORK_BOUND, the one definition */
 
-/* NULL if out (returned as rc by bg_solve for cfg) has the property, else
+/* NULL if out (returned as rc by imest__bg_solve for cfg) has the property, else
  * what is wrong. */
 static inline const char *solve_property(int rc, const bg_solve_cfg_t *cfg, const bg_solve_out_t *out)
 {

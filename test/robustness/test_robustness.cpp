@@ -447,7 +447,7 @@ TEST(RobustCondition, StandstillThenRunUnderIfoc)
 // FINDING (reported to the lead): in IFOC loaded steady state (ideal voltage
 // stage, 850 rpm, rated load, window 0.5 s) about one window in four selects
 // the spurious stationary point T_R ~ 5.7 ms, R_S ~ 27 ohm (roots 0.1189,
-// 0.0628, 0.00566 s, all admissible; src/bg_select.c keeps the least E) and is
+// 0.0628, 0.00566 s, all admissible; src/estimator/solve/bg_select.c keeps the least E) and is
 // then reported poorly_determined: never a wrong valid result, but lost
 // windows. The V/f supply at the same operating point loses none (40 of 40
 // valid). Enable when the selection prefers the well-determined minimum.

@@ -1,4 +1,4 @@
-// The background solve (internal bg_solve) on 20 000 seeded random windows
+// The background solve (internal imest__bg_solve) on 20 000 seeded random windows
 // of sums: raw bit patterns (NaN, Inf, denormal, huge), special values, and
 // structured sums R = sum W'W from random W (full rank, rank deficient, scaled
 // by 1e+-30, sign flips, one entry poisoned, random motor constants and
@@ -204,7 +204,7 @@ TEST(SolveRandom, PropertyHoldsOn20000SeededCases)
     }
     bg_solve_out_t out;
     std::memset(&out, 0xA5, sizeof out); // garbage in: the solve must set what it reports
-    const int rc = bg_solve(&s, &cfg, &out);
+    const int rc = imest__bg_solve(&s, &cfg, &out);
     const char *bad = solve_property(rc, &cfg, &out);
     if (rc >= 0 && rc < 32) by_status[rc]++;
     if (rc == IMEST_ERR_CONFIG) ++config_errors;
@@ -229,7 +229,7 @@ TEST(SolveRandom, NullArguments)
   bg_sums_t s{};
   bg_solve_cfg_t cfg = default_cfg();
   bg_solve_out_t out;
-  EXPECT_EQ(bg_solve(nullptr, &cfg, &out), IMEST_ERR_NULL);
-  EXPECT_EQ(bg_solve(&s, nullptr, &out), IMEST_ERR_NULL);
-  EXPECT_NE(bg_solve(&s, &cfg, nullptr), IMEST_OK);
+  EXPECT_EQ(imest__bg_solve(nullptr, &cfg, &out), IMEST_ERR_NULL);
+  EXPECT_EQ(imest__bg_solve(&s, nullptr, &out), IMEST_ERR_NULL);
+  EXPECT_NE(imest__bg_solve(&s, &cfg, nullptr), IMEST_OK);
 }

@@ -1,4 +1,4 @@
-// imest-bench-solve: microseconds per bg_solve on the testvector (not a
+// imest-bench-solve: microseconds per imest__bg_solve on the testvector (not a
 // test; prints figures). Usage: imest-bench-solve [repetitions]
 #include <chrono>
 #include <cstdio>
@@ -33,10 +33,10 @@ int main(int argc, char **argv)
   bg_solve_out_t o{};
   bg_solve_stats_t st{};
   volatile double sink = 0;
-  (void)bg_solve_ex(&s, &cfg, &o, &st);
+  (void)imest__bg_solve_ex(&s, &cfg, &o, &st);
   const auto t0 = std::chrono::steady_clock::now();
   for (long i = 0; i < reps; ++i) {
-    (void)bg_solve(&s, &cfg, &o);
+    (void)imest__bg_solve(&s, &cfg, &o);
     sink = sink + o.tr_s;
   }
   const auto t1 = std::chrono::steady_clock::now();
@@ -46,8 +46,8 @@ int main(int argc, char **argv)
 #else
   const char *chain = "float32";
 #endif
-  std::printf("bg_solve (%s Sturm chain): %.2f us per solve over %ld repetitions; T_R = %.9g s\n", chain, us,
-              reps, o.tr_s);
+  std::printf("imest__bg_solve (%s Sturm chain): %.2f us per solve over %ld repetitions; T_R = %.9g s\n",
+              chain, us, reps, o.tr_s);
   std::printf("roots %u, work %u (Sturm %u, bisect %u, polish %u, quality %u); no allocation\n", o.n_roots,
               o.work, st.roots.sturm_evals, st.roots.bisect_steps, st.roots.polish_evals, st.quality_evals);
   return 0;

@@ -86,10 +86,10 @@ Bf brute_force(const bg_sums_t &s, const bg_solve_cfg_t &cfg)
 int companion_roots_in_band(const bg_sums_t &s, const bg_solve_cfg_t &cfg)
 {
   bg_tables_t t;
-  if (bg_tables_build(&s, cfg.tr_nominal_s, &t) != IMEST_OK) return -1;
-  if (cfg.weight_c > 0) bg_tables_weight(&t, cfg.weight_c);
+  if (imest__bg_tables_build(&s, cfg.tr_nominal_s, &t) != IMEST_OK) return -1;
+  if (cfg.weight_c > 0) imest__bg_tables_weight(&t, cfg.weight_c);
   double r[22];
-  bg_resultant(&t, r, 0);
+  imest__bg_resultant(&t, r, 0);
   int hi = BG_RES_DEG;
   while (hi > 0 && r[hi] == 0) --hi;
   Eigen::VectorXd c(hi + 1);
@@ -112,7 +112,7 @@ void check_case(const bg_sums_t &s, const bg_solve_cfg_t &cfg, const char *name,
                 double *worst_k2, double *worst_e)
 {
   bg_solve_out_t o;
-  const int st = bg_solve(&s, &cfg, &o);
+  const int st = imest__bg_solve(&s, &cfg, &o);
   const Bf bf = brute_force(s, cfg);
   // roots in band: Sturm (float32 or float64 chain) == companion
   unsigned in_band = 0;
@@ -163,7 +163,7 @@ TEST(BruteForce, RealisticRandomSums)
     std::snprintf(name, sizeof name, "case %d (T_R %.3f, noise %.1e)", it, mo.tr, noise);
     check_case(s, cfg, name, &skipped, &wk, &we);
     bg_solve_out_t o;
-    if (bg_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
+    if (imest__bg_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
     ++n;
   }
   std::printf(
@@ -190,14 +190,14 @@ TEST(BruteForce, WeightedCostRealisticRandomSums)
     const double noise = std::pow(10.0, -4 + 3 * U(rng));
     const bg_sums_t s = it % 2 ? synthetic_sums(rng, mo, noise, 1000) : eiv_sums(rng, mo, 0.3 * noise, 1000);
     bg_solve_cfg_t cfg = default_cfg(mo.sigma, mo.ls);
-    cfg.weight_c = bg_solve_weight_c(&s);
+    cfg.weight_c = imest__bg_solve_weight_c(&s);
     ASSERT_GT(cfg.weight_c, 0.0);
     char name[80];
     std::snprintf(name, sizeof name, "weighted case %d (T_R %.3f, noise %.1e, c %.3g)", it, mo.tr, noise,
                   cfg.weight_c);
     check_case(s, cfg, name, &skipped, &wk, &we);
     bg_solve_out_t o;
-    if (bg_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
+    if (imest__bg_solve(&s, &cfg, &o) == IMEST_OK && std::fabs(o.tr_s - mo.tr) < 0.05 * mo.tr) ++near_true;
     ++n;
   }
   std::printf(
@@ -223,9 +223,9 @@ TEST(WeightedCost, ErrorsInVariablesPullThePapersMinimumTowardsSmallTR)
     const bg_sums_t s = eiv_sums(rng, mo, 100.0, 2000, /*steady=*/true);
     bg_solve_cfg_t cfg = default_cfg(mo.sigma, mo.ls);
     bg_solve_out_t op, ow;
-    const int sp = bg_solve(&s, &cfg, &op);
-    cfg.weight_c = bg_solve_weight_c(&s);
-    const int sw = bg_solve(&s, &cfg, &ow);
+    const int sp = imest__bg_solve(&s, &cfg, &op);
+    cfg.weight_c = imest__bg_solve_weight_c(&s);
+    const int sw = imest__bg_solve(&s, &cfg, &ow);
     if (n < 3)
       std::printf("[weighted] case %d: n_p w %.1f 1/s; paper T_R %.5f s, weighted T_R %.5f s (true %.3f)\n",
                   it, std::sqrt(cfg.weight_c), op.tr_s, ow.tr_s, mo.tr);

@@ -28,7 +28,7 @@ TEST(LsBaseline, ConstrainedBeatsOverParameterisedLs)
   const Eigen::VectorXd sv = svd.singularValues();
   bg_solve_out_t o;
   const bg_solve_cfg_t cfg = solvetest::default_cfg();
-  ASSERT_EQ(bg_solve(&s, &cfg, &o), IMEST_OK);
+  ASSERT_EQ(imest__bg_solve(&s, &cfg, &o), IMEST_OK);
   std::printf("[ls-baseline] cond (column-scaled, 7 columns) %.3g; LS T_R = 1/K2 = %.6g s (K5 = %.6g s); "
               "constrained T_R = %.6g s; true 0.12 s\n",
               sv[0] / sv[6], tr_ls, tr_ls_k5, o.tr_s);

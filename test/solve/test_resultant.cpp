@@ -43,9 +43,9 @@ TEST(Resultant, GenericDegree20)
   for (int it = 0; it < 500; ++it) {
     const bg_sums_t s = random_psd(rng, false, 0);
     bg_tables_t t;
-    bg_tables_scaled(&s, 0, 0, 0, &t);
+    imest__bg_tables_scaled(&s, 0, 0, 0, &t);
     double rw[22];
-    bg_resultant(&t, rw, 1);
+    imest__bg_resultant(&t, rw, 1);
     EXPECT_EQ(rw[0], 0.0); // weight 0: r_w = kappa r
     const double *r = rw + 1;
     double mag = 0;
@@ -58,13 +58,13 @@ TEST(Resultant, GenericDegree20)
     EXPECT_LE(r[0], 1e-12 * mag);
     // generic flag keeps r[19], r[20]; the regressor flag zeroes them
     double r18[22];
-    bg_resultant(&t, r18, 0);
+    imest__bg_resultant(&t, r18, 0);
     EXPECT_EQ(r18[20], 0.0);
     EXPECT_EQ(r18[21], 0.0);
     for (int k = 0; k < 20; ++k) EXPECT_EQ(r18[k], rw[k]);
     // r(0) < 0 and lead > 0 => at least one positive root, found
     double roots[20];
-    const int n = bg_roots_positive(r, 20, roots, 20);
+    const int n = imest__bg_roots_positive(r, 20, roots, 20);
     EXPECT_GE(n, 1) << it;
   }
 }
@@ -76,9 +76,9 @@ TEST(Resultant, StructuredDegree18)
   for (int it = 0; it < 500; ++it) {
     const bg_sums_t s = random_psd(rng, true, m);
     bg_tables_t t;
-    bg_tables_scaled(&s, 0, 0, 0, &t);
+    imest__bg_tables_scaled(&s, 0, 0, 0, &t);
     double rw[22];
-    bg_resultant(&t, rw, 1);
+    imest__bg_resultant(&t, rw, 1);
     const double *r = rw + 1;
     double mag = 0;
     for (int k = 0; k < 21; ++k) mag = std::max(mag, std::fabs(r[k]));
@@ -109,14 +109,14 @@ TEST(Resultant, WeightedStructuredDegree19)
   for (int it = 0; it < 300; ++it) {
     const bg_sums_t s = random_psd(rng, true, m);
     bg_tables_t t;
-    bg_tables_scaled(&s, 0, 0, 0, &t);
+    imest__bg_tables_scaled(&s, 0, 0, 0, &t);
     double r0[22];
-    bg_resultant(&t, r0, 1);
+    imest__bg_resultant(&t, r0, 1);
     const double cw = std::pow(10.0, -2 + 4 * U(rng));
-    bg_tables_weight(&t, cw);
+    imest__bg_tables_weight(&t, cw);
     EXPECT_EQ(t.cw, cw);
     double r[22];
-    bg_resultant(&t, r, 1);
+    imest__bg_resultant(&t, r, 1);
     double mag = 0;
     for (double v : r) mag = std::max(mag, std::fabs(v));
     EXPECT_LE(std::fabs(r[21]), 1e-12 * mag) << it;

@@ -1,6 +1,6 @@
-// Robustness of bg_solve: random and garbage sums (zeros, NaN, Inf, huge,
+// Robustness of imest__bg_solve: random and garbage sums (zeros, NaN, Inf, huge,
 // tiny, negative definite, rank 1, indefinite, unstructured), bad configs.
-// bg_solve must always return, with a known status, and never report a
+// imest__bg_solve must always return, with a known status, and never report a
 // non-finite or out-of-band estimate with IMEST_OK. The iteration bound
 // (out->work <= BG_SOLVE_WORK_BOUND and the per-stage bounds) is asserted
 // on every case, and on realistic synthetic windows.
@@ -21,7 +21,7 @@ void check(const bg_sums_t &s, const bg_solve_cfg_t &cfg, const char *what, int 
 {
   bg_solve_out_t o;
   bg_solve_stats_t st;
-  const int rc = bg_solve_ex(&s, &cfg, &o, &st);
+  const int rc = imest__bg_solve_ex(&s, &cfg, &o, &st);
   EXPECT_EQ(rc, o.status) << what;
   EXPECT_TRUE(rc == IMEST_OK || rc == IMEST_REASON_NUMERIC || rc == IMEST_REASON_NO_ROOT)
       << what << " rc " << rc;
@@ -185,24 +185,24 @@ TEST(Robustness, BadArguments)
   const bg_sums_t s = tv_sums();
   bg_solve_cfg_t cfg = default_cfg();
   bg_solve_out_t o;
-  EXPECT_EQ(bg_solve(nullptr, &cfg, &o), IMEST_ERR_NULL);
-  EXPECT_EQ(bg_solve(&s, nullptr, &o), IMEST_ERR_NULL);
-  EXPECT_EQ(bg_solve(&s, &cfg, nullptr), IMEST_ERR_NULL);
+  EXPECT_EQ(imest__bg_solve(nullptr, &cfg, &o), IMEST_ERR_NULL);
+  EXPECT_EQ(imest__bg_solve(&s, nullptr, &o), IMEST_ERR_NULL);
+  EXPECT_EQ(imest__bg_solve(&s, &cfg, nullptr), IMEST_ERR_NULL);
   cfg.tr_min_s = 1;
   cfg.tr_max_s = 0.5;
-  EXPECT_EQ(bg_solve(&s, &cfg, &o), IMEST_ERR_CONFIG);
+  EXPECT_EQ(imest__bg_solve(&s, &cfg, &o), IMEST_ERR_CONFIG);
   cfg = default_cfg();
   cfg.sigma = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(bg_solve(&s, &cfg, &o), IMEST_ERR_CONFIG);
+  EXPECT_EQ(imest__bg_solve(&s, &cfg, &o), IMEST_ERR_CONFIG);
   cfg = default_cfg();
   cfg.tr_nominal_s = -1; // falls back to 0.1 s: still solves
-  EXPECT_EQ(bg_solve(&s, &cfg, &o), IMEST_OK);
+  EXPECT_EQ(imest__bg_solve(&s, &cfg, &o), IMEST_OK);
   EXPECT_EQ(o.scale_s, 8.0);
   // a band that excludes every root: NO_ROOT, outputs NaN, no crash
   cfg = default_cfg();
   cfg.tr_min_s = 0.2;
   cfg.tr_max_s = 0.3;
-  EXPECT_EQ(bg_solve(&s, &cfg, &o), IMEST_REASON_NO_ROOT);
+  EXPECT_EQ(imest__bg_solve(&s, &cfg, &o), IMEST_REASON_NO_ROOT);
   EXPECT_EQ(o.n_roots, 3u);
   EXPECT_EQ(o.n_admissible, 0u);
   EXPECT_TRUE(std::isnan(o.tr_s));

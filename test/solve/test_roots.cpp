@@ -275,7 +275,7 @@ TEST(SturmVsCompanion, RandomFamilies)
       ++n_cases;
       double roots[20];
       bg_roots_stats_t st;
-      const int nr = bg_roots_positive_ex(P.c.data(), deg, roots, 20, &st);
+      const int nr = imest__bg_roots_positive_ex(P.c.data(), deg, roots, 20, &st);
       ASSERT_GE(nr, 0);
       n_roots += nr;
       n_unresolved += (int)st.unresolved;
@@ -287,7 +287,7 @@ TEST(SturmVsCompanion, RandomFamilies)
       for (int i = 0; i < nr; ++i) {
         ASSERT_GT(roots[i], 0.0);
         if (i > 0) ASSERT_GT(roots[i], roots[i - 1]);
-        const double be = std::fabs(bg_poly_eval(P.c.data(), deg, roots[i])) / abs_sum(P.c, roots[i]);
+        const double be = std::fabs(imest__bg_poly_eval(P.c.data(), deg, roots[i])) / abs_sum(P.c, roots[i]);
         worst_backward = std::max(worst_backward, be);
         EXPECT_LE(be, 1e-11) << family_name[fam] << " case " << it << " root " << roots[i] << coefs(P.c);
       }
@@ -388,26 +388,26 @@ TEST(SturmVsCompanion, BadInput)
 {
   double r[20];
   const double zero[5] = {0, 0, 0, 0, 0};
-  EXPECT_EQ(bg_roots_positive(zero, 4, r, 20), -1);
+  EXPECT_EQ(imest__bg_roots_positive(zero, 4, r, 20), -1);
   const double nanp[3] = {1, NAN, 1};
-  EXPECT_EQ(bg_roots_positive(nanp, 2, r, 20), -1);
+  EXPECT_EQ(imest__bg_roots_positive(nanp, 2, r, 20), -1);
   const double infp[3] = {1, 0, INFINITY};
-  EXPECT_EQ(bg_roots_positive(infp, 2, r, 20), -1);
-  EXPECT_EQ(bg_roots_positive(zero, 21, r, 20), -1);
+  EXPECT_EQ(imest__bg_roots_positive(infp, 2, r, 20), -1);
+  EXPECT_EQ(imest__bg_roots_positive(zero, 21, r, 20), -1);
   const double cst[3] = {2, 0, 0};
-  EXPECT_EQ(bg_roots_positive(cst, 2, r, 20), 0);
+  EXPECT_EQ(imest__bg_roots_positive(cst, 2, r, 20), 0);
   const double lin[2] = {-3, 2}; // 2x - 3
-  ASSERT_EQ(bg_roots_positive(lin, 1, r, 20), 1);
+  ASSERT_EQ(imest__bg_roots_positive(lin, 1, r, 20), 1);
   EXPECT_DOUBLE_EQ(r[0], 1.5);
   const double one[3] = {1, -2, 1}; // (x-1)^2: double root exactly at the split
-  ASSERT_EQ(bg_roots_positive(one, 2, r, 20), 1);
+  ASSERT_EQ(imest__bg_roots_positive(one, 2, r, 20), 1);
   EXPECT_NEAR(r[0], 1.0, 1e-12);
   const double xk[4] = {0, 0, -4, 1}; // x^2 (x - 4)
-  ASSERT_EQ(bg_roots_positive(xk, 3, r, 20), 1);
+  ASSERT_EQ(imest__bg_roots_positive(xk, 3, r, 20), 1);
   EXPECT_DOUBLE_EQ(r[0], 4.0);
   // max limits the output
   const double three[4] = {-6, 11, -6, 1}; // (x-1)(x-2)(x-3)
-  ASSERT_EQ(bg_roots_positive(three, 3, r, 2), 2);
+  ASSERT_EQ(imest__bg_roots_positive(three, 3, r, 2), 2);
   EXPECT_NEAR(r[0], 1.0, 1e-14);
   EXPECT_NEAR(r[1], 2.0, 1e-14);
 }

@@ -44,7 +44,7 @@ bg_tables_t abs_tables(const bg_tables_t &t)
     for (double &v : row) v = std::fabs(v);
   for (double &v : s.rwy) v = -std::fabs(v); // the builder adds -2 g
   bg_tables_t a;
-  bg_tables_scaled(&s, t.sexp, t.gexp, t.cexp, &a);
+  imest__bg_tables_scaled(&s, t.sexp, t.gexp, t.cexp, &a);
   for (int m = 0; m < 8; ++m) a.bw2[m] = std::fabs(a.bw2[m]);
   for (int m = 0; m < 9; ++m) a.bw1[m] = std::fabs(a.bw1[m]);
   for (int m = 0; m < 10; ++m) a.bw0[m] = std::fabs(a.bw0[m]);
@@ -58,7 +58,7 @@ TEST(Testvector, ScalingsAndTables)
   const auto &j = testvector();
   const bg_sums_t s = tv_sums();
   bg_tables_t t;
-  ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);
+  ASSERT_EQ(imest__bg_tables_build(&s, 0.1, &t), IMEST_OK);
   EXPECT_EQ(t.s, j["scale"]["s_K2"].get<double>());
   EXPECT_EQ(t.g, j["scale"]["g_K1"].get<double>());
   EXPECT_EQ(t.c, j["scale"]["c_norm"].get<double>());
@@ -97,9 +97,9 @@ TEST(Testvector, Resultant)
   const auto &j = testvector();
   const bg_sums_t s = tv_sums();
   bg_tables_t t;
-  ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);
+  ASSERT_EQ(imest__bg_tables_build(&s, 0.1, &t), IMEST_OK);
   double rw[22];
-  bg_resultant(&t, rw, 0);
+  imest__bg_resultant(&t, rw, 0);
   EXPECT_EQ(rw[0], 0.0); // c = 0: r_w = kappa r
   const double *r = rw + 1;
   const bg_tables_t a = abs_tables(t);
@@ -132,7 +132,7 @@ TEST(Testvector, SolveEndToEnd)
       default_cfg(j["params"]["sigma"].get<double>(), j["params"]["L_S"].get<double>());
   bg_solve_out_t o;
   bg_solve_stats_t st;
-  ASSERT_EQ(bg_solve_ex(&s, &cfg, &o, &st), IMEST_OK);
+  ASSERT_EQ(imest__bg_solve_ex(&s, &cfg, &o, &st), IMEST_OK);
   EXPECT_EQ(o.status, IMEST_OK);
   ASSERT_EQ(o.n_roots, 3u);
   EXPECT_EQ(o.n_admissible, 3u);
@@ -144,12 +144,12 @@ TEST(Testvector, SolveEndToEnd)
   }
   // candidates through the stage function
   bg_tables_t t;
-  ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);
+  ASSERT_EQ(imest__bg_tables_build(&s, 0.1, &t), IMEST_OK);
   double kap[3];
   for (int i = 0; i < 3; ++i) kap[i] = o.roots_k2[i] / t.s;
   bg_cand_t cand[3], best;
   unsigned nad = 0;
-  EXPECT_EQ(bg_select(&t, kap, 3, &cfg, &s, &best, cand, &nad), 0);
+  EXPECT_EQ(imest__bg_select(&t, kap, 3, &cfg, &s, &best, cand, &nad), 0);
   EXPECT_EQ(best.k2, cand[0].k2);
   EXPECT_EQ(nad, 3u);
   for (int i = 0; i < 3; ++i) {
@@ -200,10 +200,10 @@ TEST(Testvector, ChainPrecisionDoesNotMatterAfterPolish)
 {
   const bg_sums_t s = tv_sums();
   bg_tables_t t;
-  ASSERT_EQ(bg_tables_build(&s, 0.1, &t), IMEST_OK);
+  ASSERT_EQ(imest__bg_tables_build(&s, 0.1, &t), IMEST_OK);
   double rw[22], x[20];
-  bg_resultant(&t, rw, 0);
-  const int n = bg_roots_positive(rw, BG_RES_DEG, x, 20);
+  imest__bg_resultant(&t, rw, 0);
+  const int n = imest__bg_roots_positive(rw, BG_RES_DEG, x, 20);
   const double *r = rw + 1;
   ASSERT_EQ(n, 3);
   const auto &j = testvector();
@@ -213,6 +213,6 @@ TEST(Testvector, ChainPrecisionDoesNotMatterAfterPolish)
     EXPECT_LE(rel(x[i], ref), 2e-14) << i;
     double mag = 0;
     for (int k = 18; k >= 0; --k) mag = mag * x[i] + std::fabs(r[k]);
-    EXPECT_LE(std::fabs(bg_poly_eval(r, 18, x[i])), 1e-13 * mag) << i;
+    EXPECT_LE(std::fabs(imest__bg_poly_eval(r, 18, x[i])), 1e-13 * mag) << i;
   }
 }

@@ -3,7 +3,7 @@
 simulator's truth averaged over the same window, classifies it, and measures
 how well the validity rule separates good from bad windows, for the defaults
 and for other thresholds (the rule is re-evaluated from the printed indices,
-in the order of src/bg_validity.c; the re-evaluation is checked against the
+in the order of src/estimator/window/bg_validity.c; the re-evaluation is checked against the
 `valid` column for the defaults).
 
 usage: analyse.py OUT_DIR        (prints a Markdown report on stdout)

@@ -1,0 +1,231 @@
+/* Commissioning: config defaults and checks, instance set-up, abort, progress and names.
+ * Runs outside the ISR (init) or reads only: float64 and <math.h> are fine here. */
+#include <math.h>
+#include <stddef.h>
+
+#include "commission_internal.h"
+
+void imest_comm_config_default(imest_comm_config_t *cc)
+{
+  if (cc == NULL) return;
+  cc->fs_hz = 8000.0f;
+  cc->pwm_hz = 0.0f;
+  cc->i_max_a = 0.0f; /* required */
+  cc->level_frac = 0.8f;
+  cc->v_max_v = 0.0f;
+  cc->time_max_s = 300.0f;
+  cc->tr_max_s = 3.0f;
+  cc->n_sensors = 3u;
+  cc->encoder_cpr = 0.0f;
+  cc->r_series_ohm = 0.0f;
+  cc->pwm_on_centred = 1;
+  cc->allow_rotation = 0;
+  cc->rated_voltage_v = 0.0f;
+  cc->rated_freq_hz = 0.0f;
+  cc->rated_speed_rpm = 0.0f;
+  cc->speed_frac = 0.4f;
+  cc->ramp_s = 2.0f;
+}
+
+static int pos(float x)
+{
+  return isfinite(x) && x > 0.0f;
+}
+
+int imest_comm_config_check(const imest_comm_config_t *cc, const char **field)
+{
+  const char *bad = NULL;
+  if (cc == NULL) {
+    if (field) *field = "cc";
+    return IMEST_ERR_NULL;
+  }
+  const double fs = (double)cc->fs_hz;
+  if (!pos(cc->fs_hz) || fs < 1000.0 || fs > 1.0e5)
+    bad = "fs_hz";
+  else if (!(isfinite(cc->pwm_hz) && cc->pwm_hz >= 0.0f) ||
+           (cc->pwm_hz > 0.0f && (cc->pwm_hz < cc->fs_hz || cc->pwm_hz > 64.0f * cc->fs_hz)))
+    bad = "pwm_hz";
+  else if (!pos(cc->i_max_a) || cc->i_max_a > 1.0e5f)
+    bad = "i_max_a";
+  else if (!(isfinite(cc->level_frac) && cc->level_frac >= 0.1f && cc->level_frac <= 0.95f))
+    bad = "level_frac";
+  else if (!(isfinite(cc->v_max_v) && cc->v_max_v >= 0.0f))
+    bad = "v_max_v";
+  else if (!pos(cc->time_max_s) || cc->time_max_s > 3600.0f)
+    bad = "time_max_s";
+  else if (!(isfinite(cc->tr_max_s) && cc->tr_max_s >= 0.01f && cc->tr_max_s <= 20.0f))
+    bad = "tr_max_s";
+  else if (cc->n_sensors != 2u && cc->n_sensors != 3u)
+    bad = "n_sensors";
+  else if (!(isfinite(cc->encoder_cpr) && cc->encoder_cpr >= 0.0f && cc->encoder_cpr < 1.0e9f))
+    bad = "encoder_cpr";
+  else if (!(isfinite(cc->r_series_ohm) && cc->r_series_ohm >= 0.0f))
+    bad = "r_series_ohm";
+  else if (cc->allow_rotation && !pos(cc->rated_voltage_v))
+    bad = "rated_voltage_v";
+  else if (cc->allow_rotation && !(pos(cc->rated_freq_hz) && (double)cc->rated_freq_hz < 0.1 * fs))
+    bad = "rated_freq_hz";
+  else if (!(isfinite(cc->rated_speed_rpm) && cc->rated_speed_rpm >= 0.0f) ||
+           (cc->rated_speed_rpm > 0.0f && pos(cc->rated_freq_hz) &&
+            (double)cc->rated_speed_rpm >= 60.0 * (double)cc->rated_freq_hz))
+    bad = "rated_speed_rpm";
+  else if (!(isfinite(cc->speed_frac) && cc->speed_frac >= 0.05f && cc->speed_frac <= 1.0f))
+    bad = "speed_frac";
+  else if (!(isfinite(cc->ramp_s) && cc->ramp_s >= 0.1f && cc->ramp_s <= 60.0f))
+    bad = "ramp_s";
+  if (field) *field = bad;
+  return bad ? IMEST_ERR_CONFIG : IMEST_OK;
+}
+
+static uint32_t samples(double t_s, double fs)
+{
+  const double n = t_s * fs + 0.5;
+  return n < 1.0 ? 1u : (n > 4.0e9 ? 4000000000u : (uint32_t)n);
+}
+
+int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
+{
+  if (c == NULL || cc == NULL) return IMEST_ERR_NULL;
+  const int rc = imest_comm_config_check(cc, NULL);
+  if (rc != IMEST_OK) return rc;
+  unsigned char *raw = (unsigned char *)c; /* no <string.h> in the core */
+  for (size_t b = 0; b < sizeof *c; ++b) raw[b] = 0u;
+
+  c->cfg = *cc;
+  const double fs = (double)cc->fs_hz;
+  c->ts_s = (float)(1.0 / fs);
+  c->fpwm = cc->pwm_hz > 0.0f ? cc->pwm_hz : cc->fs_hz;
+  c->i_trip = cc->i_max_a;
+  /* phase current top level -> alpha/beta axis current: i_n = sqrt(3/2) i_phase */
+  c->level_a = cc->level_frac * cc->i_max_a * IMEST_SQRT3_2_F;
+  /* Current loop crossover fs/40 (1.5 samples of delay cost 13 degrees of phase there). */
+  c->wc = (float)(2.0 * IMEST_PI_D * fs / 40.0);
+  c->n_off = samples(0.25, fs);
+  /* discards after a level step and after a pattern switch: the loop's settling (about 5 and
+     4 closed-loop time constants of the slow PI zero at wc/4) */
+  c->n_disc_level = samples(20.0 / (double)c->wc, fs);
+  c->n_disc_pattern = samples(12.0 / (double)c->wc, fs);
+  c->n_hf_half = 4u; /* square wave at fs/8 */
+  c->n_hf_blk = samples(0.2 / (double)CM_HF_BLOCKS, fs);
+  c->n_max = samples((double)cc->time_max_s, fs);
+  for (int x = 0; x < 3; ++x) {
+    c->ginv[x] = 1.0f;
+    c->bg_ginv[x] = 1.0f;
+    c->res.i_gain_rel[x] = 1.0f;
+    c->res.wiring_map[x] = x + 1;
+    c->d_app[x] = c->d_next[x] = 0.5f;
+  }
+  c->state = IMEST_COMM_IDLE;
+  c->reason = IMEST_COMM_REASON_NONE;
+  c->stage = IMEST_COMM_STAGE_OFFSETS;
+  const float nanf_ = (float)NAN;
+  imest_comm_value_t *vals[] = {
+      &c->res.rs_ohm,      &c->res.sigma_ls_h,    &c->res.tr_s,   &c->res.rr_ohm, &c->res.ls_standstill_h,
+      &c->res.dead_time_s, &c->res.v_threshold_v, &c->res.dr_ohm, &c->res.ls_h,   &c->res.sigma};
+  for (size_t v = 0; v < sizeof vals / sizeof vals[0]; ++v) {
+    vals[v]->value = nanf_;
+    vals[v]->std_rel = nanf_;
+    vals[v]->spread_rel = nanf_;
+  }
+  c->res.encoder_cpr = nanf_;
+  c->res.speed_ratio = nanf_;
+  c->res.slip = nanf_;
+  c->res.neg_seq_rel = nanf_;
+  c->res.rotating_r_ohm = nanf_;
+  c->res.rotating_i_a = nanf_;
+  c->res.rotating_f_hz = nanf_;
+  c->res.dc_fit_rms_v = nanf_;
+  for (int x = 0; x < 3; ++x) c->res.rs_axis_ohm[x] = nanf_;
+  c->res.inverter.uncertainty = -1.0f;
+  return IMEST_OK;
+}
+
+int imest_comm_abort(imest_comm_t *c)
+{
+  if (c == NULL) return IMEST_ERR_NULL;
+  c->abort_req = 1u;
+  return IMEST_OK;
+}
+
+int imest_comm_status(const imest_comm_t *c, imest_comm_status_t *st)
+{
+  if (c == NULL || st == NULL) return IMEST_ERR_NULL;
+  st->state = c->state;
+  st->stage = (int)c->stage;
+  st->reason = c->reason;
+  st->axis = (unsigned int)c->axis;
+  st->time_s = (float)c->k * c->ts_s;
+  /* rough shares of the run: the three axes take most of the standstill part; the rotating
+     part, when allowed, about a third of the whole */
+  const float ss = c->cfg.allow_rotation ? 0.65f : 0.97f;
+  const float per_axis = (ss - 0.08f) / 3.0f;
+  const float in_axis =
+      ((float)c->plateau + (float)c->block / (float)CM_BLK_PLATEAU) / (float)(CM_PLATEAUS + 1u);
+  float p;
+  switch (c->stage) {
+  case IMEST_COMM_STAGE_OFFSETS: p = 0.01f; break;
+  case IMEST_COMM_STAGE_WIRING: p = 0.02f; break;
+  case IMEST_COMM_STAGE_TIME_CONSTANT: p = 0.04f; break;
+  case IMEST_COMM_STAGE_STAIRCASE: p = 0.08f + per_axis * ((float)c->axis + in_axis); break;
+  case IMEST_COMM_STAGE_PULSES:
+  case IMEST_COMM_STAGE_DEMAGNETISE: p = 0.08f + per_axis * ((float)c->axis + 0.9f); break;
+  case IMEST_COMM_STAGE_ROTATE: p = ss + (0.98f - ss) * (float)c->step / 5.0f; break;
+  case IMEST_COMM_STAGE_END:
+  default: p = c->state == IMEST_COMM_DONE ? 1.0f : 0.99f; break;
+  }
+  st->progress = p;
+  return IMEST_OK;
+}
+
+const char *imest_comm_reason_name(int reason)
+{
+  switch (reason) {
+  case IMEST_COMM_REASON_NONE: return "none";
+  case IMEST_COMM_REASON_ABORTED: return "aborted";
+  case IMEST_COMM_REASON_INPUT_FAULT: return "input_fault";
+  case IMEST_COMM_REASON_OVERCURRENT: return "overcurrent";
+  case IMEST_COMM_REASON_CURRENT_AT_REST: return "current_at_rest";
+  case IMEST_COMM_REASON_OPEN_PHASE: return "open_phase";
+  case IMEST_COMM_REASON_WIRING: return "wiring";
+  case IMEST_COMM_REASON_CURRENT_NOT_REACHED: return "current_not_reached";
+  case IMEST_COMM_REASON_ROTOR_MOVED: return "rotor_moved";
+  case IMEST_COMM_REASON_TIMEOUT: return "timeout";
+  case IMEST_COMM_REASON_BACKGROUND: return "background";
+  case IMEST_COMM_REASON_FIT: return "fit";
+  case IMEST_COMM_REASON_IMPLAUSIBLE: return "implausible";
+  case IMEST_COMM_REASON_ENCODER_STILL: return "encoder_still";
+  case IMEST_COMM_REASON_ROTOR_BLOCKED: return "rotor_blocked";
+  case IMEST_COMM_REASON_PHASE_ORDER: return "phase_order";
+  case IMEST_COMM_REASON_POLE_PAIRS_AMBIGUOUS: return "pole_pairs_ambiguous";
+  case IMEST_COMM_REASON_CURRENT_LIMIT_ROTATING: return "current_limit_rotating";
+  default: return "unknown";
+  }
+}
+
+const char *imest_comm_stage_name(int stage)
+{
+  switch (stage) {
+  case IMEST_COMM_STAGE_OFFSETS: return "offsets";
+  case IMEST_COMM_STAGE_WIRING: return "wiring";
+  case IMEST_COMM_STAGE_TIME_CONSTANT: return "time_constant";
+  case IMEST_COMM_STAGE_STAIRCASE: return "staircase";
+  case IMEST_COMM_STAGE_PULSES: return "pulses";
+  case IMEST_COMM_STAGE_DEMAGNETISE: return "demagnetise";
+  case IMEST_COMM_STAGE_ROTATE: return "rotate";
+  case IMEST_COMM_STAGE_END: return "end";
+  default: return "unknown";
+  }
+}
+
+const char *imest_comm_state_name(int state)
+{
+  switch (state) {
+  case IMEST_COMM_IDLE: return "idle";
+  case IMEST_COMM_RUNNING: return "running";
+  case IMEST_COMM_COMPUTING: return "computing";
+  case IMEST_COMM_DONE: return "done";
+  case IMEST_COMM_FAILED: return "failed";
+  case IMEST_COMM_ABORTED: return "aborted";
+  default: return "unknown";
+  }
+}

@@ -1,0 +1,111 @@
+/* Commissioning internals shared by the ISR stages (float32) and the
+ * background fits (float64). Internal: not part of the public API. */
+#ifndef IMEST_COMMISSION_INTERNAL_H
+#define IMEST_COMMISSION_INTERNAL_H
+
+#include "imest/imest_commission.h"
+#include "common/imest_math.h" /* constants, imest__abs, imest__clarke, IMEST_BARRIER */
+
+/* Block kinds (tag & 0xF), plateau (tag >> 4 & 0xF), pattern (tag >> 8 & 0xF). */
+enum { CM_KIND_DC = 1u, CM_KIND_HF = 2u, CM_KIND_PROBE = 3u };
+#define CM_TAG(kind, plateau, pattern)                                                                       \
+  ((uint32_t)(kind) | ((uint32_t)(plateau) << 4) | ((uint32_t)(pattern) << 8))
+#define CM_TAG_KIND(t)    ((t)&0xFu)
+#define CM_TAG_PLATEAU(t) (((t) >> 4) & 0xFu)
+#define CM_TAG_PATTERN(t) (((t) >> 8) & 0xFu)
+
+/* Modulation patterns with the same axis voltage (imest_commission.h, step 4). */
+enum { CM_PAT_CENTRED = 0u, CM_PAT_LOW = 1u, CM_PAT_HIGH = 2u };
+
+/* DC block sums (s[]): axis voltage, the three measured currents, the dead-time, threshold and
+   slope-difference regressors, the current step's delay (first block of a plateau), and the
+   switching legs' shortest pulse as a share of the period (min(d, 1 - d)). */
+enum { CM_S_V = 0, CM_S_MA = 1, CM_S_TD = 4, CM_S_VTH = 5, CM_S_DR = 6, CM_S_DELAY = 7, CM_S_PULSE = 8 };
+
+/* The plateau where the clamped patterns alternate with the centred one: the top, where the
+   switching leg's pulses are longest (at lower currents they may be shorter than the dead
+   time allows, and a clamped pattern's error is then no longer the model's). */
+#define CM_PLATEAU_PATTERNS 2u
+/* Square-wave block sums: y = current step over a period, x1 = voltage, x2 = mean current. */
+enum { CM_H_X11 = 0, CM_H_X12, CM_H_X1, CM_H_X22, CM_H_X2, CM_H_YX1, CM_H_YX2, CM_H_Y, CM_H_YY };
+
+#define CM_PLATEAUS     5u /* levels 1, 2, 3, 2, 1 thirds */
+#define CM_BLK_PLATEAU  9u /* blocks per plateau: 3 cycles of the 3 patterns */
+#define CM_HF_BLOCKS    8u
+#define CM_PROBE_ROUND  6u /* probe blocks per round; block length doubles per round */
+#define CM_PROBE_ROUNDS 9u
+#define CM_WIRING_N     3u
+
+/* Jobs handed to the background (job_kind). */
+enum {
+  CM_JOB_WIRING = 1u,
+  CM_JOB_PROBE = 2u,
+  CM_JOB_AXIS = 3u,
+  CM_JOB_STANDSTILL = 4u,
+  CM_JOB_ROTATION = 5u
+};
+
+/* Sub-steps of the rotating stage. */
+enum {
+  CM_ROT_MAGNETISE = 0u,
+  CM_ROT_RAMP = 1u,
+  CM_ROT_SETTLE = 2u,
+  CM_ROT_MEASURE = 3u,
+  CM_ROT_DOWN = 4u,
+  CM_ROT_STOP = 5u
+};
+
+/* rot_sum[] */
+enum { CM_R_ID = 0, CM_R_IQ, CM_R_ND, CM_R_NQ, CM_R_UD, CM_R_UQ, CM_R_I2, CM_R_N, CM_R_WE, CM_R_LIM };
+
+/* Level of plateau p as a fraction of the top (1/3, 2/3, 1, 2/3, 1/3). */
+static inline float cm_level(uint32_t p)
+{
+  const uint32_t q = p < 3u ? p + 1u : 5u - p;
+  return (float)q * (1.0f / 3.0f);
+}
+
+/* ISR side (commission_isr.c and the stage files). */
+void imest__cm_fail(imest_comm_t *c, int reason);
+void imest__cm_post(imest_comm_t *c, uint32_t kind, uint32_t nblk);
+int imest__cm_job_done(const imest_comm_t *c);
+void imest__cm_set_gains(imest_comm_t *c, float sl_h);
+float imest__cm_pi(imest_comm_t *c, uint32_t pat, float err, int with_p);
+void imest__cm_command(imest_comm_t *c, uint32_t pat, float u_n, float vdc);
+int imest__cm_current_loop(imest_comm_t *c, uint32_t pat, float err, float vdc);
+void imest__cm_dc_accumulate(imest_comm_t *c, const float m[3], float v_n, float vdc);
+void imest__cm_block_start(imest_comm_t *c, uint32_t tag);
+void imest__cm_block_flush(imest_comm_t *c);
+
+/* Stage entries and the end of the commanding part. */
+void imest__cm_probe_begin(imest_comm_t *c);
+void imest__cm_staircase_begin(imest_comm_t *c, uint32_t axis);
+void imest__cm_pulses_begin(imest_comm_t *c);
+void imest__cm_rotate_begin(imest_comm_t *c);
+void imest__cm_finish(imest_comm_t *c);
+
+/* Stage steps: each sets c->d_next. m: the currents (offsets and gains corrected); i_n / i_p:
+   axis and perpendicular currents; v_n: the axis voltage applied over the present period. */
+void imest__cm_stage_offsets(imest_comm_t *c, const float m[3], float vdc);
+void imest__cm_stage_wiring(imest_comm_t *c, const float m[3], float vdc);
+void imest__cm_stage_probe(imest_comm_t *c, const float m[3], float vdc, float i_n, float v_n);
+void imest__cm_stage_staircase(imest_comm_t *c, const float m[3], float vdc, float i_n, float v_n);
+void imest__cm_stage_pulses(imest_comm_t *c, float vdc, float i_n, float v_ended);
+void imest__cm_stage_demagnetise(imest_comm_t *c, float vdc, float i_n);
+void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc);
+
+/* Background side. */
+void imest__cm_fit_wiring(imest_comm_t *c);
+void imest__cm_fit_probe(imest_comm_t *c);
+void imest__cm_fit_axis(imest_comm_t *c, uint32_t axis);
+void imest__cm_fit_standstill(imest_comm_t *c);
+void imest__cm_fit_rotation(imest_comm_t *c);
+
+/* Small dense least squares (float64, background): solves the n x n symmetric positive
+   definite system a x = b (a overwritten by its Cholesky factor, x in b). Also returns the
+   inverse's diagonal in dinv if not NULL. 0 on success, -1 if not positive definite. */
+#define CM_LSQ_MAX 10
+int imest__cm_chol_solve(double a[CM_LSQ_MAX][CM_LSQ_MAX], double b[CM_LSQ_MAX], unsigned int n,
+                         double dinv[CM_LSQ_MAX]);
+
+#endif /* IMEST_COMMISSION_INTERNAL_H */

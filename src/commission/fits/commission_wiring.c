@@ -1,0 +1,164 @@
+/* Commissioning stage 2, wiring: a bipolar voltage pulse along each axis (+V then -V for the
+ * same time, so the current returns to zero and the rotor flux stays ~0), doubled from 4 % of
+ * the bus until the current responds. The current vector at the end of the +V half (its peak)
+ * says which channel reads which leg, with which sign, and whether a phase is open; its size
+ * gives a rough sigma*L_S for the current controller (high by the dead time's loss near zero
+ * current, which only lowers the loop's phase margin a little).
+ * ISR part float32; the analysis (imest__cm_fit_wiring) runs in the background, float64. */
+#include <math.h>
+#include <stddef.h>
+
+#include "commission_internal.h"
+
+enum { W_POS = 0u, W_NEG = 1u, W_REST = 2u, W_WAIT = 3u };
+
+static uint32_t pulse_len(const imest_comm_t *c)
+{
+  const uint32_t n = (uint32_t)(1.0e-3f * c->cfg.fs_hz + 0.5f);
+  return n < 4u ? 4u : n;
+}
+
+void imest__cm_stage_wiring(imest_comm_t *c, const float m[3], float vdc)
+{
+  float u = 0.0f;
+  c->cnt++;
+  const float i_big = 0.5f * c->cfg.i_max_a;
+  switch (c->step) {
+  case W_POS:
+    u = c->pulse_v;
+    if (imest__abs(m[0]) > i_big || imest__abs(m[1]) > i_big || imest__abs(m[2]) > i_big ||
+        c->cnt >= pulse_len(c)) {
+      c->pulse_n = c->cnt;
+      c->step = W_NEG;
+      c->cnt = 0u;
+    }
+    break;
+  case W_NEG:
+    u = -c->pulse_v;
+    if (c->cnt == 2u) /* the + half's last period has just been applied: the peak */
+      for (int x = 0; x < 3; ++x) c->pulse_resp[c->axis][x] = m[x];
+    if (c->cnt >= c->pulse_n) {
+      c->step = W_REST;
+      c->cnt = 0u;
+    }
+    break;
+  case W_REST: {
+    const float i_small = 0.02f * c->cfg.i_max_a;
+    const int quiet = imest__abs(m[0]) < i_small && imest__abs(m[1]) < i_small && imest__abs(m[2]) < i_small;
+    if (!((quiet && c->cnt >= 2u * c->pulse_n) || c->cnt > 50u * pulse_len(c))) break;
+    const float *r = c->pulse_resp[c->axis];
+    const uint32_t a = c->axis;
+    const float resp = IMEST_SQRT2_3_F * (r[a] - 0.5f * (r[(a + 1u) % 3u] + r[(a + 2u) % 3u]));
+    const float rmax = imest__abs(r[0]) + imest__abs(r[1]) + imest__abs(r[2]);
+    if (rmax < 0.1f * c->cfg.i_max_a && c->pulse_v < 0.5f * c->v_lim && c->pulse_tries < 8u) {
+      c->pulse_v *= 2.0f; /* too weak: twice the voltage, same axis */
+      c->pulse_tries++;
+    } else {
+      c->pulse_vk[a] = c->pulse_v;
+      c->pulse_nk[a] = c->pulse_n;
+      c->pulse_ik[a] = resp;
+      c->axis++;
+    }
+    c->step = W_POS;
+    c->cnt = 0u;
+    if (c->axis >= 3u) {
+      c->axis = 0u;
+      c->step = W_WAIT;
+      c->wait = 0u;
+      imest__cm_post(c, CM_JOB_WIRING, 0u);
+    }
+    break;
+  }
+  case W_WAIT:
+  default:
+    if (!imest__cm_job_done(c)) {
+      if (++c->wait > (uint32_t)(10.0f * c->cfg.fs_hz)) imest__cm_fail(c, IMEST_COMM_REASON_BACKGROUND);
+      break;
+    }
+    if (c->bg_fail) {
+      imest__cm_fail(c, c->bg_fail);
+      break;
+    }
+    imest__cm_set_gains(c, c->bg_sl);
+    imest__cm_probe_begin(c);
+    break;
+  }
+  imest__cm_command(c, CM_PAT_CENTRED, u, vdc);
+}
+
+/* Background: which channel reads which leg. The true response of a pulse on axis k is
+   c_k (1 on leg k, -1/2 on the others); channel ch reads sign_ch x leg perm(ch). Every one of the
+   6 x 8 assignments is scored by its correlation with the measured 3 x 3 response; the best must
+   explain it (relative residual < 0.25) and be the identity with positive signs. */
+void imest__cm_fit_wiring(imest_comm_t *c)
+{
+  static const unsigned int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  double norm2 = 0.0, amax = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    double a = 0.0;
+    for (int x = 0; x < 3; ++x) {
+      norm2 += (double)c->pulse_resp[k][x] * (double)c->pulse_resp[k][x];
+      a += fabs((double)c->pulse_resp[k][x]);
+    }
+    if (a > amax) amax = a;
+  }
+  c->bg_fail = 0;
+  /* an axis that draws (almost) nothing: a leg or phase is open */
+  for (int k = 0; k < 3; ++k) {
+    double a = 0.0;
+    for (int x = 0; x < 3; ++x) a += fabs((double)c->pulse_resp[k][x]);
+    if (!(a > 0.1 * amax) || !(amax > 0.0)) c->bg_fail = IMEST_COMM_REASON_OPEN_PHASE;
+  }
+  double best = -1.0;
+  int best_p = 0, best_s = 0;
+  for (int p = 0; p < 6; ++p)
+    for (int sgn = 0; sgn < 8; ++sgn) {
+      double dot = 0.0;
+      for (int k = 0; k < 3; ++k)
+        for (int ch = 0; ch < 3; ++ch) {
+          const double e = perms[p][ch] == (unsigned int)k ? 1.0 : -0.5;
+          const double s = (sgn >> ch) & 1 ? -1.0 : 1.0;
+          dot += s * e * (double)c->pulse_resp[k][ch];
+        }
+      if (dot > best) {
+        best = dot;
+        best_p = p;
+        best_s = sgn;
+      }
+    }
+  /* residual of the best assignment with one amplitude per axis */
+  double res2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    double num = 0.0;
+    for (int ch = 0; ch < 3; ++ch) {
+      const double e =
+          (perms[best_p][ch] == (unsigned int)k ? 1.0 : -0.5) * ((best_s >> ch) & 1 ? -1.0 : 1.0);
+      num += e * (double)c->pulse_resp[k][ch];
+    }
+    const double amp = num / 1.5; /* |e|^2 = 1.5 */
+    for (int ch = 0; ch < 3; ++ch) {
+      const double e =
+          (perms[best_p][ch] == (unsigned int)k ? 1.0 : -0.5) * ((best_s >> ch) & 1 ? -1.0 : 1.0);
+      const double r = (double)c->pulse_resp[k][ch] - amp * e;
+      res2 += r * r;
+    }
+  }
+  for (int ch = 0; ch < 3; ++ch) {
+    /* wiring_map[leg] = (channel + 1) * sign */
+    const unsigned int leg = perms[best_p][ch];
+    c->res.wiring_map[leg] = (ch + 1) * ((best_s >> ch) & 1 ? -1 : 1);
+  }
+  if (c->bg_fail == 0 && (best_p != 0 || best_s != 0)) c->bg_fail = IMEST_COMM_REASON_WIRING;
+  if (c->bg_fail == 0 && !(res2 < 0.0625 * norm2)) c->bg_fail = IMEST_COMM_REASON_OPEN_PHASE;
+  /* rough sigma*L_S: volt-seconds of the + half over the current it drove, median of three */
+  double sl[3];
+  for (int k = 0; k < 3; ++k) {
+    const double di = fabs((double)c->pulse_ik[k]);
+    sl[k] = di > 0.0 ? (double)c->pulse_vk[k] * (double)c->pulse_nk[k] * (double)c->ts_s / di : 0.0;
+  }
+  double med = sl[0];
+  if ((sl[1] - sl[0]) * (sl[1] - sl[2]) <= 0.0) med = sl[1];
+  if ((sl[2] - sl[0]) * (sl[2] - sl[1]) <= 0.0) med = sl[2];
+  if (c->bg_fail == 0 && !(med > 0.0 && med < 10.0)) c->bg_fail = IMEST_COMM_REASON_IMPLAUSIBLE;
+  c->bg_sl = (float)med;
+}

@@ -1,0 +1,203 @@
+/* Commissioning stage 7 (with allow_rotation): a rotating field at no load. The field angle
+ * advances by a unit phasor rotated every sample (no sin/cos calls). The current is controlled
+ * in the field frame to the rated magnetising current on d and zero on q (a current-fed field:
+ * voltage-fed V/f at no load oscillates on a low-inertia motor, a current-fed one is damped by
+ * the rotor circuit); feed-forward (R_S + j w L_S) I_m with the standstill values, PI for the
+ * rest. The command is turned to the centre of the period it will be applied in (1.5 samples
+ * ahead) and modulated with min-max zero sequence; the identified inverter model is added per
+ * leg, so the voltage applied is the one commanded.
+ *
+ * The run starts from a magnetised motor: the same current as DC on the a axis for 1 s + 3 T_R
+ * (the field frame starts there). Then the frequency ramps to speed_frac of rated (held while a
+ * phase current is above 90 % of i_max_a), settles (1 s + 3 T_R) and is measured over whole
+ * electrical periods (>= 1 s): the current demodulated at the field angle (positive and negative
+ * sequence), the commanded voltage, and the encoder's travel; then it ramps down and the
+ * current goes to zero. imest__cm_fit_rotation turns these into L_S, n_p, the encoder's direction and
+ * counts, and the phase-order check. ISR, float32. */
+#include "commission_internal.h"
+
+/* cos and sin of a small angle |x| < 0.3 (series; error < 1e-9) */
+static void cs_small(float x, float *co, float *si)
+{
+  const float x2 = x * x;
+  *co = 1.0f - 0.5f * x2 * (1.0f - x2 * (1.0f / 12.0f) * (1.0f - x2 * (1.0f / 30.0f)));
+  *si = x * (1.0f - x2 * (1.0f / 6.0f) * (1.0f - x2 * (1.0f / 20.0f)));
+}
+
+void imest__cm_rotate_begin(imest_comm_t *c)
+{
+  c->stage = IMEST_COMM_STAGE_ROTATE;
+  c->step = CM_ROT_MAGNETISE;
+  c->cnt = 0u;
+  c->axis = 0u;
+  c->we = 0.0f;
+  c->we_test = IMEST_2PI_F * c->cfg.speed_frac * c->cfg.rated_freq_hz;
+  c->psi = c->cfg.rated_voltage_v / (IMEST_2PI_F * c->cfg.rated_freq_hz);
+  /* the rated magnetising current (standstill L_S), within 80 % of the top level; less flux if
+     the limit says so */
+  float im = c->psi / c->ls_ss;
+  if (im > 0.8f * c->level_a) {
+    im = 0.8f * c->level_a;
+    c->psi = im * c->ls_ss;
+  }
+  c->psi_im = im;
+  c->i_ref = im;
+  c->ph_c = 1.0f;
+  c->ph_s = 0.0f;
+  c->if_d = c->if_q = 0.0f;
+  c->lim_cnt = 0u;
+  for (int j = 0; j < 9; ++j) c->rot_sum[j] = 0.0f;
+  /* measure over whole electrical periods, at least 1 s */
+  const float f_e = c->we_test / IMEST_2PI_F;
+  const float periods = (float)(uint32_t)(1.0f * f_e + 0.999f);
+  c->n_meas = (uint32_t)(periods * c->cfg.fs_hz / f_e + 0.5f);
+  c->n_ramp = (uint32_t)(c->cfg.ramp_s * c->cfg.fs_hz + 0.5f);
+  c->n_settle = (uint32_t)((1.0f + 3.0f * c->tau) * c->cfg.fs_hz + 0.5f); /* also the magnetising */
+}
+
+void imest__cm_finish(imest_comm_t *c)
+{
+  c->stage = IMEST_COMM_STAGE_END;
+  c->d_next[0] = c->d_next[1] = c->d_next[2] = 0.5f;
+  c->res.stage = (int)c->stage;
+  c->state = IMEST_COMM_COMPUTING;
+}
+
+/* The inverter's voltage error of one leg (imest.h, imest_inverter_t) from the identified
+   model, for the feed-forward: the sign made linear over the ripple band. */
+static float leg_error(const imest_comm_t *c, float i, float d, float vdc)
+{
+  float s = i / c->inv_band;
+  if (s > 1.0f) s = 1.0f;
+  if (s < -1.0f) s = -1.0f;
+  const float ai = imest__abs(i);
+  const float dc = i > 0.0f ? d : 1.0f - d;
+  return s * (c->inv_td_f * vdc + c->inv_v + c->inv_rd * ai + dc * (c->inv_rsw - c->inv_rd) * ai);
+}
+
+void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
+{
+  const float ts = c->ts_s;
+  c->cnt++;
+  const float i_hi = 0.9f * c->cfg.i_max_a;
+  const int limited = imest__abs(m[0]) > i_hi || imest__abs(m[1]) > i_hi || imest__abs(m[2]) > i_hi;
+  float ia, ib;
+  imest__clarke(m, &ia, &ib);
+  switch (c->step) {
+  case CM_ROT_MAGNETISE: {
+    if (imest__cm_current_loop(c, CM_PAT_CENTRED, c->i_ref - ia, vdc) != 0) return;
+    if (c->cnt >= c->n_settle) {
+      /* the field frame starts on the a axis: the integrators continue from the DC loop */
+      c->step = CM_ROT_RAMP;
+      c->cnt = 0u;
+      c->integ[0] = c->integ[CM_PAT_CENTRED] - c->rs_ff * c->i_ref;
+      c->integ[1] = 0.0f;
+    }
+    return;
+  }
+  case CM_ROT_RAMP:
+    if (limited) {
+      c->cnt--; /* hold the frequency while the current is high */
+      if (++c->lim_cnt > (uint32_t)c->cfg.fs_hz) {
+        imest__cm_fail(c, IMEST_COMM_REASON_CURRENT_LIMIT_ROTATING);
+        return;
+      }
+    }
+    c->we = c->we_test * (float)c->cnt / (float)c->n_ramp;
+    if (c->cnt >= c->n_ramp) {
+      c->we = c->we_test;
+      c->step = CM_ROT_SETTLE;
+      c->cnt = 0u;
+    }
+    break;
+  case CM_ROT_SETTLE:
+    if (c->cnt >= c->n_settle) {
+      c->step = CM_ROT_MEASURE;
+      c->cnt = 0u;
+      c->rot_th0 = c->th_prev;
+      c->rot_w0 = c->wraps;
+    }
+    break;
+  case CM_ROT_MEASURE: break;
+  case CM_ROT_DOWN:
+    c->we = c->we_test * (1.0f - (float)c->cnt / (float)c->n_ramp);
+    if (c->cnt >= c->n_ramp) {
+      c->we = 0.0f;
+      c->step = CM_ROT_STOP;
+      c->cnt = 0u;
+    }
+    break;
+  case CM_ROT_STOP:
+  default:
+    c->d_next[0] = c->d_next[1] = c->d_next[2] = 0.5f;
+    if (c->cnt >= c->n_zero) imest__cm_finish(c);
+    return;
+  }
+  if (limited && c->step == CM_ROT_MEASURE) c->rot_sum[CM_R_LIM] += 1.0f;
+
+  /* field angle: rotate the unit phasor, renormalise to first order */
+  float co, si;
+  cs_small(c->we * ts, &co, &si);
+  const float pc = c->ph_c * co - c->ph_s * si, ps = c->ph_s * co + c->ph_c * si;
+  const float g = 1.5f - 0.5f * (pc * pc + ps * ps);
+  c->ph_c = pc * g;
+  c->ph_s = ps * g;
+
+  /* current in the field frame, its control (the rated magnetising current on d; ramping down,
+     the current follows the frequency to zero) */
+  const float id = ia * c->ph_c + ib * c->ph_s, iq = -ia * c->ph_s + ib * c->ph_c;
+  const float ref = c->step == CM_ROT_DOWN ? c->i_ref * (1.0f - (float)c->cnt / (float)c->n_ramp) : c->i_ref;
+  const float ed = ref - id, eq = -iq;
+  const float fd = c->rs_ff * ref, fq = c->we * c->ls_ss * ref;
+  c->integ[0] += c->ki * ed;
+  c->integ[1] += c->ki * eq;
+  const float ud = fd + c->integ[0] + c->kp * ed, uq = fq + c->integ[1] + c->kp * eq;
+
+  if (c->step == CM_ROT_MEASURE) {
+    float *r = c->rot_sum;
+    r[CM_R_ID] += id;
+    r[CM_R_IQ] += iq;
+    r[CM_R_ND] += ia * c->ph_c - ib * c->ph_s;
+    r[CM_R_NQ] += ia * c->ph_s + ib * c->ph_c;
+    r[CM_R_UD] += ud;
+    r[CM_R_UQ] += uq;
+    r[CM_R_I2] += ia * ia + ib * ib;
+    r[CM_R_N] += 1.0f;
+    if (c->cnt >= c->n_meas) {
+      c->rot_th1 = c->th_prev;
+      c->rot_wraps = c->wraps - c->rot_w0;
+      r[CM_R_WE] = c->we;
+      imest__cm_post(c, CM_JOB_ROTATION, 0u);
+      c->step = CM_ROT_DOWN;
+      c->cnt = 0u;
+    }
+  }
+
+  /* the voltage for the period after the next sample, at that period's centre angle */
+  cs_small(1.5f * c->we * ts, &co, &si);
+  const float c2 = c->ph_c * co - c->ph_s * si, s2 = c->ph_s * co + c->ph_c * si;
+  const float ua = ud * c2 - uq * s2, ub = ud * s2 + uq * c2;
+  float v[3];
+  v[0] = IMEST_SQRT2_3_F * ua;
+  v[1] = IMEST_SQRT2_3_F * (-0.5f * ua + IMEST_HALF_SQRT3_F * ub);
+  v[2] = IMEST_SQRT2_3_F * (-0.5f * ua - IMEST_HALF_SQRT3_F * ub);
+  float hi = v[0], lo = v[0];
+  for (int x = 1; x < 3; ++x) {
+    if (v[x] > hi) hi = v[x];
+    if (v[x] < lo) lo = v[x];
+  }
+  /* the inverter model's error at the current expected in that period: the present current
+     turned ahead with the field by 1.5 samples (a sign decided 1.5 samples early shifts the
+     error's fundamental by w 1.5 T, across the current: into the reactive voltage) */
+  const float pa = ia * co - ib * si, pb = ia * si + ib * co;
+  float ip[3];
+  ip[0] = IMEST_SQRT2_3_F * pa;
+  ip[1] = IMEST_SQRT2_3_F * (-0.5f * pa + IMEST_HALF_SQRT3_F * pb);
+  ip[2] = IMEST_SQRT2_3_F * (-0.5f * pa - IMEST_HALF_SQRT3_F * pb);
+  const float v0 = -0.5f * (hi + lo), inv = 1.0f / vdc;
+  for (int x = 0; x < 3; ++x) {
+    float d = 0.5f + (v[x] + v0) * inv;
+    d += leg_error(c, ip[x], d, vdc) * inv;
+    c->d_next[x] = d < 0.0f ? 0.0f : (d > 1.0f ? 1.0f : d);
+  }
+}

@@ -1,0 +1,399 @@
+/* Configuration defaults and checks, filter design, instance initialisation.
+ * Runs once, outside the ISR: float64 and <math.h> are fine here. */
+#include <math.h>
+#include <stddef.h>
+
+#include "bg_noise.h"
+#include "common/imest_math.h"
+
+void imest_config_default(imest_config_t *cfg)
+{
+  if (cfg == NULL) return;
+  cfg->pole_pairs = 0; /* motor constants: the caller must set them */
+  cfg->ls_h = 0.0f;
+  cfg->sigma = 0.0f;
+  cfg->fs_hz = 4000.0f;
+  cfg->window_s = 1.0f;
+  cfg->filter_hz = 100.0f;
+  cfg->aa_hz = 0.0f;
+  cfg->u_delay_s = 0.0f;
+  cfg->dc_block_hz = 1.0f;
+  cfg->angle_observer_hz = 0.0f; /* auto: filter_hz / 4 */
+  cfg->warmup_s = 0.0f;
+  cfg->start_at_rest = 0;
+  cfg->tr_nominal_s = 0.1f;
+  cfg->tr_min_s = 1.0e-3f;
+  cfg->tr_max_s = 10.0f;
+  cfg->rs_min_ohm = 0.0f;
+  cfg->rs_max_ohm = 1.0e3f;
+  cfg->max_pe_k2_rel = 0.1f;
+  cfg->max_ei = 3.0f;
+  cfg->min_current_a = 0.05f;
+  cfg->min_slip_ratio = 0.1f;
+  cfg->i_limit_a = 0.0f;
+  cfg->u_limit_v = 0.0f;
+  cfg->i_absurd_a = 1.0e4f;
+  cfg->u_absurd_v = 1.0e5f;
+  cfg->speed_limit_rad_s = 3000.0f;
+  cfg->pwm_hz = 0.0f;
+  cfg->pwm_timing = IMEST_PWM_NEXT_PERIOD;
+  cfg->inverter.dead_time_s = 0.0f;
+  cfg->inverter.v_switch_v = 0.0f;
+  cfg->inverter.r_switch_ohm = 0.0f;
+  cfg->inverter.v_diode_v = 0.0f;
+  cfg->inverter.r_diode_ohm = 0.0f;
+  cfg->inverter.i_band_a = 0.0f;
+  cfg->inverter.uncertainty = -1.0f; /* unknown until the user (or commissioning) says */
+  cfg->rs_tolerance = 0.05f;
+  cfg->tr_tolerance = 0.02f;
+  cfg->u_uncertainty_v = 0.0f;
+  cfg->timing_uncertainty_s = 1.0e-6f;
+  cfg->rs_nominal_ohm = 0.0f;
+}
+
+/* The config's float fields and their ranges, checked in order by one loop
+ * (a table costs a fraction of the flash of one comparison chain, and float
+ * arithmetic is the FPU's: no soft-double code for a check). */
+enum { C_ANY = 0, C_NONNEG = 1, C_POS = 2 };
+typedef struct {
+  unsigned short offset;
+  unsigned short kind; /* C_*: finite, and >= 0 or > 0 */
+  float below_fs;      /* |value| * (1/fs) must stay below this (0: no bound) ... */
+  float below;         /* ... and |value| below this (0: no bound) */
+  const char *name;
+} check_t;
+
+#define CHK(f, kind, below_fs, below)                                                                        \
+  {                                                                                                          \
+    (unsigned short)offsetof(imest_config_t, f), kind, below_fs, below, #f                                   \
+  }
+static const check_t k_checks[] = {
+    CHK(ls_h, C_POS, 0.0f, 0.0f),
+    CHK(sigma, C_POS, 0.0f, 1.0f),
+    CHK(fs_hz, C_POS, 0.0f, 1.000001e6f),
+    CHK(window_s, C_POS, 0.0f, 0.0f),
+    CHK(filter_hz, C_POS, 0.4f, 0.0f),
+    CHK(aa_hz, C_NONNEG, 0.45f, 0.0f),
+    CHK(u_delay_s, C_ANY, 0.0f, 0.0f),
+    CHK(dc_block_hz, C_NONNEG, 0.01f, 0.0f),
+    CHK(angle_observer_hz, C_ANY, 0.0f, 0.0f),
+    CHK(warmup_s, C_NONNEG, 0.0f, 0.0f),
+    CHK(tr_nominal_s, C_POS, 0.0f, 0.0f),
+    CHK(tr_min_s, C_POS, 0.0f, 0.0f),
+    CHK(tr_max_s, C_POS, 0.0f, 0.0f),
+    CHK(rs_min_ohm, C_NONNEG, 0.0f, 0.0f),
+    CHK(rs_max_ohm, C_POS, 0.0f, 0.0f),
+    CHK(max_pe_k2_rel, C_POS, 0.0f, 0.0f),
+    CHK(max_ei, C_POS, 0.0f, 0.0f),
+    CHK(min_current_a, C_NONNEG, 0.0f, 0.0f),
+    CHK(min_slip_ratio, C_NONNEG, 0.0f, 0.0f),
+    CHK(i_limit_a, C_NONNEG, 0.0f, 0.0f),
+    CHK(u_limit_v, C_NONNEG, 0.0f, 0.0f),
+    CHK(i_absurd_a, C_POS, 0.0f, 0.0f),
+    CHK(u_absurd_v, C_POS, 0.0f, 0.0f),
+    CHK(speed_limit_rad_s, C_POS, 3.0f, 0.0f),
+    CHK(pwm_hz, C_NONNEG, 0.0f, 0.0f),
+    CHK(inverter.dead_time_s, C_NONNEG, 0.0f, 0.0f),
+    CHK(inverter.v_switch_v, C_NONNEG, 0.0f, 0.0f),
+    CHK(inverter.r_switch_ohm, C_NONNEG, 0.0f, 0.0f),
+    CHK(inverter.v_diode_v, C_NONNEG, 0.0f, 0.0f),
+    CHK(inverter.r_diode_ohm, C_NONNEG, 0.0f, 0.0f),
+    CHK(inverter.i_band_a, C_NONNEG, 0.0f, 0.0f),
+    CHK(inverter.uncertainty, C_ANY, 0.0f, 0.0f),
+    CHK(rs_tolerance, C_POS, 0.0f, 0.0f),
+    CHK(tr_tolerance, C_POS, 0.0f, 0.0f),
+    CHK(u_uncertainty_v, C_NONNEG, 0.0f, 0.0f),
+    CHK(timing_uncertainty_s, C_NONNEG, 0.0f, 0.0f),
+    CHK(rs_nominal_ohm, C_NONNEG, 0.0f, 0.0f),
+};
+#undef CHK
+
+static int check_ok(const check_t *c, float x, float fs)
+{
+  if (!isfinite(x)) return 0;
+  if ((c->kind == C_NONNEG && x < 0.0f) || (c->kind == C_POS && !(x > 0.0f))) return 0;
+  const float ax = fabsf(x);
+  if (c->below_fs > 0.0f && !(ax < c->below_fs * fs)) return 0;
+  return !(c->below > 0.0f && !(ax < c->below));
+}
+
+int imest_config_check(const imest_config_t *cfg, const char **field)
+{
+  if (cfg == NULL) {
+    if (field) *field = "cfg";
+    return IMEST_ERR_NULL;
+  }
+  const char *bad = NULL;
+  const float fs = cfg->fs_hz, pwm = cfg->pwm_hz > 0.0f ? cfg->pwm_hz : fs;
+  if (cfg->pole_pairs < 1u || cfg->pole_pairs > 64u) bad = "pole_pairs";
+  for (unsigned int k = 0; bad == NULL && k < sizeof k_checks / sizeof k_checks[0]; ++k) {
+    const float x = *(const float *)(const void *)((const char *)cfg + k_checks[k].offset);
+    if (!check_ok(&k_checks[k], x, fs)) bad = k_checks[k].name;
+  }
+  /* the bounds that involve two fields */
+  if (bad != NULL) {
+  } else if (cfg->window_s * fs < 64.0f || cfg->window_s * fs > 4.0e8f)
+    bad = "window_s";
+  else if (fabsf(cfg->u_delay_s) * fs > 1.000001f)
+    bad = "u_delay_s";
+  else if (!(cfg->angle_observer_hz < 0.25f * fs))
+    bad = "angle_observer_hz";
+  else if (cfg->warmup_s > cfg->window_s * 100.0f)
+    bad = "warmup_s";
+  else if (!(cfg->tr_max_s > cfg->tr_min_s))
+    bad = "tr_max_s";
+  else if (!(cfg->rs_max_ohm > cfg->rs_min_ohm))
+    bad = "rs_max_ohm";
+  else if (cfg->pwm_hz != 0.0f && cfg->pwm_hz < fs * 0.999999f)
+    bad = "pwm_hz";
+  else if (!(cfg->pwm_timing == IMEST_PWM_NEXT_PERIOD || cfg->pwm_timing == IMEST_PWM_CENTRED ||
+             cfg->pwm_timing == IMEST_PWM_LAST_PERIOD))
+    bad = "pwm_timing";
+  else if (!(cfg->inverter.dead_time_s * pwm < 0.5f))
+    bad = "inverter.dead_time_s";
+  else if (!(cfg->timing_uncertainty_s * fs < 1.0f))
+    bad = "timing_uncertainty_s";
+  if (field) *field = bad;
+  return bad ? IMEST_ERR_CONFIG : IMEST_OK;
+}
+
+/* tan(x) for 0 < x < 1.3 by its sin and cos series (fixed 14 terms, relative
+ * error < 1e-15): libm's tan() alone would cost ~4.5 KB of flash on a
+ * Cortex-M4 (argument reduction tables). */
+static double tan_small(double x)
+{
+  const double x2 = x * x;
+  double s = x, c = 1.0, ts = x, tc = 1.0;
+  for (int k = 1; k <= 14; ++k) {
+    ts *= -x2 / (double)((2 * k) * (2 * k + 1));
+    tc *= -x2 / (double)((2 * k - 1) * (2 * k));
+    s += ts;
+    c += tc;
+  }
+  return s / c;
+}
+
+/* Butterworth-3 by the bilinear transform prewarped at fc: a first-order
+ * section (s + 1) and a second-order section (s^2 + s + 1). */
+static void design_bw3(imest_bw3_t *f, double fc, double fs)
+{
+  const double k = tan_small(IMEST_PI_D * fc / fs);
+  const double g1 = k / (1.0 + k);
+  f->b0 = (imest_real_t)g1;
+  f->a1 = (imest_real_t)((k - 1.0) / (1.0 + k));
+  const double a0 = 1.0 + k + k * k;
+  const double g2 = k * k / a0;
+  f->c0 = (imest_real_t)g2;
+  f->d1 = (imest_real_t)(2.0 * (k * k - 1.0) / a0);
+  f->d2 = (imest_real_t)((1.0 - k + k * k) / a0);
+}
+
+/* exp(-x) for 0 <= x <= 1.6 by its series (fixed 16 terms, float32): libm's
+ * exp() would cost flash. */
+static float exp_neg_small(float x)
+{
+  float sum = 1.0f, term = 1.0f;
+  for (int k = 1; k <= 16; ++k) {
+    term *= -x / (float)k;
+    sum += term;
+  }
+  return sum;
+}
+
+/* Angle observer gains: an alpha-beta-gamma tracker with a triple pole at
+ * r = exp(-w_n T): alpha = 1 - r^3, beta = 1.5 (1 - r)^2 (1 + r),
+ * gamma = (1 - r)^3 (f_n < 0: never engaged). */
+static void design_angle(imest_angle_t *o, float fn, float fs)
+{
+  const float r = exp_neg_small(2.0f * (float)IMEST_PI_D * (fn > 0.0f ? fn : 0.0f) / fs), q = 1.0f - r;
+  o->k1 = 1.0f - r * r * r;
+  o->k2 = 1.5f * q * q * (1.0f + r);
+  o->k3 = q * q * q;
+  o->enabled = fn >= 0.0f;
+  o->engaged = 0u; /* until a window at steady speed */
+}
+
+/* Duty-cycle input: the weights of the two periods around a sample
+ * (pwm_timing) and the inverter model per leg. */
+static void design_duty(imest_duty_model_t *d, const imest_config_t *cfg)
+{
+  const float fpwm = cfg->pwm_hz > 0.0f ? cfg->pwm_hz : cfg->fs_hz;
+  /* NEXT_PERIOD: the previous period ends at the sample and this one starts
+   * there, so their mean refers to the sample; otherwise this call's duty
+   * alone (LAST_PERIOD's half-sample lag is taken up by the delay, init). */
+  const int next = cfg->pwm_timing == IMEST_PWM_NEXT_PERIOD;
+  d->w_prev = next ? 0.5f : 0.0f;
+  d->w_now = next ? 0.5f : 1.0f;
+  const imest_inverter_t *v = &cfg->inverter;
+  d->td_f = v->dead_time_s * fpwm;
+  d->v_d = v->v_diode_v;
+  d->r_d = v->r_diode_ohm;
+  d->dv = v->v_switch_v - v->v_diode_v;
+  d->dr = v->r_switch_ohm - v->r_diode_ohm;
+  /* the current ripple's peak at 50 % duty, V_dc / (8 sigma L_S f_pwm) per
+   * carrier period: where the sign of the error is decided inside the period */
+  d->band2 = v->i_band_a * v->i_band_a;
+  d->vdc2_w = 12.0f / (cfg->u_absurd_v * cfg->u_absurd_v);
+  d->band_per_v = v->i_band_a > 0.0f ? 0.0f : 1.0f / (8.0f * cfg->sigma * cfg->ls_h * fpwm);
+  /* the staircase's images alias into the samples when the steps' edges are
+   * the sample instants (NEXT_PERIOD; docs/METHOD.md §17) */
+  d->zoh = next ? 1.0f / (12.0f * cfg->fs_hz * cfg->sigma * cfg->ls_h) : 0.0f;
+}
+
+/* 2nd-order Butterworth (Q = 1/sqrt 2) anti-alias model; fc = 0: identity. */
+static void design_aa(imest_sos_t *f, double fc, double fs)
+{
+  if (fc <= 0.0) {
+    f->c0 = 1;
+    f->d1 = 0;
+    f->d2 = 0;
+    return;
+  }
+  const double k = tan_small(IMEST_PI_D * fc / fs);
+  const double a0 = 1.0 + IMEST_SQRT2_D * k + k * k;
+  const double g = k * k / a0;
+  f->c0 = (imest_real_t)g;
+  f->d1 = (imest_real_t)(2.0 * (k * k - 1.0) / a0);
+  f->d2 = (imest_real_t)((1.0 - IMEST_SQRT2_D * k + k * k) / a0);
+}
+
+int imest_init(imest_t *s, const imest_config_t *cfg)
+{
+  if (s == NULL || cfg == NULL) return IMEST_ERR_NULL;
+  const int rc = imest_config_check(cfg, NULL);
+  if (rc != IMEST_OK) return rc;
+
+  /* no memset: the core does not depend on <string.h> */
+  unsigned char *raw = (unsigned char *)s;
+  for (size_t b = 0; b < sizeof *s; ++b) raw[b] = 0u;
+
+  /* float arithmetic wherever the ISR's float32 constants come out the same
+   * (the FPU's, no soft-double code); the filter design keeps float64 */
+  const float fs = cfg->fs_hz, sigma = cfg->sigma;
+  const double m = (1.0 - (double)sigma) / (double)sigma;
+  s->fs = fs;
+  s->inv2t = 0.5f * fs;
+  s->invt2 = fs * fs;
+  s->n = (imest_real_t)cfg->pole_pairs;
+  s->m = (imest_real_t)m;
+  s->inv_s = 1.0f / (sigma * cfg->ls_h);
+  /* no ADC limit configured: the absurd-value limit takes its place */
+  s->i_lim = cfg->i_limit_a > 0.0f ? cfg->i_limit_a : cfg->i_absurd_a;
+  s->u_lim = cfg->u_limit_v > 0.0f ? cfg->u_limit_v : cfg->u_absurd_v;
+  s->i_abs = cfg->i_absurd_a;
+  s->u_abs = cfg->u_absurd_v;
+  s->dth_max = cfg->speed_limit_rad_s / fs; /* per sample */
+  {
+    /* How much the voltage lags the currents: the timing scheme's own lag
+     * (duty input, LAST_PERIOD: the period that ended, half a sample) plus
+     * u_delay_s. A lag delays currents and angle; a lead delays the voltage. */
+    const float lag = (cfg->pwm_timing == IMEST_PWM_LAST_PERIOD ? 0.5f : 0.0f) + cfg->u_delay_s * fs;
+    s->dly_i = lag > 0.0f ? lag : 0.0f;
+    s->dly_u = lag < 0.0f ? -lag : 0.0f;
+  }
+  /* an even number of samples: a regressor sample's sums take two calls
+   * (isr_accumulate.h), and a window holds whole samples */
+  s->window_n = 2u * (uint32_t)(cfg->window_s * fs * 0.5f + 0.5f);
+
+  {
+    const float wd = 2.0f * (float)IMEST_PI_D * cfg->dc_block_hz / fs;
+    s->dcb_a = wd / (1.0f + wd); /* backward Euler: stable for any wd */
+  }
+  design_bw3(&s->bw, (double)cfg->filter_hz, (double)fs);
+  imest__bg_noise_gains(&s->bw, (double)fs, s->noise_g);
+  design_aa(&s->aa, (double)cfg->aa_hz, (double)fs);
+  s->aa_on = cfg->aa_hz > 0.0f;
+  design_angle(&s->obs, cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz, fs);
+  design_duty(&s->duty, cfg);
+
+  /* warm-up: the slowest Butterworth-3 pole decays as exp(-pi fc t); 3/fc
+   * leaves < 1e-4 of a start-up transient; the anti-alias model adds its own. */
+  double warm_s = (double)cfg->warmup_s; /* float64: whole samples come out as intended */
+  if (warm_s <= 0.0) {
+    warm_s = 3.0 / (double)cfg->filter_hz;
+    if (cfg->aa_hz > 0.0f) warm_s += 2.0 / (double)cfg->aa_hz;
+  }
+  s->warmup_fault_n = (uint32_t)(warm_s * (double)fs) + 3u; /* rounded up, +2 */
+  s->warmup_n = cfg->start_at_rest ? 0u : s->warmup_fault_n;
+  s->warm = s->warmup_n;
+  /* At the very first start the offset tracker starts from zero: the offsets,
+   * and the filter's own response to signals that were already there (a
+   * record that starts mid-run), decay as exp(-t/tau). 5 tau (0.8 s at 1 Hz)
+   * leaves 0.7 % of them; 2.5 tau left a 15 kW motor's first window valid
+   * with R_S +4 % (measured, ideal sensors). After a fault the tracker keeps
+   * its state; at rest it starts from the first currents. */
+  if (!cfg->start_at_rest && cfg->warmup_s <= 0.0f && cfg->dc_block_hz > 0.0f)
+    s->warm += (uint32_t)(5.0f / (2.0f * (float)IMEST_PI_D * cfg->dc_block_hz) * fs);
+
+  /* background constants */
+  s->sigma = cfg->sigma;
+  s->ls_h = cfg->ls_h;
+  s->tr_nominal_s = cfg->tr_nominal_s;
+  s->tr_min_s = cfg->tr_min_s;
+  s->tr_max_s = cfg->tr_max_s;
+  s->rs_min_ohm = cfg->rs_min_ohm;
+  s->rs_max_ohm = cfg->rs_max_ohm;
+  s->max_pe_k2_rel = cfg->max_pe_k2_rel;
+  s->max_ei = cfg->max_ei;
+  s->min_current_a = cfg->min_current_a;
+  s->min_slip_ratio = cfg->min_slip_ratio;
+  s->rs_tolerance = cfg->rs_tolerance;
+  s->tr_tolerance = cfg->tr_tolerance;
+  s->u_uncertainty_v = cfg->u_uncertainty_v;
+  s->timing_uncertainty_s = cfg->timing_uncertainty_s;
+  s->rs_nominal_ohm = cfg->rs_nominal_ohm;
+  s->tr_nominal_known = cfg->tr_nominal_known != 0;
+  s->inverter = cfg->inverter;
+  s->pwm_hz = cfg->pwm_hz > 0.0f ? cfg->pwm_hz : cfg->fs_hz;
+
+  /* first centring: nominal T_R, and gamma with R_S = 0 (any c0 is correct;
+   * a close one only improves float32 precision) */
+  const double k2 = 1.0 / (double)cfg->tr_nominal_s;
+  const double k1 = m * k2;
+  imest__bg_centre_from_k(s->win[0].c0, k1, k2, m);
+  imest__bg_centre_from_k(s->win[1].c0, k1, k2, m);
+  s->win[0].flags = s->warm ? IMEST_FLAG_WARMUP : 0u;
+  return IMEST_OK;
+}
+
+uint32_t imest_overruns(const imest_t *s)
+{
+  return s ? s->overruns : 0u;
+}
+
+const char *imest_err_name(int err)
+{
+  switch (err) {
+  case IMEST_OK: return "ok";
+  case IMEST_ERR_NULL: return "null_argument";
+  case IMEST_ERR_CONFIG: return "bad_config";
+  case IMEST_ERR_ARG: return "bad_argument";
+  default: return "unknown";
+  }
+}
+
+const char *imest_reason_name(int reason)
+{
+  switch (reason) {
+  case IMEST_REASON_NONE: return "ok";
+  case IMEST_REASON_WARMUP: return "warmup";
+  case IMEST_REASON_INPUT_FAULT: return "input_fault";
+  case IMEST_REASON_ADC_SATURATION: return "adc_saturation";
+  case IMEST_REASON_ENCODER_FAULT: return "encoder_fault";
+  case IMEST_REASON_NO_CURRENT: return "no_current";
+  case IMEST_REASON_STANDSTILL: return "standstill";
+  case IMEST_REASON_ZERO_SLIP: return "zero_slip";
+  case IMEST_REASON_NUMERIC: return "numeric";
+  case IMEST_REASON_NO_ROOT: return "no_root";
+  case IMEST_REASON_NOT_MINIMUM: return "not_minimum";
+  case IMEST_REASON_POORLY_DETERMINED: return "poorly_determined";
+  case IMEST_REASON_HIGH_RESIDUAL: return "high_residual";
+  case IMEST_REASON_RS_OUT_OF_RANGE: return "rs_out_of_range";
+  case IMEST_REASON_WIRING_MISMATCH: return "wiring_mismatch";
+  case IMEST_REASON_CONSTANTS_MISMATCH: return "constants_mismatch";
+  case IMEST_REASON_RS_UNCERTAIN: return "rs_uncertain";
+  case IMEST_REASON_GAIN_MISMATCH: return "gain_mismatch";
+  case IMEST_REASON_TR_UNCERTAIN: return "tr_uncertain";
+  default: return "unknown";
+  }
+}

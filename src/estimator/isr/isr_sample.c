@@ -1,0 +1,319 @@
+/* The ISR path: one call per sample, fixed instruction count, float32 only.
+ * Stages: (duty cycles -> phase voltage) -> plausibility -> 3-2 transform ->
+ * offsets -> alignment -> angle observer -> rotation -> filters and
+ * derivatives -> regressor -> accumulation -> hand-off at the window end. */
+#include "isr_accumulate.h"
+#include "isr_angle.h"
+#include "isr_duty.h"
+#include "isr_regressor.h"
+#include "isr_transform.h"
+
+/* How the entry points describe a sample to isr_step(). */
+#define ISR_IN_RANGE 1u /* every electrical input strictly inside its ADC limit (NaN fails) */
+#define ISR_U_NOISY  2u /* the voltage is measured (its noise is evidence), not formed from duties */
+
+static void isr_chan_reset(imest_chan_t *c)
+{
+  c->s1 = RL(0);
+  c->s2a = RL(0);
+  c->s2b = RL(0);
+  c->y1 = RL(0);
+  c->y2 = RL(0);
+}
+
+/* Zero every filter state and restart the warm-up: a fault must not leave
+ * NaN or a spike in a filter memory. */
+static void isr_restart_filters(imest_t *s)
+{
+  isr_chan_reset(&s->f_ux);
+  isr_chan_reset(&s->f_uy);
+  isr_chan_reset(&s->f_ix);
+  isr_chan_reset(&s->f_iy);
+  isr_chan_reset(&s->f_w);
+  s->aa_s1 = RL(0);
+  s->aa_s2 = RL(0);
+  s->warm = s->warmup_fault_n; /* also after a start at rest: the filters restart mid-run */
+}
+
+/* Reset a window buffer for a new window (the background clears the sums of
+ * a buffer it releases; after an overrun the ISR reuses its own buffer). */
+static void isr_open_window(imest_t *s, imest_window_t *w, uint32_t pending_flags)
+{
+  w->seq = s->seq;
+  w->samples = 0;
+  w->used = 0;
+  w->flags = pending_flags | (s->warm ? IMEST_FLAG_WARMUP : 0u);
+  w->rot = RL(0);
+  w->nreg = 0;
+  s->k = 0;
+}
+
+/* The second half of a pending regressor sample's sums (isr_accumulate.h):
+ * a window's sums always hold whole samples. */
+#if defined(__GNUC__)
+__attribute__((noinline)) /* one copy of the 28 products for the odd call, a flush and a fault */
+#endif
+static void
+isr_complete_pending(imest_t *s, imest_window_t *w)
+{
+  if (s->zpend) {
+    isr_accumulate_b(w, s->zx, s->zy);
+    s->zpend = 0u;
+  }
+}
+
+/* Window complete: hand it over if the background has released the other
+ * buffer, else drop it (counted, never torn). Returns 1 if handed over. */
+static int isr_close_window(imest_t *s)
+{
+  imest_window_t *w = &s->win[s->published & 1u];
+  isr_complete_pending(s, w); /* a flushed window can end on an even sample */
+  w->samples = s->k;
+  /* the ISR state the background judges the window by, as it is now */
+  w->duty_input = s->duty_input;
+  w->vdc_v = s->vdc_prev;
+  w->off_ia = s->off_ia;
+  w->off_ib = s->off_ib;
+  s->seq++;
+  if (s->published == s->released) {
+    IMEST_BARRIER();                  /* window contents before the index */
+    s->published = s->published + 1u; /* the ISR now fills the other buffer */
+    isr_open_window(s, &s->win[s->published & 1u], 0u);
+    return 1;
+  }
+  /* overrun: the background still owns the other buffer */
+  s->overruns = s->overruns + 1u;
+  for (unsigned int p = 0; p < IMEST_NACC; ++p) {
+    w->sum[p] = RL(0);
+    w->blk[p] = RL(0);
+  }
+  isr_open_window(s, w, IMEST_FLAG_OVERRUN);
+  return 0;
+}
+
+/* Common part once alpha/beta are known: ua, ub, ia, ib alpha/beta, i0 the
+ * zero sequence i_a + i_b + i_c of the phase currents (0 where the caller
+ * gives alpha/beta), th the mechanical angle as given, how: ISR_* bits.
+ * Scalar arguments: they travel in FPU registers. */
+static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t ia, imest_real_t ib,
+                    imest_real_t i0, imest_real_t th, unsigned int how)
+{
+  imest_window_t *w = &s->win[s->published & 1u];
+  uint32_t fault = 0;
+
+  /* Only an out-of-range sample pays for telling saturation from garbage:
+   * NaN and Inf fail every comparison. */
+  if (!(how & ISR_IN_RANGE)) {
+    const int plausible = imest__within(ua, s->u_abs) & imest__within(ub, s->u_abs) &
+                          imest__within(ia, s->i_abs) & imest__within(ib, s->i_abs);
+    fault = plausible ? IMEST_FLAG_ADC_SAT : IMEST_FLAG_INPUT_FAULT;
+  }
+  if (!imest__within(th, RL(1.0e8))) fault |= IMEST_FLAG_INPUT_FAULT;
+  if (fault & IMEST_FLAG_INPUT_FAULT) th = s->th_prev; /* keep the last good angle */
+  const uint32_t first = !s->started;
+  const imest_real_t dth = first ? RL(0) : imest__wrap_pi(th - s->th_prev);
+  s->started = 1u;
+  s->th_prev = th;
+  if (!imest__within(dth, s->dth_max)) fault |= IMEST_FLAG_ENCODER_FAULT;
+
+  if (fault) {
+    /* the sample is not used, the filters restart from rest and the angle
+     * observer restarts from the encoder (a jump must not ring through it) */
+    w->flags |= fault | IMEST_FLAG_WARMUP;
+    isr_complete_pending(s, w);
+    isr_restart_filters(s);
+    isr_angle_reset(&s->obs, s->obs.dth);
+    s->k++;
+    return (s->k >= s->window_n) ? isr_close_window(s) : 0;
+  }
+
+  /* Sensor offsets: the same high-pass on all four electrical channels, so
+   * the motor's equations still hold for the filtered signals. A start at
+   * rest (warmup_n is 0 only then) has no current yet: its first currents
+   * are the offsets. */
+  if (first) {
+    if (s->warmup_n == 0u) {
+      s->off_ia = ia;
+      s->off_ib = ib;
+    }
+    isr_angle_reset(&s->obs, RL(0));
+  }
+  ua = isr_dc_block(s->dcb_a, &s->off_ua, ua);
+  ub = isr_dc_block(s->dcb_a, &s->off_ub, ub);
+  ia = isr_dc_block(s->dcb_a, &s->off_ia, ia);
+  ib = isr_dc_block(s->dcb_a, &s->off_ib, ib);
+  const imest_real_t ia_now = ia, ib_now = ib;
+
+  /* White-noise evidence for the background's bias compensation: the third
+   * difference of the alpha input (beta carries the same noise).
+   * A smooth signal's third difference is (w_e T)^3 of it (1e-4 at 30 Hz and
+   * 4 kHz), white noise's sqrt(20) of it. Kept as the last value and its
+   * last two differences. */
+  const imest_real_t ia_prev = s->ia1, ua_prev = s->ua1;
+  const imest_real_t d1i = ia - ia_prev, d2i = d1i - s->dia1, d3i = d2i - s->d2ia1;
+  s->ia1 = ia;
+  s->dia1 = d1i;
+  s->d2ia1 = d2i;
+  imest_real_t noise_u = RL(0);
+  if (how & ISR_U_NOISY) { /* a voltage formed from duty cycles has no sensor noise */
+    const imest_real_t d1u = ua - ua_prev, d2u = d1u - s->dua1, d3u = d2u - s->d2ua1;
+    s->dua1 = d1u;
+    s->d2ua1 = d2u;
+    noise_u = d3u * d3u;
+  }
+  s->ua1 = ua;
+
+  /* The encoder angle through the tracking observer (which keeps quantisation
+   * steps out of the rotation and the speed alike); its step is the speed. */
+  imest_real_t step;
+  imest_real_t th_r = th + isr_angle_update(&s->obs, dth, &step);
+  imest_real_t w_raw = step * s->fs;
+  /* Optional stages branch on configuration only (the same path every
+   * sample), so a drive that does not use them does not pay for them. */
+  if (s->dly_i != RL(0)) {
+    /* the voltage lags: delay currents and angle to match */
+    const imest_real_t a = s->dly_i, w_now = w_raw;
+    ia = ia - a * (ia - ia_prev);
+    ib = ib - a * (ib - s->ib1);
+    s->ib1 = ib_now;
+    w_raw = w_now - a * (w_now - s->wr_prev);
+    th_r = th_r - a * step;
+    s->wr_prev = w_now;
+  }
+  if (s->dly_u != RL(0)) {
+    /* the voltage leads: delay it to match */
+    const imest_real_t ub_now = ub;
+    ua = ua - s->dly_u * (ua - ua_prev);
+    ub = ub - s->dly_u * (ub - s->ub1);
+    s->ub1 = ub_now;
+  }
+  if (s->aa_on) {
+    /* the angle through a model of the electrical channels' AA filter */
+    w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, w_raw);
+  }
+
+  /* rotation into the rotor frame by n_p * theta */
+  imest_real_t sn, cs;
+  isr_sincos(imest__wrap_pi(s->n * th_r), &sn, &cs);
+  imest_real_t ux, uy, ix, iy;
+  isr_rotate(sn, cs, ua, ub, &ux, &uy);
+  isr_rotate(sn, cs, ia, ib, &ix, &iy);
+
+  isr_signals_t g;
+  g.ux = isr_filter_deriv(s, &s->f_ux, ux);
+  g.uy = isr_filter_deriv(s, &s->f_uy, uy);
+  g.ix = isr_filter_deriv(s, &s->f_ix, ix);
+  g.iy = isr_filter_deriv(s, &s->f_iy, iy);
+  isr_filter_speed(s, &s->f_w, w_raw, &g.w, &g.dw);
+
+  if (s->warm) {
+    s->warm--;
+    w->flags |= IMEST_FLAG_WARMUP;
+  } else {
+    if ((s->k & 1u) == 0u) {
+      /* even call: the regressor, stored for the odd call, and its first sums */
+      isr_regressor(s, &g, w->c0, s->zx, s->zy);
+      isr_extra_t x;
+      /* i x di/dt: in steady state |i|^2 times the slip frequency */
+      x.cross = g.ix.x * g.iy.dx - g.iy.x * g.ix.dx;
+      x.noise_i = d3i * d3i;
+      x.noise_u = noise_u;
+      x.i0 = i0;
+      x.ia = ia_now; /* offset-free, before any delay, like i0 */
+      x.ib = ib_now;
+      x.ua = ua;
+      isr_accumulate_a(w, s->zx, s->zy, &x);
+      s->zpend = 1u;
+    } else {
+      isr_complete_pending(s, w);
+    }
+    w->rot += step;
+    w->used++;
+  }
+  isr_fold(w, s->k % IMEST_NACC);
+
+  s->k++;
+  return (s->k >= s->window_n) ? isr_close_window(s) : 0;
+}
+
+int imest_isr_flush(imest_t *s)
+{
+  return (s->k > 0u) ? isr_close_window(s) : 0;
+}
+
+int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a, float i_beta_a,
+                 float theta_rad)
+{
+  const imest_real_t ua = (imest_real_t)u_alpha_v, ub = (imest_real_t)u_beta_v;
+  const imest_real_t ia = (imest_real_t)i_alpha_a, ib = (imest_real_t)i_beta_a;
+  /* the limits apply to whatever quantities the caller passes */
+  const int in_range = (imest__abs(ia) < s->i_lim) & (imest__abs(ib) < s->i_lim) &
+                       (imest__abs(ua) < s->u_lim) & (imest__abs(ub) < s->u_lim);
+  s->duty_input = 0u;
+  return isr_step(s, ua, ub, ia, ib, RL(0), (imest_real_t)theta_rad,
+                  (in_range ? ISR_IN_RANGE : 0u) | ISR_U_NOISY);
+}
+
+int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], float theta_rad)
+{
+  imest_real_t u[3], i[3];
+  int in_range = 1;
+  for (unsigned int p = 0; p < 3u; ++p) {
+    u[p] = (imest_real_t)u_abc_v[p];
+    i[p] = (imest_real_t)i_abc_a[p];
+    /* a sample at (or beyond) the ADC limit: the true value is unknown */
+    in_range &= (imest__abs(i[p]) < s->i_lim) & (imest__abs(u[p]) < s->u_lim);
+  }
+  imest_real_t ua, ub, ia, ib;
+  imest__clarke(u, &ua, &ub);
+  imest__clarke(i, &ia, &ib);
+  s->duty_input = 0u;
+  return isr_step(s, ua, ub, ia, ib, (i[0] + i[1]) + i[2], (imest_real_t)theta_rad,
+                  (in_range ? ISR_IN_RANGE : 0u) | ISR_U_NOISY);
+}
+
+int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float i_abc_a[3], float theta_rad)
+{
+  const imest_duty_model_t *m = &s->duty;
+  const imest_real_t vdc = (imest_real_t)vdc_v, vdc_prev = s->vdc_prev;
+  s->vdc_prev = vdc;
+  /* per sample, shared by the legs: the weighted bus voltages, the dead-time
+   * error at their mean plus the diode threshold, and the zero-crossing band */
+  isr_duty_k_t k;
+  k.kp = m->w_prev * vdc_prev;
+  k.kn = m->w_now * vdc;
+  k.vdc = vdc;
+  k.vdc_prev = vdc_prev;
+  const imest_real_t vbar = k.kp + k.kn;
+  k.e0 = m->td_f * vbar + m->v_d;
+  const imest_real_t band = m->band_per_v * vbar;
+  k.band2 = band * band + m->band2;
+  const imest_real_t ia = (imest_real_t)i_abc_a[0], ib = (imest_real_t)i_abc_a[1],
+                     ic = (imest_real_t)i_abc_a[2];
+  const imest_real_t da = (imest_real_t)duty_abc[0], db = (imest_real_t)duty_abc[1],
+                     dc = (imest_real_t)duty_abc[2];
+  imest_real_t step[3];
+  const imest_real_t va = isr_duty_leg(m, &k, &s->dleg[0], da, ia, &step[0]);
+  const imest_real_t vb = isr_duty_leg(m, &k, &s->dleg[1], db, ib, &step[1]);
+  const imest_real_t vc = isr_duty_leg(m, &k, &s->dleg[2], dc, ic, &step[2]);
+  /* the ADC limit applies to the currents; the duties and the bus voltage
+   * only have to be numbers: one test catches NaN, Inf or absurd duties and
+   * a bus voltage near u_absurd_v (both weighted into one sum of squares) */
+  const int in_range = (imest__abs(ia) < s->i_lim) & (imest__abs(ib) < s->i_lim) &
+                       (imest__abs(ic) < s->i_lim) &
+                       (((da * da + db * db) + dc * dc) + m->vdc2_w * (vdc * vdc) < RL(12));
+  const imest_real_t u[3] = {va, vb, vc}, i[3] = {ia, ib, ic};
+  imest_real_t ua, ub, ia_ab, ib_ab, sa, sb;
+  imest__clarke(u, &ua, &ub); /* the zero sequence (the legs' common part) drops out */
+  imest__clarke(i, &ia_ab, &ib_ab);
+  /* The voltage is a staircase (one step per sample): the sampled current
+   * carries the aliased images of its steps, -(T / 12 sigma L_S) times the
+   * step at the sample (docs/METHOD.md §17; uncorrected, R_S -10 % on the
+   * 4 kW motor at 4 kHz, -2.5 % at 8 kHz). */
+  imest__clarke(step, &sa, &sb);
+  ia_ab += m->zoh * sa;
+  ib_ab += m->zoh * sb;
+  s->duty_input = 1u;
+  return isr_step(s, ua, ub, ia_ab, ib_ab, (ia + ib) + ic, (imest_real_t)theta_rad,
+                  in_range ? ISR_IN_RANGE : 0u);
+}

@@ -1,0 +1,443 @@
+/* Background stage: is this window's estimate trustworthy, and for which
+ * parameter? The first reason found, most fundamental first, becomes the
+ * reason; T_R and R_S get their own verdicts (R_S is far more sensitive to
+ * the voltage's and the timing's errors than T_R). imest__bg_judge() runs
+ * the ordered tables of checks at the end of this file. A threshold a user
+ * tunes is a config field (each table row names it); a threshold physics
+ * fixes is a named constant below, with its reason. README "When is a window
+ * valid" and docs/METHOD.md §13 give the measurements behind the defaults.
+ * Every evidence is dimensionless: the same rule holds for any motor size. */
+#include <math.h>
+
+#include "bg_validity.h"
+#include "common/imest_math.h"
+
+/* The window's operating point, from its sums: stator frequency, slip,
+ * power and impedance (power-invariant alpha/beta: the power is the motor's).
+ * float32 throughout this file: every evidence is a ratio, and the FPU's
+ * arithmetic keeps the verdict small and fast on a single-precision core. */
+typedef struct {
+  float we;    /* stator (field) frequency [rad/s]: the current's rotation in the stator frame */
+  float slip;  /* slip fraction: the rotor-frame current's rotation / we */
+  float p_w;   /* mean electrical power u.i [W] */
+  float s_va;  /* mean |u| |i| [VA] */
+  float z_ohm; /* |u| / |i| [ohm] */
+  float i2;    /* mean |i|^2 [A^2] */
+  float i_pk;  /* peak phase current of the fundamental [A] */
+} op_point_t;
+
+/* a sign-type error dV has the fundamental (4/pi) dV */
+#define FOUR_OVER_PI_F (4.0f / IMEST_PI_F)
+
+/* Constants of the checks (their reasons where they are used):
+ * R_S within what heating explains around its nominal: 20 C .. 200 C copper
+ * and a 10 % data-sheet error. */
+#define RS_NOMINAL_MIN     0.7
+#define RS_NOMINAL_MAX     1.9
+/* T_R within its band around a known nominal: the rotor heats (T_R falls to
+ * about 0.6 of cold) and data-sheet values are off. */
+#define TR_NOMINAL_MIN     0.45
+#define TR_NOMINAL_MAX     1.5
+/* L_S at no load that differs from ls_h by more than this cannot be the motor's. */
+#define LS_NOLOAD_TOL      0.06f
+/* No load: slip ratio below this (L_S measured 1 % low), field above 5 Hz. */
+#define NOLOAD_SLIP_RATIO  0.1f
+#define NOLOAD_MIN_HZ      5.0f
+/* At rest: the mean speed below this (about 10 rpm; an encoder toggling by
+ * a count averages to zero here). */
+#define AT_REST_RAD_S      1.0
+/* A current-sensor gain mismatch |E| worth flagging (0.2 %). */
+#define GAIN_MISMATCH_FLAG 0.002f
+/* The wiring checks: judged above this field frequency only. */
+#define WIRING_MIN_HZ      2.0f
+
+static void operating_point(const imest_t *s, const bg_window_stats_t *st, const bg_sums_t *sm, uint32_t nreg,
+                            op_point_t *op)
+{
+  const float n = nreg > 0u ? (float)nreg : 1.0f;
+  const float slip_rate = (float)st->slip_rate;
+  op->we = slip_rate + s->n * (float)st->w_mean;
+  op->slip = fabsf(op->we) > 0.0f ? slip_rate / op->we : 0.0f;
+  /* W1.W4 - W2.W4 = u.i / (sigma L_S) exactly (i_perp.i = 0) */
+  op->p_w = (float)(sm->rw[0][3] - sm->rw[1][3]) / s->inv_s / n;
+  const float i2 = fmaxf((float)sm->rw[3][3] / n, 0.0f), u2 = fmaxf(2.0f * (float)st->u_ms, 0.0f);
+  op->i2 = i2;
+  op->s_va = sqrtf(i2 * u2); /* balanced: |u|^2 = 2 u_alpha^2 */
+  op->z_ohm = i2 > 0.0f ? sqrtf(u2 / i2) : 0.0f;
+  op->i_pk = sqrtf(i2 * (2.0f / 3.0f)); /* |i_alphabeta| = sqrt(3/2) phase peak */
+}
+
+/* The data contradict the conventions the config says (README remedies):
+ * - the rotor-frame current turns faster than the field (slip > 1.25): the
+ *   rotor would turn against its field at steady speed. An encoder counting
+ *   backwards gives 2.
+ * - negative slip while the motor takes power: generating gives power back.
+ *   Phases b and c swapped, or the electrical angle given for the
+ *   mechanical, give -1 (with 2 pole pairs). And motoring slip while power
+ *   flows back: the currents' sign.
+ * - a slip of half the field or more at a slip frequency no motor reaches
+ *   (5 Hz, above breakdown for motors from 0.4 kW up): pole pairs half the
+ *   motor's, or an angle in the wrong unit.
+ * - an impedance no motor with these constants has: below a third of the
+ *   leakage reactance, or above three times the magnetising one plus a
+ *   generous R_S (currents in mA, volts for kilovolts ...).
+ * Judged only with a stator frequency above 2 Hz and real power flowing. */
+static int wiring_mismatch(const imest_t *s, const op_point_t *op)
+{
+  const float we = fabsf(op->we);
+  if (!(we > IMEST_2PI_F * WIRING_MIN_HZ) || !(op->s_va > 0.0f)) return 0;
+  const float ls = s->ls_h, sl = s->sigma * ls;
+  if (op->slip > 1.25f) return 1;
+  if (op->slip < -0.25f && op->p_w > 0.1f * op->s_va) return 1;
+  if (op->slip > 0.02f && op->p_w < -0.1f * op->s_va) return 1;
+  if (op->slip > 0.45f && fabsf(op->slip) * we > IMEST_2PI_F * 5.0f) return 1;
+  if (op->z_ohm < we * sl / 3.0f) return 1;
+  const float rs_max = (s->rs_nominal_ohm > 0.0f) ? 3.0f * s->rs_nominal_ohm : 10.0f * we * ls;
+  return op->z_ohm > 3.0f * we * ls + rs_max;
+}
+
+/* The uncertainty of the voltage's fundamental per phase [V]: the inverter
+ * model's error at this current times its relative uncertainty (duty input),
+ * or u_uncertainty_v (measured voltages); negative: unknown. *shape_v: the
+ * uncertainty whose harmonics T_R sees (duty input with a known uncertainty;
+ * else 0). */
+static float voltage_uncertainty(const imest_t *s, const imest_window_t *w, const op_point_t *op,
+                                 float *shape_v)
+{
+  *shape_v = 0.0f;
+  if (!w->duty_input) return s->u_uncertainty_v;
+  const imest_inverter_t *v = &s->inverter;
+  if (v->uncertainty < 0.0f) return -1.0f;
+  const float a = op->i_pk;
+  const float e = fabsf(v->dead_time_s * s->pwm_hz * (float)w->vdc_v + v->v_diode_v + v->r_diode_ohm * a +
+                        0.5f * ((v->v_switch_v - v->v_diode_v) + (v->r_switch_ohm - v->r_diode_ohm) * a));
+  const float dv = v->uncertainty * e;
+  /* the error's shape near the zero crossings (the ripple's, the devices'
+   * capacitances) is not known to better than 20 % of it even when every
+   * number of the model is exact: with the numbers exact and stated 3 %
+   * uncertain, T_R at 25 % load was valid and 1.0-1.9 % off (2.2 / 4 kW,
+   * 1-3 us); the harmonics' bound takes at least that */
+  *shape_v = fmaxf(dv, 0.2f * e);
+  return dv;
+}
+
+/* Error bounds of T_R and R_S from the systematic errors the config states,
+ * through the motor's steady-state impedance Z = R_S + j we L_S (1 + j sigma a)
+ * / (1 + j a), a = slip frequency x T_R (docs/METHOD.md §18):
+ * - a voltage error in phase with the current (the inverter's, sign-type:
+ *   fundamental (4/pi) dV) moves Re Z only, i.e. R_S only, by (4/pi) dV / I;
+ * - a timing error tau turns Z by -j we tau: R_S and T_R both move. Twice
+ *   the first-order sensitivity, which the simulator shows to be about half
+*   the measured effect (the delay also moves the currents against the angle).
+ * - the PWM staircase's aliased images (docs/METHOD.md §17.2) add
+ *   -(T^2 / 12 sigma L_S) du/dt to the sampled current: the admittance gains
+ *   -j eps, eps = we T^2 / (12 sigma L_S), so Z gains j eps Z^2 and Re Z
+ *   -2 eps Re Z Im Z, all of it R_S. With measured phase voltages (not
+ *   corrected: the source may be smooth) the whole effect is uncertain; the
+ *   duty input corrects it to within about 20 % (measured), 30 % is kept.
+ *   Measured on 11 kW at rated speed, half load, 8 kHz: R_S -8.3 %; this
+ *   term says 9 %. It scales with (we T)^2 and |Z|^2 / R_S: high speed,
+ *   large motors, light load.
+ * - the inverter model's uncertain share (duty input) is sign-type too: its
+ *   harmonics (1/5, 1/7 ... of the fundamental) drive current harmonics at a
+ *   slip near 1, where the rotor resistance (1 - sigma) L_S / T_R is in series,
+ *   so the fit reads them as T_R. No first-order formula; on the simulator
+ *   (2.2-37 kW, 0-3 us, 1 V drops, model exact or 20 % off) T_R moved by 0.2
+ *   to 0.45 times what the in-phase term (4/pi) dV / I would move it taken in
+ *   quadrature (largest at 25 % load, where dZ/dT_R is small). The bound
+ *   takes 0.5 times it, in Im Z.
+ * dv_v: the voltage uncertainty [V] (negative: unknown); harm_v: the
+ * uncertainty whose harmonics T_R sees (duty input; 0 otherwise). */
+static void systematic_bounds(const imest_t *s, const imest_window_t *w, const op_point_t *op,
+                              float slip_rate, float tr, float rs, float dv_v, float harm_v, float *tr_rel,
+                              float *rs_rel)
+{
+  const float we = op->we, ls = s->ls_h, sg = s->sigma;
+  const float a = slip_rate * tr, den = 1.0f + a * a;
+  /* Z and dZ/dT_R = we L_S ws (1 - sigma) / (1 + j a)^2 */
+  const float zr = rs + we * ls * (a * (1.0f - sg)) / den;
+  const float zi = we * ls * (1.0f + sg * a * a) / den;
+  const float k = we * ls * slip_rate * (1.0f - sg) / (den * den);
+  const float dr = k * (1.0f - a * a), di = k * (-2.0f * a);
+  const float tau = 2.0f * s->timing_uncertainty_s;
+  const float t_pwm = 1.0f / s->pwm_hz;
+  const float share = (w->duty_input && s->duty.zoh > 0.0f) ? 0.3f : 1.0f;
+  const float eps = share * fabsf(we) * t_pwm * t_pwm / (12.0f * sg * ls);
+  const float dzr = fabsf(we) * tau * fabsf(zi) + eps * 2.0f * fabsf(zr * zi);
+  const float harm = 0.5f * FOUR_OVER_PI_F * harm_v / op->i_pk;
+  const float dzi = fabsf(we) * tau * fabsf(zr) + eps * fabsf(zr * zr - zi * zi) + harm;
+  const float dt = fabsf(di) > 0.0f ? dzi / fabsf(di) : INFINITY;
+  *tr_rel = dt / tr;
+  const float dr_volt = dv_v < 0.0f ? INFINITY : FOUR_OVER_PI_F * dv_v / op->i_pk;
+  *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs;
+}
+
+/* The current sensors' gain mismatch from the zero sequence (three sensors:
+ * i_a + i_b + i_c is the sensors' error), as the complex pattern E = sum_x
+ * eps_x e^(-j 2 pi x / 3) of the per-phase gain errors: |E| (0 with two
+ * sensors, where the third is computed and the zero sequence is exactly 0). */
+static float gain_mismatch(const imest_window_t *w, const bg_sums_t *sm)
+{
+  const float s2 = (float)sm->rw[3][3];
+  if (!(s2 > 0.0f)) return 0.0f;
+  const float ca = w->sum[IMEST_ACC_I0A] + w->blk[IMEST_ACC_I0A];
+  const float cb = w->sum[IMEST_ACC_I0B] + w->blk[IMEST_ACC_I0B];
+  return IMEST_SQRT3_2_F * sqrtf(ca * ca + cb * cb) / s2;
+}
+
+/* L_S at no load: the reactance the motor shows with (nearly) no rotor
+ * current is w_e L_S (slip ratio 0.1: 1 % lower), the reactive power over
+ * |i|^2. A configured L_S that differs by more than 6 % cannot be the motor's:
+ * at one operating point the estimator absorbs it in T_R and R_S (L_S 10 %
+ * high: T_R +11 %, R_S -42 %, residual unchanged), so this is the only place
+ * it shows. Latched: every later window is constants_mismatch. */
+static void noload_ls_check(imest_t *s, const op_point_t *op, float slip_ratio, int steady, imest_result_t *r)
+{
+  const float we = fabsf(op->we);
+  if (!(steady && slip_ratio < NOLOAD_SLIP_RATIO && we > IMEST_2PI_F * NOLOAD_MIN_HZ && op->i2 > 0.0f &&
+        op->s_va > 0.0f))
+    return;
+  const float q = sqrtf(fmaxf(0.0f, op->s_va * op->s_va - op->p_w * op->p_w));
+  const float ls_meas = q / op->i2 / we;
+  r->ls_noload_h = (double)ls_meas;
+  const float dev = ls_meas / s->ls_h - 1.0f;
+  s->ls_check = (fabsf(dev) > LS_NOLOAD_TOL) ? 2u : (s->ls_check == 2u ? 2u : 1u);
+}
+
+/* Everything a check reads: the window, its statistics and sums, the solve,
+ * the result filled so far (the estimate, its error indices and bounds). */
+typedef struct {
+  imest_t *s; /* the no-load L_S check latches its finding in s->ls_check */
+  const imest_window_t *w;
+  const bg_window_stats_t *st;
+  const bg_solve_out_t *so;
+  imest_result_t *r;
+  op_point_t op;
+  int steady;
+  float tr_b, rs_b, g_b; /* T_R's and R_S's systematic bounds, the gain mismatch's share */
+} judge_t;
+
+/* One check: the reason a window gets when it fails it. */
+typedef struct {
+  int reason;
+  int (*fails)(judge_t *j);
+} judge_check_t;
+
+static int input_fault(judge_t *j)
+{
+  return (j->r->flags & IMEST_FLAG_INPUT_FAULT) != 0u;
+}
+static int adc_saturation(judge_t *j)
+{
+  return (j->r->flags & IMEST_FLAG_ADC_SAT) != 0u;
+}
+static int encoder_fault(judge_t *j)
+{
+  return (j->r->flags & IMEST_FLAG_ENCODER_FAULT) != 0u;
+}
+/* warm-up samples are not accumulated; the rest of the window is clean data,
+ * so warm-up invalidates a window only when it took half of it */
+static int warmup(judge_t *j)
+{
+  return (j->r->flags & IMEST_FLAG_WARMUP) && 2u * j->r->used_samples < j->r->samples;
+}
+/* min_current_a. i_rms_a is what passed the offset high-pass. A DC current it
+ * removed (magnetising at rest) is in the tracked means: that rotor is at
+ * rest with excitation, not without current. */
+static int low_current(judge_t *j)
+{
+  return !(j->st->i_rms_a >= (double)j->s->min_current_a);
+}
+static int low_current_at_rest(judge_t *j)
+{
+  const double ia = (double)j->w->off_ia, ib = (double)j->w->off_ib;
+  const int dc = sqrt(ia * ia + ib * ib) >= (double)j->s->min_current_a;
+  return low_current(j) && dc && fabs(j->st->w_mean) < AT_REST_RAD_S;
+}
+/* ls_h, sigma, pole_pairs, rs_nominal_ohm */
+static int wiring(judge_t *j)
+{
+  return wiring_mismatch(j->s, &j->op);
+}
+/* ls_h (latched: once L_S at no load disagrees, every later window) */
+static int ls_mismatch(judge_t *j)
+{
+  noload_ls_check(j->s, &j->op, (float)j->r->slip_ratio, j->steady, j->r);
+  return j->s->ls_check == 2u;
+}
+/* min_slip_ratio */
+static int low_slip(judge_t *j)
+{
+  return !(j->r->slip_ratio >= (double)j->s->min_slip_ratio);
+}
+static int low_slip_at_rest(judge_t *j)
+{
+  return low_slip(j) && fabs(j->st->w_mean) < AT_REST_RAD_S;
+}
+static int solve_numeric(judge_t *j)
+{
+  return j->so->status == IMEST_REASON_NUMERIC;
+}
+/* tr_min_s, tr_max_s */
+static int solve_no_root(judge_t *j)
+{
+  return j->so->status != IMEST_OK;
+}
+static int not_minimum(judge_t *j)
+{
+  return !j->so->hessian_pd;
+}
+/* max_pe_k2_rel. The parametric error index does not shrink with the span
+ * (the residual and the cost's curvature both grow with it); the part of the
+ * estimate's error that the sensors' white noise causes does, as
+ * 1/sqrt(windows), but a systematic part (an inverter's or a model's error,
+ * the same in every window) does not. The index is split by the residual's
+ * shares, the noise's (e_i_noise^2 / e_i^2) and the rest's, and only the
+ * noise's is credited the n windows: pe^2 (1 - f + f / n) against
+ * max_pe_k2_rel^2. */
+static int poorly_determined(judge_t *j)
+{
+  const imest_result_t *r = j->r;
+  const double f = r->e_i > 0.0 ? fmin(1.0, (r->e_i_noise * r->e_i_noise) / (r->e_i * r->e_i)) : 1.0;
+  const double pe2 = r->pe_k2_rel * r->pe_k2_rel * ((1.0 - f) + f / (double)r->windows);
+  return !(pe2 <= (double)j->s->max_pe_k2_rel * (double)j->s->max_pe_k2_rel);
+}
+/* max_ei: the residual beyond what the sensors' white noise explains */
+static int high_residual(judge_t *j)
+{
+  const imest_result_t *r = j->r;
+  const double em = sqrt(fmax(0.0, r->e_i * r->e_i - r->e_i_noise * r->e_i_noise));
+  return !(em <= (double)j->s->max_ei);
+}
+/* rs_min_ohm, rs_max_ohm */
+static int rs_out_of_range(judge_t *j)
+{
+  return !(j->r->rs_ohm >= (double)j->s->rs_min_ohm && j->r->rs_ohm <= (double)j->s->rs_max_ohm);
+}
+/* rs_nominal_ohm: constants that cannot be the motor's */
+static int rs_off_nominal(judge_t *j)
+{
+  const double rn = (double)j->s->rs_nominal_ohm;
+  return j->s->rs_nominal_ohm > 0.0f &&
+         !(j->r->rs_ohm >= RS_NOMINAL_MIN * rn && j->r->rs_ohm <= RS_NOMINAL_MAX * rn);
+}
+/* tr_nominal_s (when given) */
+static int tr_off_nominal(judge_t *j)
+{
+  const double tn = (double)j->s->tr_nominal_s;
+  return j->s->tr_nominal_known && !(j->r->tr_s >= TR_NOMINAL_MIN * tn && j->r->tr_s <= TR_NOMINAL_MAX * tn);
+}
+/* never a confident non-finite number */
+static int not_finite(judge_t *j)
+{
+  return !(isfinite(j->r->tr_s) && isfinite(j->r->rs_ohm) && isfinite(j->r->e_i));
+}
+/* tr_tolerance. The bounds are steady-state figures: T_R's is judged only
+ * below the pull-out slip (a sigma < 1), where a drive runs steadily; beyond
+ * it the window is a transient (a run-up) whose dynamics determine T_R. */
+static int tr_uncertain(judge_t *j)
+{
+  const float a_slip = (float)j->st->slip_rate * (float)j->r->tr_s * j->s->sigma;
+  return a_slip < 1.0f && !(j->tr_b <= j->s->tr_tolerance);
+}
+/* rs_tolerance: the current sensors' gain mismatch takes most of R_S's bound */
+static int rs_gain_mismatch(judge_t *j)
+{
+  return !(j->rs_b + j->g_b <= j->s->rs_tolerance) && j->g_b > j->rs_b;
+}
+/* rs_tolerance */
+static int rs_uncertain(judge_t *j)
+{
+  return !(j->rs_b + j->g_b <= j->s->rs_tolerance);
+}
+
+/* T_R's verdict: the first check the window fails, most fundamental first. */
+static const judge_check_t tr_checks[] = {
+    {IMEST_REASON_INPUT_FAULT, input_fault},
+    {IMEST_REASON_ADC_SATURATION, adc_saturation},
+    {IMEST_REASON_ENCODER_FAULT, encoder_fault},
+    {IMEST_REASON_WARMUP, warmup},
+    {IMEST_REASON_STANDSTILL, low_current_at_rest},
+    {IMEST_REASON_NO_CURRENT, low_current},
+    {IMEST_REASON_WIRING_MISMATCH, wiring},
+    {IMEST_REASON_CONSTANTS_MISMATCH, ls_mismatch},
+    {IMEST_REASON_STANDSTILL, low_slip_at_rest},
+    {IMEST_REASON_ZERO_SLIP, low_slip},
+    {IMEST_REASON_NUMERIC, solve_numeric},
+    {IMEST_REASON_NO_ROOT, solve_no_root},
+    {IMEST_REASON_NOT_MINIMUM, not_minimum},
+    {IMEST_REASON_POORLY_DETERMINED, poorly_determined},
+    {IMEST_REASON_HIGH_RESIDUAL, high_residual},
+    {IMEST_REASON_RS_OUT_OF_RANGE, rs_out_of_range},
+    {IMEST_REASON_CONSTANTS_MISMATCH, rs_off_nominal},
+    {IMEST_REASON_CONSTANTS_MISMATCH, tr_off_nominal},
+    {IMEST_REASON_NUMERIC, not_finite},
+    {IMEST_REASON_TR_UNCERTAIN, tr_uncertain},
+};
+
+/* R_S's verdict, once T_R's is valid: its own bound. */
+static const judge_check_t rs_checks[] = {
+    {IMEST_REASON_GAIN_MISMATCH, rs_gain_mismatch},
+    {IMEST_REASON_RS_UNCERTAIN, rs_uncertain},
+};
+
+static int first_failed(const judge_check_t *c, unsigned int n, judge_t *j)
+{
+  for (unsigned int k = 0; k < n; ++k)
+    if (c[k].fails(j)) return c[k].reason;
+  return IMEST_REASON_NONE;
+}
+
+/* The systematic bounds: T_R's (the staircase, the timing, the inverter
+ * model's harmonics) and R_S's: the voltage's uncertainty (the inverter
+ * model's, or none known), the timing's, the staircase's, the current
+ * sensors' gain mismatch (|E| |Z| / R_S, measured: the paper motor, 1 %
+ * between two sensors, R_S -3.5 %). Infinite without an estimate. */
+static void bounds(judge_t *j, const bg_sums_t *sm)
+{
+  imest_result_t *r = j->r;
+  const float mism = gain_mismatch(j->w, sm);
+  if (mism > GAIN_MISMATCH_FLAG) r->flags |= IMEST_FLAG_GAIN_MISMATCH;
+  j->tr_b = INFINITY;
+  j->rs_b = INFINITY;
+  j->g_b = 0.0f;
+  const int have = j->so->status == IMEST_OK && isfinite(r->tr_s) && r->tr_s > 0.0;
+  if (have && isfinite(r->rs_ohm) && r->rs_ohm > 0.0) {
+    const float rs = (float)r->rs_ohm;
+    float harm_v;
+    const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &harm_v);
+    systematic_bounds(j->s, j->w, &j->op, (float)j->st->slip_rate, (float)r->tr_s, rs, dv_v, harm_v, &j->tr_b,
+                      &j->rs_b);
+    j->g_b = mism * j->op.z_ohm / rs;
+    r->tr_bound_rel = (double)j->tr_b;
+    r->rs_bound_rel = (double)(j->rs_b + j->g_b);
+  }
+}
+
+void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, const bg_sums_t *sm,
+                     const bg_solve_out_t *so, int steady, imest_result_t *r)
+{
+  judge_t j = {.s = s, .w = w, .st = st, .so = so, .r = r, .steady = steady};
+  operating_point(s, st, sm, w->nreg, &j.op);
+  r->i_rms_a = st->i_rms_a;
+  const int have = so->status == IMEST_OK && isfinite(r->tr_s) && r->tr_s > 0.0;
+  /* Excitation: the mean rotation rate of the rotor-frame current vector
+   * (sum of i x di/dt over sum of |i|^2) times T_R: in steady state the
+   * slip frequency x T_R, the ratio of rotor to magnetising current (noise
+   * averages out of it: 0.004..0.008 at no load with 12-bit sensors, 1.1 at
+   * rated load). Below 0.1 T_R is weakly observable. With the estimate's
+   * T_R (the motor's, for any size; the nominal T_R where there is none). */
+  r->slip_ratio = (double)(fabsf((float)st->slip_rate) * (have ? (float)r->tr_s : s->tr_nominal_s));
+  r->ls_noload_h = NAN; /* the no-load check fills it where it runs */
+  bounds(&j, sm);
+  const int status = first_failed(tr_checks, sizeof tr_checks / sizeof tr_checks[0], &j);
+  const int rs_status = status != IMEST_REASON_NONE
+                            ? status
+                            : first_failed(rs_checks, sizeof rs_checks / sizeof rs_checks[0], &j);
+  r->tr_reason = status;
+  r->tr_valid = (status == IMEST_REASON_NONE);
+  r->rs_reason = rs_status;
+  r->rs_valid = (rs_status == IMEST_REASON_NONE);
+  r->valid = r->tr_valid && r->rs_valid;
+  r->status = r->tr_valid ? rs_status : status;
+}

@@ -1,0 +1,13 @@
+/* Background stage: the verdict on one window (docs/METHOD.md §7; README "When
+ * is a window valid"). Internal: not part of the public API. */
+#ifndef IMEST_BG_VALIDITY_H
+#define IMEST_BG_VALIDITY_H
+
+#include "bg_window.h"
+
+/* Fills valid/status and the per-parameter verdicts of r from the window
+ * flags, the window's statistics and the solve. */
+void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, const bg_sums_t *sm,
+                     const bg_solve_out_t *so, int steady, imest_result_t *r);
+
+#endif /* IMEST_BG_VALIDITY_H */

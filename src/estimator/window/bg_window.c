@@ -1,0 +1,84 @@
+/* Background stage 1: take one window's ISR sums to float64 8x8 form.
+ * The ISR accumulated Z = [W1 W2 W4 W5 W6 W7 W8 e] with e = y - W c0; here
+ * R_Wy = R_We + R_W c0 and R_y = R_ee + 2 c0.R_We + c0' R_W c0 (float64), and
+ * row/column 3 = -m x row/column 4 (docs/METHOD.md §2). The centred form (c0, R_We,
+ * R_ee) is passed on too, for E without cancellation (bg_select.c). */
+#include <math.h>
+
+#include "bg_window.h"
+#include "isr_accumulate.h"
+
+/* 7-column index -> 8-column (K) index */
+static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
+
+void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out,
+                           bg_window_stats_t *st)
+{
+  double z[8][8];
+  for (unsigned int i = 0; i < 8u; ++i) {
+    for (unsigned int j = i; j < 8u; ++j) {
+      const unsigned int p = IMEST_ACC_INDEX(i, j);
+      z[i][j] = (double)w->sum[p] + (double)w->blk[p];
+      z[j][i] = z[i][j];
+    }
+  }
+  double c0[7];
+  for (unsigned int i = 0; i < 7u; ++i) c0[i] = (double)w->c0[i];
+
+  double rwy7[7];
+  double ry = z[7][7];
+  for (unsigned int i = 0; i < 7u; ++i) {
+    double acc = z[i][7];
+    for (unsigned int j = 0; j < 7u; ++j) acc += z[i][j] * c0[j];
+    rwy7[i] = acc;
+    ry += c0[i] * (z[i][7] + acc); /* 2 c0.R_We + c0' R_W c0 = c0.(R_We + R_Wy) */
+  }
+
+  for (unsigned int i = 0; i < 7u; ++i) {
+    out->rwy[k_of_col[i]] = rwy7[i];
+    for (unsigned int j = 0; j < 7u; ++j) out->rw[k_of_col[i]][k_of_col[j]] = z[i][j];
+  }
+  for (unsigned int j = 0; j < 8u; ++j) {
+    out->rw[2][j] = -m * out->rw[3][j];
+  }
+  for (unsigned int i = 0; i < 8u; ++i) {
+    out->rw[i][2] = -m * out->rw[i][3];
+  }
+  out->rw[2][2] = m * m * out->rw[3][3];
+  out->rwy[2] = -m * out->rwy[3];
+  out->ry = ry;
+  /* centred form (bg_solve.h): E of a candidate without the cancellation of
+   * the un-centred R_y, R_Wy (floor ~1e-5 R_y with float32 sums) */
+  out->centred = 1;
+  out->e_slack = 0.0;
+  out->ree = z[7][7];
+  for (unsigned int i = 0; i < 7u; ++i) {
+    out->c0[k_of_col[i]] = c0[i];
+    out->rwe[k_of_col[i]] = z[i][7];
+  }
+  out->c0[2] = 0.0;
+  out->rwe[2] = -m * out->rwe[3];
+
+  /* the sums hold every second used sample (isr_accumulate.h); the angle
+   * steps all of them */
+  const double n = w->nreg > 0u ? (double)w->nreg : 1.0;
+  const double n_used = w->used > 0u ? (double)w->used : 1.0;
+  const double r44 = out->rw[3][3];
+  st->i_rms_a = sqrt(fmax(r44, 0.0) / n);
+  st->w_mean = (double)w->rot * fs / n_used;
+  const double cross = (double)w->sum[IMEST_ACC_ROT] + (double)w->blk[IMEST_ACC_ROT];
+  st->slip_rate = (r44 > 0.0) ? cross / r44 : 0.0;
+  st->u_ms = ((double)w->sum[IMEST_ACC_UU] + (double)w->blk[IMEST_ACC_UU]) / n;
+}
+
+/* Centring vector c0 (7-column form) for a given K1, K2 (docs/METHOD.md §2, §10). */
+void imest__bg_centre_from_k(imest_real_t c0[7], double k1, double k2, double m)
+{
+  c0[0] = (imest_real_t)k1;
+  c0[1] = (imest_real_t)k2;
+  c0[2] = (imest_real_t)(k1 * k2 - m * k2 * k2); /* K4 - m K3 (column 3 folded into 4) */
+  c0[3] = (imest_real_t)(1.0 / k2);
+  c0[4] = (imest_real_t)(k1 / k2);
+  c0[5] = (imest_real_t)(k1 / (k2 * k2));
+  c0[6] = (imest_real_t)(1.0 / (k2 * k2));
+}
