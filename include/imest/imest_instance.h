@@ -62,6 +62,8 @@ typedef struct {
   uint32_t duty_input;         /**< the window's last sample came through imest_isr_duty */
   imest_real_t vdc_v;          /**< duty input: the bus voltage of the window's last sample [V] */
   imest_real_t off_ia, off_ib; /**< the offsets the high-pass tracked at the window's end [A] */
+  /* What the background tells the ISR, written before it releases the buffer: */
+  uint32_t engage; /**< engage the angle observer (the window's speed was steady) */
 } imest_window_t;
 
 /** Butterworth-3 as a first-order and a second-order section (transposed DF-II).
@@ -99,13 +101,13 @@ typedef struct {
 
 /** Angle tracking observer between the encoder and the rotation (src/estimator/isr/isr_angle.h). */
 typedef struct {
-  imest_real_t k1, k2, k3;   /**< gains per sample */
-  imest_real_t d;            /**< estimated angle minus encoder angle [rad] */
-  imest_real_t dth;          /**< estimated angle step per sample [rad] */
-  imest_real_t ddth;         /**< estimated change of the step per sample [rad] */
-  volatile uint32_t engaged; /**< the one field the background writes for the ISR: set at a steady
-                                  speed (0: the encoder as it is); a single word, read once per sample */
-  uint32_t enabled;          /**< configured (angle_observer_hz >= 0) */
+  imest_real_t k1, k2, k3; /**< gains per sample */
+  imest_real_t d;          /**< estimated angle minus encoder angle [rad] */
+  imest_real_t dth;        /**< estimated angle step per sample [rad] */
+  imest_real_t ddth;       /**< estimated change of the step per sample [rad] */
+  uint32_t engaged;        /**< the observer's estimate in use (0: the encoder as it is); the ISR
+                                  takes it from the background's word in a buffer it refills */
+  uint32_t enabled;        /**< configured (angle_observer_hz >= 0) */
 } imest_angle_t;
 
 /** Consecutive windows' sums combined by the background (src/estimator/window/bg_combine.c). */

@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "bg_noise.h"
+#include "common/imest_handoff.h"
 #include "common/imest_math.h"
 
 void imest_config_default(imest_config_t *cfg)
@@ -257,20 +258,13 @@ static void design_aa(imest_sos_t *f, double fc, double fs)
   f->d2 = (imest_real_t)((1.0 - IMEST_SQRT2_D * k + k * k) / a0);
 }
 
-int imest_init(imest_t *s, const imest_config_t *cfg)
+/* The ISR's constants: the sample rate's, the motor's, the limits, the
+ * channels' alignment, the window length and the front end's filters. Float
+ * arithmetic wherever the ISR's float32 constants come out the same (the
+ * FPU's, no soft-double code); the filter design keeps float64. */
+static void init_isr_constants(imest_t *s, const imest_config_t *cfg, double m)
 {
-  if (s == NULL || cfg == NULL) return IMEST_ERR_NULL;
-  const int rc = imest_config_check(cfg, NULL);
-  if (rc != IMEST_OK) return rc;
-
-  /* no memset: the core does not depend on <string.h> */
-  unsigned char *raw = (unsigned char *)s;
-  for (size_t b = 0; b < sizeof *s; ++b) raw[b] = 0u;
-
-  /* float arithmetic wherever the ISR's float32 constants come out the same
-   * (the FPU's, no soft-double code); the filter design keeps float64 */
   const float fs = cfg->fs_hz, sigma = cfg->sigma;
-  const double m = (1.0 - (double)sigma) / (double)sigma;
   s->fs = fs;
   s->inv2t = 0.5f * fs;
   s->invt2 = fs * fs;
@@ -305,7 +299,12 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   s->aa_on = cfg->aa_hz > 0.0f;
   design_angle(&s->obs, cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz, fs);
   design_duty(&s->duty, cfg);
+}
 
+/* The warm-up: samples the filters settle, at the start and after a fault. */
+static void init_warmup(imest_t *s, const imest_config_t *cfg)
+{
+  const float fs = cfg->fs_hz;
   /* warm-up: the slowest Butterworth-3 pole decays as exp(-pi fc t); 3/fc
    * leaves < 1e-4 of a start-up transient; the anti-alias model adds its own. */
   double warm_s = (double)cfg->warmup_s; /* float64: whole samples come out as intended */
@@ -324,8 +323,11 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
    * its state; at rest it starts from the first currents. */
   if (!cfg->start_at_rest && cfg->warmup_s <= 0.0f && cfg->dc_block_hz > 0.0f)
     s->warm += (uint32_t)(5.0f / (2.0f * (float)IMEST_PI_D * cfg->dc_block_hz) * fs);
+}
 
-  /* background constants */
+/* What the background judges by, as configured. */
+static void init_background_constants(imest_t *s, const imest_config_t *cfg)
+{
   s->sigma = cfg->sigma;
   s->ls_h = cfg->ls_h;
   s->tr_nominal_s = cfg->tr_nominal_s;
@@ -345,7 +347,22 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   s->tr_nominal_known = cfg->tr_nominal_known != 0;
   s->inverter = cfg->inverter;
   s->pwm_hz = cfg->pwm_hz > 0.0f ? cfg->pwm_hz : cfg->fs_hz;
+}
 
+int imest_init(imest_t *s, const imest_config_t *cfg)
+{
+  if (s == NULL || cfg == NULL) return IMEST_ERR_NULL;
+  const int rc = imest_config_check(cfg, NULL);
+  if (rc != IMEST_OK) return rc;
+
+  /* no memset: the core does not depend on <string.h> */
+  unsigned char *raw = (unsigned char *)s;
+  for (size_t b = 0; b < sizeof *s; ++b) raw[b] = 0u;
+
+  const double m = (1.0 - (double)cfg->sigma) / (double)cfg->sigma;
+  init_isr_constants(s, cfg, m);
+  init_warmup(s, cfg);
+  init_background_constants(s, cfg);
   /* first centring: nominal T_R, and gamma with R_S = 0 (any c0 is correct;
    * a close one only improves float32 precision) */
   const double k2 = 1.0 / (double)cfg->tr_nominal_s;
@@ -358,7 +375,7 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
 
 uint32_t imest_overruns(const imest_t *s)
 {
-  return s ? s->overruns : 0u;
+  return s ? IMEST_LOAD_RELAXED(&s->overruns) : 0u;
 }
 
 const char *imest_err_name(int err)

@@ -2,6 +2,7 @@
  * Stages: (duty cycles -> phase voltage) -> plausibility -> 3-2 transform ->
  * offsets -> alignment -> angle observer -> rotation -> filters and
  * derivatives -> regressor -> accumulation -> hand-off at the window end. */
+#include "common/imest_handoff.h"
 #include "isr_accumulate.h"
 #include "isr_angle.h"
 #include "isr_duty.h"
@@ -11,6 +12,15 @@
 /* How the entry points describe a sample to isr_step(). */
 #define ISR_IN_RANGE 1u /* every electrical input strictly inside its ADC limit (NaN fails) */
 #define ISR_U_NOISY  2u /* the voltage is measured (its noise is evidence), not formed from duties */
+
+/* One sample as the entry points hand it to isr_step(). */
+typedef struct {
+  imest_real_t ua, ub, ia, ib; /* alpha/beta (the stages update them in place) */
+  imest_real_t i0;             /* zero sequence i_a + i_b + i_c (0 where the caller gives alpha/beta) */
+  imest_real_t th;             /* mechanical angle as given */
+  imest_real_t ia_now, ib_now; /* the currents offset-free, before any delay */
+  unsigned int how;            /* ISR_* bits */
+} isr_in_t;
 
 static void isr_chan_reset(imest_chan_t *c)
 {
@@ -75,14 +85,20 @@ static int isr_close_window(imest_t *s)
   w->off_ia = s->off_ia;
   w->off_ib = s->off_ib;
   s->seq++;
-  if (s->published == s->released) {
-    IMEST_BARRIER();                  /* window contents before the index */
-    s->published = s->published + 1u; /* the ISR now fills the other buffer */
-    isr_open_window(s, &s->win[s->published & 1u], 0u);
+  const uint32_t pub = s->published; /* the ISR's own index */
+  if (pub == IMEST_LOAD_ACQUIRE(&s->released)) {
+    /* the window's contents before the index; the ISR now fills the other
+     * buffer, and takes the background's word on the angle observer from
+     * it (decided on the window that buffer held: deterministic, two
+     * windows on) */
+    IMEST_STORE_RELEASE(&s->published, pub + 1u);
+    imest_window_t *next = &s->win[(pub + 1u) & 1u];
+    s->obs.engaged = next->engage;
+    isr_open_window(s, next, 0u);
     return 1;
   }
   /* overrun: the background still owns the other buffer */
-  s->overruns = s->overruns + 1u;
+  IMEST_STORE_RELAXED(&s->overruns, s->overruns + 1u);
   for (unsigned int p = 0; p < IMEST_NACC; ++p) {
     w->sum[p] = RL(0);
     w->blk[p] = RL(0);
@@ -91,145 +107,193 @@ static int isr_close_window(imest_t *s)
   return 0;
 }
 
-/* Common part once alpha/beta are known: ua, ub, ia, ib alpha/beta, i0 the
- * zero sequence i_a + i_b + i_c of the phase currents (0 where the caller
- * gives alpha/beta), th the mechanical angle as given, how: ISR_* bits.
- * Scalar arguments: they travel in FPU registers. */
-static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t ia, imest_real_t ib,
-                    imest_real_t i0, imest_real_t th, unsigned int how)
+/* The plausibility of a sample: 0, or the fault bits it sets. Only an
+ * out-of-range sample pays for telling saturation from garbage: NaN and Inf
+ * fail every comparison. A faulty angle is replaced by the last good one;
+ * *dth is the angle's step. */
+static inline uint32_t isr_check(imest_t *s, const isr_in_t *in, imest_real_t *th, imest_real_t *dth)
 {
-  imest_window_t *w = &s->win[s->published & 1u];
   uint32_t fault = 0;
-
-  /* Only an out-of-range sample pays for telling saturation from garbage:
-   * NaN and Inf fail every comparison. */
-  if (!(how & ISR_IN_RANGE)) {
-    const int plausible = imest__within(ua, s->u_abs) & imest__within(ub, s->u_abs) &
-                          imest__within(ia, s->i_abs) & imest__within(ib, s->i_abs);
+  if (!(in->how & ISR_IN_RANGE)) {
+    const int plausible = imest__within(in->ua, s->u_abs) & imest__within(in->ub, s->u_abs) &
+                          imest__within(in->ia, s->i_abs) & imest__within(in->ib, s->i_abs);
     fault = plausible ? IMEST_FLAG_ADC_SAT : IMEST_FLAG_INPUT_FAULT;
   }
-  if (!imest__within(th, RL(1.0e8))) fault |= IMEST_FLAG_INPUT_FAULT;
-  if (fault & IMEST_FLAG_INPUT_FAULT) th = s->th_prev; /* keep the last good angle */
-  const uint32_t first = !s->started;
-  const imest_real_t dth = first ? RL(0) : imest__wrap_pi(th - s->th_prev);
-  s->started = 1u;
-  s->th_prev = th;
-  if (!imest__within(dth, s->dth_max)) fault |= IMEST_FLAG_ENCODER_FAULT;
+  if (!imest__within(*th, RL(1.0e8))) fault |= IMEST_FLAG_INPUT_FAULT;
+  if (fault & IMEST_FLAG_INPUT_FAULT) *th = s->th_prev; /* keep the last good angle */
+  *dth = s->started ? imest__wrap_pi(*th - s->th_prev) : RL(0);
+  if (!imest__within(*dth, s->dth_max)) fault |= IMEST_FLAG_ENCODER_FAULT;
+  return fault;
+}
 
-  if (fault) {
-    /* the sample is not used, the filters restart from rest and the angle
-     * observer restarts from the encoder (a jump must not ring through it) */
-    w->flags |= fault | IMEST_FLAG_WARMUP;
-    isr_complete_pending(s, w);
-    isr_restart_filters(s);
-    isr_angle_reset(&s->obs, s->obs.dth);
-    s->k++;
-    return (s->k >= s->window_n) ? isr_close_window(s) : 0;
-  }
+/* A faulty sample is not used: the filters restart from rest and the angle
+ * observer restarts from the encoder (a jump must not ring through it). */
+static inline int isr_fault(imest_t *s, imest_window_t *w, uint32_t fault)
+{
+  w->flags |= fault | IMEST_FLAG_WARMUP;
+  isr_complete_pending(s, w);
+  isr_restart_filters(s);
+  isr_angle_reset(&s->obs, s->obs.dth);
+  s->k++;
+  return (s->k >= s->window_n) ? isr_close_window(s) : 0;
+}
 
-  /* Sensor offsets: the same high-pass on all four electrical channels, so
-   * the motor's equations still hold for the filtered signals. A start at
-   * rest (warmup_n is 0 only then) has no current yet: its first currents
-   * are the offsets. */
+/* Sensor offsets: the same high-pass on all four electrical channels, so the
+ * motor's equations still hold for the filtered signals. A start at rest
+ * (warmup_n is 0 only then) has no current yet: its first currents are the
+ * offsets. */
+static inline void isr_offsets(imest_t *s, isr_in_t *in, uint32_t first)
+{
   if (first) {
     if (s->warmup_n == 0u) {
-      s->off_ia = ia;
-      s->off_ib = ib;
+      s->off_ia = in->ia;
+      s->off_ib = in->ib;
     }
     isr_angle_reset(&s->obs, RL(0));
   }
-  ua = isr_dc_block(s->dcb_a, &s->off_ua, ua);
-  ub = isr_dc_block(s->dcb_a, &s->off_ub, ub);
-  ia = isr_dc_block(s->dcb_a, &s->off_ia, ia);
-  ib = isr_dc_block(s->dcb_a, &s->off_ib, ib);
-  const imest_real_t ia_now = ia, ib_now = ib;
+  in->ua = isr_dc_block(s->dcb_a, &s->off_ua, in->ua);
+  in->ub = isr_dc_block(s->dcb_a, &s->off_ub, in->ub);
+  in->ia = isr_dc_block(s->dcb_a, &s->off_ia, in->ia);
+  in->ib = isr_dc_block(s->dcb_a, &s->off_ib, in->ib);
+}
 
-  /* White-noise evidence for the background's bias compensation: the third
-   * difference of the alpha input (beta carries the same noise).
-   * A smooth signal's third difference is (w_e T)^3 of it (1e-4 at 30 Hz and
-   * 4 kHz), white noise's sqrt(20) of it. Kept as the last value and its
-   * last two differences. */
-  const imest_real_t ia_prev = s->ia1, ua_prev = s->ua1;
-  const imest_real_t d1i = ia - ia_prev, d2i = d1i - s->dia1, d3i = d2i - s->d2ia1;
-  s->ia1 = ia;
+/* White-noise evidence for the background's bias compensation: the third
+ * difference of the alpha input (beta carries the same noise). A smooth
+ * signal's third difference is (w_e T)^3 of it (1e-4 at 30 Hz and 4 kHz),
+ * white noise's sqrt(20) of it. Kept as the last value and its last two
+ * differences; *ia_prev, *ua_prev: the last values (the delays use them). */
+static inline void isr_noise(imest_t *s, const isr_in_t *in, imest_real_t *d3i_out, imest_real_t *noise_u,
+                             imest_real_t *ia_prev, imest_real_t *ua_prev)
+{
+  *ia_prev = s->ia1;
+  *ua_prev = s->ua1;
+  const imest_real_t d1i = in->ia - *ia_prev, d2i = d1i - s->dia1, d3i = d2i - s->d2ia1;
+  s->ia1 = in->ia;
   s->dia1 = d1i;
   s->d2ia1 = d2i;
-  imest_real_t noise_u = RL(0);
-  if (how & ISR_U_NOISY) { /* a voltage formed from duty cycles has no sensor noise */
-    const imest_real_t d1u = ua - ua_prev, d2u = d1u - s->dua1, d3u = d2u - s->d2ua1;
+  *d3i_out = d3i;
+  *noise_u = RL(0);
+  if (in->how & ISR_U_NOISY) { /* a voltage formed from duty cycles has no sensor noise */
+    const imest_real_t d1u = in->ua - *ua_prev, d2u = d1u - s->dua1, d3u = d2u - s->d2ua1;
     s->dua1 = d1u;
     s->d2ua1 = d2u;
-    noise_u = d3u * d3u;
+    *noise_u = d3u * d3u;
   }
-  s->ua1 = ua;
+  s->ua1 = in->ua;
+}
+
+/* Alignment of the channels in time. Optional stages branch on configuration
+ * only (the same path every sample), so a drive that does not use them does
+ * not pay for them. step: the observer's angle step; *th_r, *w_raw: the
+ * angle and the raw speed, delayed where the currents are. */
+static inline void isr_align(imest_t *s, isr_in_t *in, imest_real_t ia_prev, imest_real_t ua_prev,
+                             imest_real_t step, imest_real_t *th_r, imest_real_t *w_raw)
+{
+  if (s->dly_i != RL(0)) {
+    /* the voltage lags: delay currents and angle to match */
+    const imest_real_t a = s->dly_i, w_now = *w_raw;
+    in->ia = in->ia - a * (in->ia - ia_prev);
+    in->ib = in->ib - a * (in->ib - s->ib1);
+    s->ib1 = in->ib_now;
+    *w_raw = w_now - a * (w_now - s->wr_prev);
+    *th_r = *th_r - a * step;
+    s->wr_prev = w_now;
+  }
+  if (s->dly_u != RL(0)) {
+    /* the voltage leads: delay it to match */
+    const imest_real_t ub_now = in->ub;
+    in->ua = in->ua - s->dly_u * (in->ua - ua_prev);
+    in->ub = in->ub - s->dly_u * (in->ub - s->ub1);
+    s->ub1 = ub_now;
+  }
+  if (s->aa_on) {
+    /* the angle through a model of the electrical channels' AA filter */
+    *w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, *w_raw);
+  }
+}
+
+/* Rotation into the rotor frame by n_p * theta, then the filters and
+ * derivatives of every channel. */
+static inline void isr_rotor_frame(imest_t *s, const isr_in_t *in, imest_real_t th_r, imest_real_t w_raw,
+                                   isr_signals_t *g)
+{
+  imest_real_t sn, cs;
+  isr_sincos(imest__wrap_pi(s->n * th_r), &sn, &cs);
+  imest_real_t ux, uy, ix, iy;
+  isr_rotate(sn, cs, in->ua, in->ub, &ux, &uy);
+  isr_rotate(sn, cs, in->ia, in->ib, &ix, &iy);
+  g->ux = isr_filter_deriv(s, &s->f_ux, ux);
+  g->uy = isr_filter_deriv(s, &s->f_uy, uy);
+  g->ix = isr_filter_deriv(s, &s->f_ix, ix);
+  g->iy = isr_filter_deriv(s, &s->f_iy, iy);
+  isr_filter_speed(s, &s->f_w, w_raw, &g->w, &g->dw);
+}
+
+/* The sample into the window: after the warm-up, an even call forms the
+ * regressor (stored for the odd call) and its first sums, the odd call the
+ * rest. */
+static inline void isr_window_sample(imest_t *s, imest_window_t *w, const isr_in_t *in,
+                                     const isr_signals_t *g, imest_real_t d3i, imest_real_t noise_u,
+                                     imest_real_t step)
+{
+  if (s->warm) {
+    s->warm--;
+    w->flags |= IMEST_FLAG_WARMUP;
+    return;
+  }
+  if ((s->k & 1u) == 0u) {
+    isr_regressor(s, g, w->c0, s->zx, s->zy);
+    isr_extra_t x;
+    /* i x di/dt: in steady state |i|^2 times the slip frequency */
+    x.cross = g->ix.x * g->iy.dx - g->iy.x * g->ix.dx;
+    x.noise_i = d3i * d3i;
+    x.noise_u = noise_u;
+    x.i0 = in->i0;
+    x.ia = in->ia_now; /* offset-free, before any delay, like i0 */
+    x.ib = in->ib_now;
+    x.ua = in->ua;
+    isr_accumulate_a(w, s->zx, s->zy, &x);
+    s->zpend = 1u;
+  } else {
+    isr_complete_pending(s, w);
+  }
+  w->rot += step;
+  w->used++;
+}
+
+/* Common part once alpha/beta are known: ua, ub, ia, ib alpha/beta, i0 the
+ * zero sequence i_a + i_b + i_c of the phase currents (0 where the caller
+ * gives alpha/beta), th the mechanical angle as given, how: ISR_* bits; the
+ * stages of the file's opening comment in order. Scalar arguments: they
+ * travel in FPU registers (the stages are inlined: in stays in registers). */
+static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t ia, imest_real_t ib,
+                    imest_real_t i0, imest_real_t th_in, unsigned int how)
+{
+  isr_in_t in = {ua, ub, ia, ib, i0, th_in, RL(0), RL(0), how};
+  imest_window_t *w = &s->win[s->published & 1u];
+  imest_real_t th = in.th, dth;
+  const uint32_t fault = isr_check(s, &in, &th, &dth);
+  const uint32_t first = !s->started;
+  s->started = 1u;
+  s->th_prev = th;
+  if (fault) return isr_fault(s, w, fault);
+
+  isr_offsets(s, &in, first);
+  in.ia_now = in.ia;
+  in.ib_now = in.ib;
+  imest_real_t d3i, noise_u, ia_prev, ua_prev;
+  isr_noise(s, &in, &d3i, &noise_u, &ia_prev, &ua_prev);
 
   /* The encoder angle through the tracking observer (which keeps quantisation
    * steps out of the rotation and the speed alike); its step is the speed. */
   imest_real_t step;
   imest_real_t th_r = th + isr_angle_update(&s->obs, dth, &step);
   imest_real_t w_raw = step * s->fs;
-  /* Optional stages branch on configuration only (the same path every
-   * sample), so a drive that does not use them does not pay for them. */
-  if (s->dly_i != RL(0)) {
-    /* the voltage lags: delay currents and angle to match */
-    const imest_real_t a = s->dly_i, w_now = w_raw;
-    ia = ia - a * (ia - ia_prev);
-    ib = ib - a * (ib - s->ib1);
-    s->ib1 = ib_now;
-    w_raw = w_now - a * (w_now - s->wr_prev);
-    th_r = th_r - a * step;
-    s->wr_prev = w_now;
-  }
-  if (s->dly_u != RL(0)) {
-    /* the voltage leads: delay it to match */
-    const imest_real_t ub_now = ub;
-    ua = ua - s->dly_u * (ua - ua_prev);
-    ub = ub - s->dly_u * (ub - s->ub1);
-    s->ub1 = ub_now;
-  }
-  if (s->aa_on) {
-    /* the angle through a model of the electrical channels' AA filter */
-    w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, w_raw);
-  }
-
-  /* rotation into the rotor frame by n_p * theta */
-  imest_real_t sn, cs;
-  isr_sincos(imest__wrap_pi(s->n * th_r), &sn, &cs);
-  imest_real_t ux, uy, ix, iy;
-  isr_rotate(sn, cs, ua, ub, &ux, &uy);
-  isr_rotate(sn, cs, ia, ib, &ix, &iy);
+  isr_align(s, &in, ia_prev, ua_prev, step, &th_r, &w_raw);
 
   isr_signals_t g;
-  g.ux = isr_filter_deriv(s, &s->f_ux, ux);
-  g.uy = isr_filter_deriv(s, &s->f_uy, uy);
-  g.ix = isr_filter_deriv(s, &s->f_ix, ix);
-  g.iy = isr_filter_deriv(s, &s->f_iy, iy);
-  isr_filter_speed(s, &s->f_w, w_raw, &g.w, &g.dw);
-
-  if (s->warm) {
-    s->warm--;
-    w->flags |= IMEST_FLAG_WARMUP;
-  } else {
-    if ((s->k & 1u) == 0u) {
-      /* even call: the regressor, stored for the odd call, and its first sums */
-      isr_regressor(s, &g, w->c0, s->zx, s->zy);
-      isr_extra_t x;
-      /* i x di/dt: in steady state |i|^2 times the slip frequency */
-      x.cross = g.ix.x * g.iy.dx - g.iy.x * g.ix.dx;
-      x.noise_i = d3i * d3i;
-      x.noise_u = noise_u;
-      x.i0 = i0;
-      x.ia = ia_now; /* offset-free, before any delay, like i0 */
-      x.ib = ib_now;
-      x.ua = ua;
-      isr_accumulate_a(w, s->zx, s->zy, &x);
-      s->zpend = 1u;
-    } else {
-      isr_complete_pending(s, w);
-    }
-    w->rot += step;
-    w->used++;
-  }
+  isr_rotor_frame(s, &in, th_r, w_raw, &g);
+  isr_window_sample(s, w, &in, &g, d3i, noise_u, step);
   isr_fold(w, s->k % IMEST_NACC);
 
   s->k++;

@@ -6,6 +6,7 @@
 #include <stddef.h>
 
 #include "bg_combine.h"
+#include "common/imest_handoff.h"
 #include "bg_noise.h"
 #include "bg_validity.h"
 
@@ -41,14 +42,14 @@ static void result_header(const imest_t *s, const imest_window_t *w, imest_resul
   out->seq = w->seq;
   out->samples = w->samples;
   out->used_samples = w->used;
-  out->overruns = s->overruns;
+  out->overruns = IMEST_LOAD_RELAXED(&s->overruns);
   out->flags = (unsigned int)(w->flags & 0xFFFFu); /* every IMEST_FLAG_ fits 16 bits (int may be 16) */
   /* every window before this one was complete (a flushed one ends a run) */
   out->t_end_s = ((double)w->seq * (double)s->window_n + (double)w->samples - 1.0) / (double)s->fs;
   out->span_s = (double)w->samples / (double)s->fs;
   out->windows = 1u;
-  out->tr_bound_rel = NAN;
-  out->rs_bound_rel = NAN;
+  out->tr_bound_rel = (double)NAN;
+  out->rs_bound_rel = (double)NAN;
 }
 
 /* The window's sums and statistics; is the speed steady; the white noise's
@@ -104,7 +105,7 @@ static void combine_join(imest_t *s, const imest_window_t *w, double m, bg_step_
 static void solve(const imest_t *s, const imest_window_t *w, bg_step_t *x, bg_solve_out_t *so)
 {
   so->status = IMEST_REASON_NUMERIC;
-  so->tr_s = NAN;
+  so->tr_s = (double)NAN;
   if (w->used < MIN_USED_SAMPLES) return;
   bg_solve_cfg_t cfg = {0}; /* fields added later default to 0 */
   cfg.sigma = (double)s->sigma;
@@ -142,17 +143,17 @@ static void result_from_solve(const bg_step_t *x, const imest_t *s, const bg_sol
     out->pe_k2_rel = so->pe_k2 / so->k2;
     if (so->hessian_pd) out->flags |= IMEST_FLAG_HESSIAN_PD;
   } else {
-    out->tr_s = NAN;
-    out->rs_ohm = NAN;
-    out->k1 = NAN;
-    out->k2 = NAN;
-    out->e = NAN;
-    out->e_i = NAN;
-    out->e_i_noise = NAN;
-    out->pe_k1 = NAN;
-    out->pe_k2 = NAN;
-    out->pe_k1_rel = NAN;
-    out->pe_k2_rel = NAN;
+    out->tr_s = (double)NAN;
+    out->rs_ohm = (double)NAN;
+    out->k1 = (double)NAN;
+    out->k2 = (double)NAN;
+    out->e = (double)NAN;
+    out->e_i = (double)NAN;
+    out->e_i_noise = (double)NAN;
+    out->pe_k1 = (double)NAN;
+    out->pe_k2 = (double)NAN;
+    out->pe_k1_rel = (double)NAN;
+    out->pe_k2_rel = (double)NAN;
   }
   out->n_roots = so->status == IMEST_REASON_NUMERIC ? 0u : so->n_roots;
   out->n_admissible = so->status == IMEST_REASON_NUMERIC ? 0u : so->n_admissible;
@@ -182,22 +183,22 @@ static void release_window(imest_t *s, imest_window_t *w, double m, const bg_ste
     s->last_k2 = (float)out->k2;
   }
   if (s->last_k2 > 0.0f) imest__bg_centre_from_k(w->c0, (double)s->last_k1, (double)s->last_k2, m);
-  /* the angle observer smooths only at a steady speed (src/estimator/isr/isr_angle.h) */
-  s->obs.engaged = (s->obs.enabled && x->steady) ? 1u : 0u;
+  /* the angle observer smooths only at a steady speed (src/estimator/isr/isr_angle.h);
+   * the word travels in the buffer, the ISR takes it when it refills it */
+  w->engage = (s->obs.enabled && x->steady) ? 1u : 0u;
   for (unsigned int p = 0; p < IMEST_NACC; ++p) {
     w->sum[p] = 0;
     w->blk[p] = 0;
   }
-  IMEST_BARRIER(); /* buffer cleared before it is released */
-  s->released = s->released + 1u;
+  IMEST_STORE_RELEASE(&s->released, s->released + 1u); /* the buffer, cleared, back to the ISR */
 }
 
 int imest_background(imest_t *s, imest_result_t *out)
 {
   if (s == NULL || out == NULL) return IMEST_ERR_NULL;
-  if (s->published == s->released) return 0;
-  IMEST_BARRIER(); /* read the window only after seeing it published */
-  imest_window_t *w = &s->win[s->released & 1u];
+  const uint32_t rel = s->released;                       /* the background's own index */
+  if (IMEST_LOAD_ACQUIRE(&s->published) == rel) return 0; /* the window only after its index */
+  imest_window_t *w = &s->win[rel & 1u];
   const double m = (double)s->m;
   bg_step_t x;
   bg_solve_out_t so = {0};

@@ -2,7 +2,7 @@
  * parameter? The first reason found, most fundamental first, becomes the
  * reason; T_R and R_S get their own verdicts (R_S is far more sensitive to
  * the voltage's and the timing's errors than T_R). imest__bg_judge() runs
- * the ordered tables of checks at the end of this file. A threshold a user
+ * the ordered lists of checks at the end of this file (TR_CHECKS, RS_CHECKS). A threshold a user
  * tunes is a config field (each table row names it); a threshold physics
  * fixes is a named constant below, with its reason. README "When is a window
  * valid" and docs/METHOD.md §13 give the measurements behind the defaults.
@@ -217,73 +217,67 @@ typedef struct {
   float tr_b, rs_b, g_b; /* T_R's and R_S's systematic bounds, the gain mismatch's share */
 } judge_t;
 
-/* One check: the reason a window gets when it fails it. */
-typedef struct {
-  int reason;
-  int (*fails)(judge_t *j);
-} judge_check_t;
-
-static int input_fault(judge_t *j)
+static inline int input_fault(judge_t *j)
 {
   return (j->r->flags & IMEST_FLAG_INPUT_FAULT) != 0u;
 }
-static int adc_saturation(judge_t *j)
+static inline int adc_saturation(judge_t *j)
 {
   return (j->r->flags & IMEST_FLAG_ADC_SAT) != 0u;
 }
-static int encoder_fault(judge_t *j)
+static inline int encoder_fault(judge_t *j)
 {
   return (j->r->flags & IMEST_FLAG_ENCODER_FAULT) != 0u;
 }
 /* warm-up samples are not accumulated; the rest of the window is clean data,
  * so warm-up invalidates a window only when it took half of it */
-static int warmup(judge_t *j)
+static inline int warmup(judge_t *j)
 {
   return (j->r->flags & IMEST_FLAG_WARMUP) && 2u * j->r->used_samples < j->r->samples;
 }
 /* min_current_a. i_rms_a is what passed the offset high-pass. A DC current it
  * removed (magnetising at rest) is in the tracked means: that rotor is at
  * rest with excitation, not without current. */
-static int low_current(judge_t *j)
+static inline int low_current(judge_t *j)
 {
   return !(j->st->i_rms_a >= (double)j->s->min_current_a);
 }
-static int low_current_at_rest(judge_t *j)
+static inline int low_current_at_rest(judge_t *j)
 {
   const double ia = (double)j->w->off_ia, ib = (double)j->w->off_ib;
   const int dc = sqrt(ia * ia + ib * ib) >= (double)j->s->min_current_a;
   return low_current(j) && dc && fabs(j->st->w_mean) < AT_REST_RAD_S;
 }
 /* ls_h, sigma, pole_pairs, rs_nominal_ohm */
-static int wiring(judge_t *j)
+static inline int wiring(judge_t *j)
 {
   return wiring_mismatch(j->s, &j->op);
 }
 /* ls_h (latched: once L_S at no load disagrees, every later window) */
-static int ls_mismatch(judge_t *j)
+static inline int ls_mismatch(judge_t *j)
 {
   noload_ls_check(j->s, &j->op, (float)j->r->slip_ratio, j->steady, j->r);
   return j->s->ls_check == 2u;
 }
 /* min_slip_ratio */
-static int low_slip(judge_t *j)
+static inline int low_slip(judge_t *j)
 {
   return !(j->r->slip_ratio >= (double)j->s->min_slip_ratio);
 }
-static int low_slip_at_rest(judge_t *j)
+static inline int low_slip_at_rest(judge_t *j)
 {
   return low_slip(j) && fabs(j->st->w_mean) < AT_REST_RAD_S;
 }
-static int solve_numeric(judge_t *j)
+static inline int solve_numeric(judge_t *j)
 {
   return j->so->status == IMEST_REASON_NUMERIC;
 }
 /* tr_min_s, tr_max_s */
-static int solve_no_root(judge_t *j)
+static inline int solve_no_root(judge_t *j)
 {
   return j->so->status != IMEST_OK;
 }
-static int not_minimum(judge_t *j)
+static inline int not_minimum(judge_t *j)
 {
   return !j->so->hessian_pd;
 }
@@ -295,7 +289,7 @@ static int not_minimum(judge_t *j)
  * shares, the noise's (e_i_noise^2 / e_i^2) and the rest's, and only the
  * noise's is credited the n windows: pe^2 (1 - f + f / n) against
  * max_pe_k2_rel^2. */
-static int poorly_determined(judge_t *j)
+static inline int poorly_determined(judge_t *j)
 {
   const imest_result_t *r = j->r;
   const double f = r->e_i > 0.0 ? fmin(1.0, (r->e_i_noise * r->e_i_noise) / (r->e_i * r->e_i)) : 1.0;
@@ -303,88 +297,97 @@ static int poorly_determined(judge_t *j)
   return !(pe2 <= (double)j->s->max_pe_k2_rel * (double)j->s->max_pe_k2_rel);
 }
 /* max_ei: the residual beyond what the sensors' white noise explains */
-static int high_residual(judge_t *j)
+static inline int high_residual(judge_t *j)
 {
   const imest_result_t *r = j->r;
   const double em = sqrt(fmax(0.0, r->e_i * r->e_i - r->e_i_noise * r->e_i_noise));
   return !(em <= (double)j->s->max_ei);
 }
 /* rs_min_ohm, rs_max_ohm */
-static int rs_out_of_range(judge_t *j)
+static inline int rs_out_of_range(judge_t *j)
 {
   return !(j->r->rs_ohm >= (double)j->s->rs_min_ohm && j->r->rs_ohm <= (double)j->s->rs_max_ohm);
 }
 /* rs_nominal_ohm: constants that cannot be the motor's */
-static int rs_off_nominal(judge_t *j)
+static inline int rs_off_nominal(judge_t *j)
 {
   const double rn = (double)j->s->rs_nominal_ohm;
   return j->s->rs_nominal_ohm > 0.0f &&
          !(j->r->rs_ohm >= RS_NOMINAL_MIN * rn && j->r->rs_ohm <= RS_NOMINAL_MAX * rn);
 }
 /* tr_nominal_s (when given) */
-static int tr_off_nominal(judge_t *j)
+static inline int tr_off_nominal(judge_t *j)
 {
   const double tn = (double)j->s->tr_nominal_s;
   return j->s->tr_nominal_known && !(j->r->tr_s >= TR_NOMINAL_MIN * tn && j->r->tr_s <= TR_NOMINAL_MAX * tn);
 }
 /* never a confident non-finite number */
-static int not_finite(judge_t *j)
+static inline int not_finite(judge_t *j)
 {
   return !(isfinite(j->r->tr_s) && isfinite(j->r->rs_ohm) && isfinite(j->r->e_i));
 }
 /* tr_tolerance. The bounds are steady-state figures: T_R's is judged only
  * below the pull-out slip (a sigma < 1), where a drive runs steadily; beyond
  * it the window is a transient (a run-up) whose dynamics determine T_R. */
-static int tr_uncertain(judge_t *j)
+static inline int tr_uncertain(judge_t *j)
 {
   const float a_slip = (float)j->st->slip_rate * (float)j->r->tr_s * j->s->sigma;
   return a_slip < 1.0f && !(j->tr_b <= j->s->tr_tolerance);
 }
 /* rs_tolerance: the current sensors' gain mismatch takes most of R_S's bound */
-static int rs_gain_mismatch(judge_t *j)
+static inline int rs_gain_mismatch(judge_t *j)
 {
   return !(j->rs_b + j->g_b <= j->s->rs_tolerance) && j->g_b > j->rs_b;
 }
 /* rs_tolerance */
-static int rs_uncertain(judge_t *j)
+static inline int rs_uncertain(judge_t *j)
 {
   return !(j->rs_b + j->g_b <= j->s->rs_tolerance);
 }
 
-/* T_R's verdict: the first check the window fails, most fundamental first. */
-static const judge_check_t tr_checks[] = {
-    {IMEST_REASON_INPUT_FAULT, input_fault},
-    {IMEST_REASON_ADC_SATURATION, adc_saturation},
-    {IMEST_REASON_ENCODER_FAULT, encoder_fault},
-    {IMEST_REASON_WARMUP, warmup},
-    {IMEST_REASON_STANDSTILL, low_current_at_rest},
-    {IMEST_REASON_NO_CURRENT, low_current},
-    {IMEST_REASON_WIRING_MISMATCH, wiring},
-    {IMEST_REASON_CONSTANTS_MISMATCH, ls_mismatch},
-    {IMEST_REASON_STANDSTILL, low_slip_at_rest},
-    {IMEST_REASON_ZERO_SLIP, low_slip},
-    {IMEST_REASON_NUMERIC, solve_numeric},
-    {IMEST_REASON_NO_ROOT, solve_no_root},
-    {IMEST_REASON_NOT_MINIMUM, not_minimum},
-    {IMEST_REASON_POORLY_DETERMINED, poorly_determined},
-    {IMEST_REASON_HIGH_RESIDUAL, high_residual},
-    {IMEST_REASON_RS_OUT_OF_RANGE, rs_out_of_range},
-    {IMEST_REASON_CONSTANTS_MISMATCH, rs_off_nominal},
-    {IMEST_REASON_CONSTANTS_MISMATCH, tr_off_nominal},
-    {IMEST_REASON_NUMERIC, not_finite},
-    {IMEST_REASON_TR_UNCERTAIN, tr_uncertain},
-};
+/* The checks in order, as X(reason, predicate): a window gets the reason of
+ * the first check it fails, most fundamental first (the predicates above say
+ * which config field each reads). An X-list, not a table in memory: it
+ * expands into the chain of tests, as small as one written by hand. */
+#define TR_CHECKS(X)                                                                                         \
+  X(IMEST_REASON_INPUT_FAULT, input_fault)                                                                   \
+  X(IMEST_REASON_ADC_SATURATION, adc_saturation)                                                             \
+  X(IMEST_REASON_ENCODER_FAULT, encoder_fault)                                                               \
+  X(IMEST_REASON_WARMUP, warmup)                                                                             \
+  X(IMEST_REASON_STANDSTILL, low_current_at_rest)                                                            \
+  X(IMEST_REASON_NO_CURRENT, low_current)                                                                    \
+  X(IMEST_REASON_WIRING_MISMATCH, wiring)                                                                    \
+  X(IMEST_REASON_CONSTANTS_MISMATCH, ls_mismatch)                                                            \
+  X(IMEST_REASON_STANDSTILL, low_slip_at_rest)                                                               \
+  X(IMEST_REASON_ZERO_SLIP, low_slip)                                                                        \
+  X(IMEST_REASON_NUMERIC, solve_numeric)                                                                     \
+  X(IMEST_REASON_NO_ROOT, solve_no_root)                                                                     \
+  X(IMEST_REASON_NOT_MINIMUM, not_minimum)                                                                   \
+  X(IMEST_REASON_POORLY_DETERMINED, poorly_determined)                                                       \
+  X(IMEST_REASON_HIGH_RESIDUAL, high_residual)                                                               \
+  X(IMEST_REASON_RS_OUT_OF_RANGE, rs_out_of_range)                                                           \
+  X(IMEST_REASON_CONSTANTS_MISMATCH, rs_off_nominal)                                                         \
+  X(IMEST_REASON_CONSTANTS_MISMATCH, tr_off_nominal)                                                         \
+  X(IMEST_REASON_NUMERIC, not_finite)                                                                        \
+  X(IMEST_REASON_TR_UNCERTAIN, tr_uncertain)
 
-/* R_S's verdict, once T_R's is valid: its own bound. */
-static const judge_check_t rs_checks[] = {
-    {IMEST_REASON_GAIN_MISMATCH, rs_gain_mismatch},
-    {IMEST_REASON_RS_UNCERTAIN, rs_uncertain},
-};
+/* R_S's own checks, once T_R's verdict is valid. */
+#define RS_CHECKS(X)                                                                                         \
+  X(IMEST_REASON_GAIN_MISMATCH, rs_gain_mismatch)                                                            \
+  X(IMEST_REASON_RS_UNCERTAIN, rs_uncertain)
 
-static int first_failed(const judge_check_t *c, unsigned int n, judge_t *j)
+#define RETURN_IF_FAILS(reason, fails)                                                                       \
+  if (fails(j)) return (reason);
+
+static int tr_verdict(judge_t *j)
 {
-  for (unsigned int k = 0; k < n; ++k)
-    if (c[k].fails(j)) return c[k].reason;
+  TR_CHECKS(RETURN_IF_FAILS)
+  return IMEST_REASON_NONE;
+}
+
+static int rs_verdict(judge_t *j)
+{
+  RS_CHECKS(RETURN_IF_FAILS)
   return IMEST_REASON_NONE;
 }
 
@@ -428,12 +431,10 @@ void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_
    * rated load). Below 0.1 T_R is weakly observable. With the estimate's
    * T_R (the motor's, for any size; the nominal T_R where there is none). */
   r->slip_ratio = (double)(fabsf((float)st->slip_rate) * (have ? (float)r->tr_s : s->tr_nominal_s));
-  r->ls_noload_h = NAN; /* the no-load check fills it where it runs */
+  r->ls_noload_h = (double)NAN; /* the no-load check fills it where it runs */
   bounds(&j, sm);
-  const int status = first_failed(tr_checks, sizeof tr_checks / sizeof tr_checks[0], &j);
-  const int rs_status = status != IMEST_REASON_NONE
-                            ? status
-                            : first_failed(rs_checks, sizeof rs_checks / sizeof rs_checks[0], &j);
+  const int status = tr_verdict(&j);
+  const int rs_status = status != IMEST_REASON_NONE ? status : rs_verdict(&j);
   r->tr_reason = status;
   r->tr_valid = (status == IMEST_REASON_NONE);
   r->rs_reason = rs_status;
