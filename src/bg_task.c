@@ -31,8 +31,8 @@ int imest_background(imest_t *s, imest_result_t *out)
   out->t_end_s = ((double)w->seq * (double)s->window_n + (double)w->samples - 1.0) / (double)s->fs;
   out->span_s = (double)w->samples / (double)s->fs;
   out->windows = 1u;
-  out->tr_bound_rel = NAN;
-  out->rs_bound_rel = NAN;
+  out->tr_bound_rel = (double)NAN;
+  out->rs_bound_rel = (double)NAN;
 
   const double m = (double)s->m;
   bg_sums_t sums;
@@ -82,7 +82,7 @@ int imest_background(imest_t *s, imest_result_t *out)
   const double ry_all = combined ? s->combo.ry_raw : ry_raw;
   bg_solve_out_t so = {0};
   so.status = IMEST_REASON_NUMERIC;
-  so.tr_s = NAN;
+  so.tr_s = (double)NAN;
   if (w->used >= 16u) {
     bg_solve_cfg_t cfg = {0}; /* fields added later default to 0 */
     cfg.sigma = (double)s->sigma;
@@ -116,17 +116,17 @@ int imest_background(imest_t *s, imest_result_t *out)
     out->pe_k2_rel = so.pe_k2 / so.k2;
     if (so.hessian_pd) out->flags |= IMEST_FLAG_HESSIAN_PD;
   } else {
-    out->tr_s = NAN;
-    out->rs_ohm = NAN;
-    out->k1 = NAN;
-    out->k2 = NAN;
-    out->e = NAN;
-    out->e_i = NAN;
-    out->e_i_noise = NAN;
-    out->pe_k1 = NAN;
-    out->pe_k2 = NAN;
-    out->pe_k1_rel = NAN;
-    out->pe_k2_rel = NAN;
+    out->tr_s = (double)NAN;
+    out->rs_ohm = (double)NAN;
+    out->k1 = (double)NAN;
+    out->k2 = (double)NAN;
+    out->e = (double)NAN;
+    out->e_i = (double)NAN;
+    out->e_i_noise = (double)NAN;
+    out->pe_k1 = (double)NAN;
+    out->pe_k2 = (double)NAN;
+    out->pe_k1_rel = (double)NAN;
+    out->pe_k2_rel = (double)NAN;
   }
   out->n_roots = so.status == IMEST_REASON_NUMERIC ? 0u : so.n_roots;
   out->n_admissible = so.status == IMEST_REASON_NUMERIC ? 0u : so.n_admissible;

@@ -213,7 +213,7 @@ void bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, 
     status = (dc && fabs(st->w_mean) < 1.0) ? IMEST_REASON_STANDSTILL : IMEST_REASON_NO_CURRENT;
   }
   if (status == IMEST_REASON_NONE && wiring_mismatch(s, &op)) status = IMEST_REASON_WIRING_MISMATCH;
-  r->ls_noload_h = NAN;
+  r->ls_noload_h = (double)NAN;
   if (status == IMEST_REASON_NONE) noload_ls_check(s, &op, (float)r->slip_ratio, steady, r);
   if (status == IMEST_REASON_NONE && s->ls_check == 2u) status = IMEST_REASON_CONSTANTS_MISMATCH;
   if (status == IMEST_REASON_NONE && !(r->slip_ratio >= (double)s->min_slip_ratio)) {

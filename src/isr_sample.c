@@ -242,7 +242,7 @@ int imest_isr_ab(imest_t *s, float u_alpha_v, float u_beta_v, float i_alpha_a, f
   const imest_real_t ua = (imest_real_t)u_alpha_v, ub = (imest_real_t)u_beta_v;
   const imest_real_t ia = (imest_real_t)i_alpha_a, ib = (imest_real_t)i_beta_a;
   /* the limits apply to whatever quantities the caller passes */
-  const int in_range = (isr_abs(ia) < s->i_lim) & (isr_abs(ib) < s->i_lim) & (isr_abs(ua) < s->u_lim) &
+  const int in_range = (int)(isr_abs(ia) < s->i_lim) & (isr_abs(ib) < s->i_lim) & (isr_abs(ua) < s->u_lim) &
                        (isr_abs(ub) < s->u_lim);
   s->duty_input = 0u;
   return isr_step(s, ua, ub, ia, ib, RL(0), (imest_real_t)theta_rad,
@@ -257,7 +257,7 @@ int imest_isr_abc(imest_t *s, const float u_abc_v[3], const float i_abc_a[3], fl
     u[p] = (imest_real_t)u_abc_v[p];
     i[p] = (imest_real_t)i_abc_a[p];
     /* a sample at (or beyond) the ADC limit: the true value is unknown */
-    in_range &= (isr_abs(i[p]) < s->i_lim) & (isr_abs(u[p]) < s->u_lim);
+    in_range &= (int)(isr_abs(i[p]) < s->i_lim) & (isr_abs(u[p]) < s->u_lim);
   }
   imest_real_t ua, ub, ia, ib;
   isr_clarke(u, &ua, &ub);
@@ -294,7 +294,7 @@ int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float
   /* the ADC limit applies to the currents; the duties and the bus voltage
    * only have to be numbers: one test catches NaN, Inf or absurd duties and
    * a bus voltage near u_absurd_v (both weighted into one sum of squares) */
-  const int in_range = (isr_abs(ia) < s->i_lim) & (isr_abs(ib) < s->i_lim) & (isr_abs(ic) < s->i_lim) &
+  const int in_range = (int)(isr_abs(ia) < s->i_lim) & (isr_abs(ib) < s->i_lim) & (isr_abs(ic) < s->i_lim) &
                        (((da * da + db * db) + dc * dc) + m->vdc2_w * (vdc * vdc) < RL(12));
   const imest_real_t u[3] = {va, vb, vc}, i[3] = {ia, ib, ic};
   imest_real_t ua, ub, ia_ab, ib_ab, sa, sb;
