@@ -131,8 +131,9 @@ static int inum(const char *s, long *v)
 }
 
 #define CFG(field) offsetof(imsim_config_t, field)
-#define NONE_LO    (-INFINITY)
-#define NONE_HI    INFINITY
+/* INFINITY is a float; the bounds are double (clang's -Wdouble-promotion). */
+#define NONE_LO    (-(double)INFINITY)
+#define NONE_HI    ((double)INFINITY)
 
 /* Real-valued flags: value in (lo, hi) or [lo, hi] as lo_open/hi_open say. */
 typedef struct {

@@ -50,24 +50,24 @@ static void synth(unsigned int k, imest_result_t *r)
   r->span_s = 1.0 * (double)r->windows;
   switch (k % 10u) {
   case 3u: /* no candidate */
-    r->tr_s = NAN;
-    r->rs_ohm = NAN;
-    r->e_i = NAN;
-    r->pe_k1_rel = NAN;
-    r->pe_k2_rel = NAN;
+    r->tr_s = (double)NAN;
+    r->rs_ohm = (double)NAN;
+    r->e_i = (double)NAN;
+    r->pe_k1_rel = (double)NAN;
+    r->pe_k2_rel = (double)NAN;
     r->valid = 0;
     r->status = IMEST_REASON_NO_ROOT;
     r->tr_valid = r->rs_valid = 0;
     r->tr_reason = r->rs_reason = IMEST_REASON_NO_ROOT;
-    r->tr_bound_rel = r->rs_bound_rel = NAN;
+    r->tr_bound_rel = r->rs_bound_rel = (double)NAN;
     r->flags = IMEST_FLAG_WARMUP | IMEST_FLAG_ENCODER_FAULT;
     r->n_admissible = 0u;
     break;
   case 5u: /* saturation of every field */
     r->tr_s = 1e300;
-    r->rs_ohm = -INFINITY;
+    r->rs_ohm = -(double)INFINITY;
     r->e_i = 9.5;
-    r->pe_k1_rel = INFINITY;
+    r->pe_k1_rel = (double)INFINITY;
     r->pe_k2_rel = 2.0;
     r->valid = 0;
     r->status = IMEST_REASON_HIGH_RESIDUAL;

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # check-refs: skip-file (this test writes a fixture tree full of dangling names)
-"""tools/check-refs on a small fixture tree: it must report each dangling
+"""tools/scripts/check-refs on a small fixture tree: it must report each dangling
 file, document, section and heading reference (file:line) and nothing that
 resolves, exit 1 for a dangling tree, 0 once fixed, 2 on a usage error.
 
@@ -41,7 +41,7 @@ See docs/METHOD.md §1 and §2.2.
 /* check-refs: ignore src/ignored.h */
 """,
     "src/b.h": "/* b */\n",
-    "tools/check-refs.allow": "results/*   generated\nbuild*   build output\nfixture_only.h   test\n",
+    "tools/scripts/check-refs.allow": "results/*   generated\nbuild*   build output\nfixture_only.h   test\n",
 }
 EXPECTED = {
     "src/a.c:2: §3: docs/METHOD.md has no section 3",

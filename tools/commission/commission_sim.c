@@ -130,7 +130,8 @@ double comm_sim_model_leg_error(const imest_inverter_t *m, double vdc, double fp
   if (s > 1.0) s = 1.0;
   if (s < -1.0) s = -1.0;
   const double a = fabs(i), dc = i > 0.0 ? d : 1.0 - d;
-  const double vs = m->v_switch_v, vd = m->v_diode_v, rs = m->r_switch_ohm, rd = m->r_diode_ohm;
+  const double vs = (double)m->v_switch_v, vd = (double)m->v_diode_v, rs = (double)m->r_switch_ohm,
+               rd = (double)m->r_diode_ohm;
   return s * ((double)m->dead_time_s * fpwm * vdc + vd + rd * a + dc * ((vs - vd) + (rs - rd) * a));
 }
 
@@ -232,7 +233,7 @@ int comm_sim_run(const comm_sim_opts_t *o, comm_sim_out_t *out)
       fprintf(o->trace, "%.6f,%u,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,%.6f\n", s.t, (unsigned int)c->stage,
               s.i_abc[0], s.i_abc[1], s.i_abc[2], (double)d[0], (double)d[1], (double)d[2], s.speed_rad_s,
               s.theta);
-    const double dd[3] = {d[0], d[1], d[2]};
+    const double dd[3] = {(double)d[0], (double)d[1], (double)d[2]};
     imsim_set_duty(simp, dd);
     if (bg_every == 0u || n % bg_every == 0u)
       while (imest_comm_background(c) == 1) {}

@@ -256,10 +256,11 @@ int main(int argc, char **argv)
         "sigma_err_pct,tr_err_pct,np,np_true,encoder_dir,dead_time_err_us,inv_err_model_v,inv_err_total_v\n");
     printf("%s,%s,%s,%d,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%d,%.4f,%.4f,%.4f\n", o.preset,
            imest_comm_state_name(r->state), imest_comm_reason_name(r->reason), r->valid, (double)r->time_s,
-           out.i_peak_true_a, pct(r->rs_ohm.value, out.rs_identifiable_ohm), pct(r->rs_ohm.value, out.rs_ohm),
-           pct(r->sigma_ls_h.value, out.sigma_ls_h), pct(r->ls_h.value, out.ls_h),
-           pct(r->sigma.value, out.sigma), pct(r->tr_s.value, out.tr_s), r->pole_pairs, out.pole_pairs,
-           r->encoder_dir, ((double)r->inverter.dead_time_s - sc->dead_time_s) * 1e6, out.inv_err_model_v,
+           out.i_peak_true_a, pct((double)r->rs_ohm.value, out.rs_identifiable_ohm),
+           pct((double)r->rs_ohm.value, out.rs_ohm), pct((double)r->sigma_ls_h.value, out.sigma_ls_h),
+           pct((double)r->ls_h.value, out.ls_h), pct((double)r->sigma.value, out.sigma),
+           pct((double)r->tr_s.value, out.tr_s), r->pole_pairs, out.pole_pairs, r->encoder_dir,
+           ((double)r->inverter.dead_time_s - sc->dead_time_s) * 1e6, out.inv_err_model_v,
            out.inv_err_total_v);
     return r->valid ? 0 : 1;
   }
@@ -279,20 +280,20 @@ int main(int argc, char **argv)
   printf("\n\n  %-26s %12s %12s %10s\n", "quantity", "identified", "true", "error");
   char note[160];
   snprintf(note, sizeof note, "true = winding %.5g + min(r_sw, r_d) %.4g; vs winding %+.3f %%", out.rs_ohm,
-           out.rs_identifiable_ohm - out.rs_ohm, pct(r->rs_ohm.value, out.rs_ohm));
-  row("R_S [ohm]", 1.0, r->rs_ohm.value, out.rs_identifiable_ohm, note);
+           out.rs_identifiable_ohm - out.rs_ohm, pct((double)r->rs_ohm.value, out.rs_ohm));
+  row("R_S [ohm]", 1.0, (double)r->rs_ohm.value, out.rs_identifiable_ohm, note);
   snprintf(note, sizeof note, "axes %.5g %.5g %.5g, spread %.2g %%", (double)r->rs_axis_ohm[0],
            (double)r->rs_axis_ohm[1], (double)r->rs_axis_ohm[2], 100.0 * (double)r->rs_ohm.spread_rel);
   printf("  %-26s %s\n", "", note);
   snprintf(note, sizeof note, "spread %.2g %%", 100.0 * (double)r->sigma_ls_h.spread_rel);
-  row("sigma*L_S [mH]", 1e3, r->sigma_ls_h.value, out.sigma_ls_h, note);
+  row("sigma*L_S [mH]", 1e3, (double)r->sigma_ls_h.value, out.sigma_ls_h, note);
   snprintf(note, sizeof note, "%s; standstill %.5g mH (%+.2f %%)",
            (r->flags & IMEST_COMM_FLAG_LS_STANDSTILL) ? "standstill" : "rotating",
-           1e3 * (double)r->ls_standstill_h.value, pct(r->ls_standstill_h.value, out.ls_h));
-  row("L_S [mH]", 1e3, r->ls_h.value, out.ls_h, note);
-  row("sigma", 1.0, r->sigma.value, out.sigma, NULL);
-  row("T_R [ms]", 1e3, r->tr_s.value, out.tr_s, "flux tails");
-  row("R_R' [ohm]", 1.0, r->rr_ohm.value, out.rr_ohm, "(1-sigma) L_S / T_R");
+           1e3 * (double)r->ls_standstill_h.value, pct((double)r->ls_standstill_h.value, out.ls_h));
+  row("L_S [mH]", 1e3, (double)r->ls_h.value, out.ls_h, note);
+  row("sigma", 1.0, (double)r->sigma.value, out.sigma, NULL);
+  row("T_R [ms]", 1e3, (double)r->tr_s.value, out.tr_s, "flux tails");
+  row("R_R' [ohm]", 1.0, (double)r->rr_ohm.value, out.rr_ohm, "(1-sigma) L_S / T_R");
   {
     /* with the firmware's counts assumed right, n_p x the firmware's angle is what must match */
     const double cpr_fw = o.cpr_assumed > 0.0 ? o.cpr_assumed : (double)sc->encoder_counts;

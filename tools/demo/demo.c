@@ -63,6 +63,10 @@
 #include "imest_socketcan.h"
 #endif
 
+/* A double NaN: the C library's NAN is a float, and clang's -Wdouble-promotion
+   flags its conversion. */
+#define D_NAN ((double)NAN)
+
 /* ------------------------------------------------------------------------- */
 /* Options                                                                    */
 
@@ -133,14 +137,14 @@ static void acc_add(acc_t *a, const imsim_sample_t *s)
     a->psi_ref += s->ifoc_flux_ref_wb;
     a->ifoc_tr += s->ifoc_tr_s;
   } else {
-    a->te_ref = a->psi_ref = a->ifoc_tr = NAN;
+    a->te_ref = a->psi_ref = a->ifoc_tr = D_NAN;
   }
 }
 
 static truth_t acc_mean(const acc_t *a)
 {
   truth_t t;
-  const double n = a->n > 0 ? a->n : (double)NAN;
+  const double n = a->n > 0 ? a->n : D_NAN;
   t.tr = a->tr / n;
   t.rs = a->rs / n;
   t.speed = a->speed / n;
@@ -154,7 +158,7 @@ static truth_t acc_mean(const acc_t *a)
   t.temp_s = a->temp_s / n;
   t.temp_r = a->temp_r / n;
   t.ifoc_tr = a->ifoc_tr / n;
-  if (!isfinite(t.te_ref)) t.te_err_rms = NAN;
+  if (!isfinite(t.te_ref)) t.te_err_rms = D_NAN;
   return t;
 }
 
@@ -338,7 +342,7 @@ static int exp1_wave(job_t *j, const char *dir, double tr_id, double rs_id)
     double uab[2], iab[2];
     imsim_abc_to_ab(ma->u_abc, uab);
     imsim_abc_to_ab(ma->i_abc, iab);
-    const double w_enc = k >= 2 * H ? (th[2 * H] - th[0]) * cm.fs_hz / (2.0 * H) : (double)NAN;
+    const double w_enc = k >= 2 * H ? (th[2 * H] - th[0]) * cm.fs_hz / (2.0 * H) : D_NAN;
     fprintf(f, "%.6f,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.6g,%.6g\n", ma->t, uab[0], uab[1], iab[0],
             iab[1], w_enc, ma->speed_rad_s, mb->i_ab_true[0], mb->speed_rad_s, tr_id, rs_id);
   }
@@ -495,7 +499,8 @@ static void on_window(void *ctx, const imest_result_t *r)
   run_t *x = (run_t *)ctx;
   job_t *j = x->j;
   (void)imest_can_publish(&x->tee->pub, r); /* refusals are counted by the log port */
-  static const truth_t nan_t = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+  static const truth_t nan_t = {D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN,
+                                D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN};
   const truth_t *t = (r->seq < x->nwin && r->seq < x->win) ? &x->truth[r->seq] : &nan_t;
   fprintf(x->csv,
           "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
@@ -522,7 +527,8 @@ static void on_window(void *ctx, const imest_result_t *r)
 static void on_window_true(void *ctx, const imest_result_t *r)
 {
   run_t *x = (run_t *)ctx;
-  static const truth_t nan_t = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+  static const truth_t nan_t = {D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN,
+                                D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN};
   const truth_t *t = (r->seq < x->nwin && r->seq < x->win) ? &x->truth[r->seq] : &nan_t;
   fprintf(x->csv_true, "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%d,%d\n", x->name, r->seq, r->t_end_s, r->tr_s,
           r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr, t->rs, r->tr_valid, r->rs_valid);
@@ -571,7 +577,10 @@ static int job_close(run_t *x)
 #ifdef IMEST_DEMO_HAVE_SOCKETCAN
   if (x->tee->live) imest_socketcan_close(&x->tee->sc);
 #endif
-  const int bad = (fclose(x->log) != 0) | (fclose(x->csv) != 0) | (x->csv_true && fclose(x->csv_true) != 0);
+  /* every file is closed, whichever fails */
+  int bad = fclose(x->log) != 0;
+  if (fclose(x->csv) != 0) bad = 1;
+  if (x->csv_true && fclose(x->csv_true) != 0) bad = 1;
   x->log = x->csv = x->csv_true = NULL;
   run_release(x);
   if (bad) {
@@ -882,7 +891,7 @@ static int report(const job_t jobs[NEXP], const int started[NEXP], double t0)
     printf("\n");
   }
   struct rusage ru;
-  double cpu = NAN;
+  double cpu = D_NAN;
   if (getrusage(RUSAGE_SELF, &ru) == 0)
     cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
           1e-6 * (double)ru.ru_stime.tv_usec;

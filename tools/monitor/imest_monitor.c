@@ -155,12 +155,15 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
     valid[0] = nr[0] = na[0] = flags[0] = satb[0] = '\0';
   }
   fmt_reason(status, sizeof status, h_q, r->status);
-  snprintf(trv, sizeof trv, h_v ? "%d" : "", r->tr_valid);
-  snprintf(rsv, sizeof rsv, h_v ? "%d" : "", r->rs_valid);
+  trv[0] = rsv[0] = nw[0] = '\0'; /* empty without the validity group */
+  if (h_v) {
+    snprintf(trv, sizeof trv, "%d", r->tr_valid);
+    snprintf(rsv, sizeof rsv, "%d", r->rs_valid);
+    snprintf(nw, sizeof nw, "%u", r->windows);
+  }
   fmt_reason(trr, sizeof trr, h_v, r->tr_reason);
   fmt_reason(rsr, sizeof rsr, h_v, r->rs_reason);
   fmt_value(span, sizeof span, h_v, "%.3f", r->span_s, sat, IMEST_CAN_SAT_SPAN);
-  snprintf(nw, sizeof nw, h_v ? "%u" : "", r->windows);
   if (m->csv) {
     fmt_value(trb, sizeof trb, h_b, "%.5f", r->tr_bound_rel, sat, IMEST_CAN_SAT_TRB);
     fmt_value(rsb, sizeof rsb, h_b, "%.5f", r->rs_bound_rel, sat, IMEST_CAN_SAT_RSB);

@@ -138,7 +138,7 @@ static int can_log_close(can_log_t *c)
 /* ------------------------------------------------------------------------- */
 /* run: every sample through the ISR call, the background per window          */
 
-/* The columns up to flags keep their places (tools/accuracy reads them by
+/* The columns up to flags keep their places (tools/studies/accuracy reads them by
  * position); the per-parameter verdicts and bounds came later and follow. */
 static void print_header(void)
 {

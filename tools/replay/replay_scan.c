@@ -354,11 +354,11 @@ int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s)
   memset(s, 0, sizeof *s);
   tally_t y;
   memset(&y, 0, sizeof y);
-  y.dt_min = y.lo = INFINITY;
-  y.dt_max = y.hi = -INFINITY;
+  y.dt_min = y.lo = (double)INFINITY;
+  y.dt_max = y.hi = -(double)INFINITY;
   y.all_unit_steps = 1;
-  y.d_min = y.vdc_min = INFINITY;
-  y.d_max = -INFINITY;
+  y.d_min = y.vdc_min = (double)INFINITY;
+  y.d_max = -(double)INFINITY;
   double v[CSV_MAX_NEED];
   replay_sample_t x;
   int rc;

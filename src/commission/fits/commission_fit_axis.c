@@ -200,9 +200,9 @@ static void fit_square_wave(imest_comm_t *c, uint32_t nb, imest_comm_axis_fit_t 
   r[2] = s[CM_H_Y];
   const double rhs[3] = {r[0], r[1], r[2]};
   if (n < 16.0 || imest__cm_chol_solve(a, r, 3u, dinv) != 0 || !(r[0] > 0.0)) {
-    f->slsig_h = NAN;
-    f->slsig_std = NAN;
-    f->rhf_ohm = NAN;
+    f->slsig_h = (double)NAN;
+    f->slsig_std = (double)NAN;
+    f->rhf_ohm = (double)NAN;
     return;
   }
   const double sse = s[CM_H_YY] - (r[0] * rhs[0] + r[1] * rhs[1] + r[2] * rhs[2]);
@@ -334,9 +334,9 @@ void imest__cm_fit_axis(imest_comm_t *c, uint32_t axis)
     f->td_s = x.beta[1] / ktd;
     f->td_std = sqrt(s2 * x.dinv[1]) / ktd;
     f->vth_v = 0.0;
-    f->vth_std = NAN;
+    f->vth_std = (double)NAN;
     f->dr_ohm = 0.0;
-    f->dr_std = NAN;
+    f->dr_std = (double)NAN;
   }
   f->tau_s = tau;
   f->tau_std = d2 > 0.0 ? tau * sqrt(2.0 * s2 / d2) : (double)NAN;

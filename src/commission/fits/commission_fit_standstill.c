@@ -82,8 +82,8 @@ void imest__cm_fit_standstill(imest_comm_t *c)
   set_value(&r->v_threshold_v, vthm, sqrt(vth_var) / 3.0 / fabs(vthm), vthsp);
   set_value(&r->dr_ohm, drm, sqrt(dr_var) / 3.0 / fabs(drm), drsp);
   const double ls_ss = slm + lmm;
-  set_value(&r->ls_standstill_h, ls_ss, NAN, (lmsp * lmm) / ls_ss);
-  set_value(&r->rr_ohm, lmm / taum, NAN, NAN);
+  set_value(&r->ls_standstill_h, ls_ss, (double)NAN, (lmsp * lmm) / ls_ss);
+  set_value(&r->rr_ohm, lmm / taum, (double)NAN, (double)NAN);
   r->dc_fit_rms_v = (float)sqrt(rms2 / 3.0);
 
   /* the inverter model (imest_inverter_t) */
@@ -126,8 +126,8 @@ void imest__cm_fit_standstill(imest_comm_t *c)
   c->tau = (float)taum;
   c->ls_ss = (float)ls_ss;
   if (!c->cfg.allow_rotation) {
-    set_value(&r->ls_h, ls_ss, NAN, NAN);
-    set_value(&r->sigma, slm / ls_ss, NAN, NAN);
+    set_value(&r->ls_h, ls_ss, (double)NAN, (double)NAN);
+    set_value(&r->sigma, slm / ls_ss, (double)NAN, (double)NAN);
     r->flags |= IMEST_COMM_FLAG_LS_STANDSTILL;
     c->final_ready = 1;
   }

@@ -119,7 +119,8 @@ def comparison(summary, table, base_dir):
         return []
     old = json.load(open(sj))
     olds = old["summary"]
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    # the top of the tree: this file is tools/studies/envelope/report.py
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
     shown = os.path.relpath(os.path.abspath(base_dir), root)
     L = [f"## Against `{shown}`\n",
          f"Earlier run: {old['meta']['form']} form, {old['meta']['points']} recordings, "

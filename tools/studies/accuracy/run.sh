@@ -2,10 +2,10 @@
 # Accuracy of imest-replay on the simulator's recordings of the paper's two
 # experiments, ideal and 12-bit sensors: per-window error of T_R and R_S
 # against the truth averaged over the same window, valid/invalid counts.
-# Usage: tools/accuracy/run.sh [BUILD_DIR] [EXP2_SECONDS]
+# Usage: tools/studies/accuracy/run.sh [BUILD_DIR] [EXP2_SECONDS]
 # Environment: REPLAY_ARGS = extra imest-replay options for every recording.
 set -euo pipefail
-top=$(cd "$(dirname "$0")/../.." && pwd)
+top=$(cd "$(dirname "$0")/../../.." && pwd)
 build=${1:-$top/build}
 dur2=${2:-120}
 sim=$build/bin/imest-sim

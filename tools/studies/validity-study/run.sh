@@ -4,13 +4,13 @@
 # every window with the simulator's truth and report how well the validity
 # rule separates good from bad windows. Results: README.md in this folder.
 #
-# usage: tools/validity-study/run.sh [BUILD_DIR] [OUT_DIR]
+# usage: tools/studies/validity-study/run.sh [BUILD_DIR] [OUT_DIR]
 #   BUILD_DIR  build with imest-sim and imest-replay (default: build-vs; built if missing)
 #   OUT_DIR    where the per-case results go (default: BUILD_DIR/validity-study)
 # Runs on 2 cores (JOBS=n to change); a few minutes. Needs /usr/bin/python3 + numpy.
 set -eu
 HERE=$(cd "$(dirname "$0")" && pwd)
-ROOT=$(cd "$HERE/../.." && pwd)
+ROOT=$(cd "$HERE/../../.." && pwd)
 B=${1:-$ROOT/build-vs}
 OUT=${2:-$B/validity-study}
 JOBS=${JOBS:-2}
