@@ -396,6 +396,18 @@ TEST(Verdict, WiringEncoderBackwardsSlipNearTwo)
   EXPECT_TR_REASON(judge(x), IMEST_REASON_WIRING_MISMATCH);
 }
 
+TEST(Verdict, WiringEncoderBackwardsAtLowFieldFrequency)
+{
+  // at 2.2 Hz the backwards encoder's slip (1.64) turns the current by less
+  // than 5 Hz in the rotor: only the slip > 1.25 rule sees it
+  Scene sc = paper_scene();
+  sc.f_hz = 2.2;
+  Win x = build(sc);
+  x.st.w_mean = -x.w_mech;
+  x.st.slip_rate = x.we + 2.0 * x.w_mech;
+  EXPECT_TR_REASON(judge(x), IMEST_REASON_WIRING_MISMATCH);
+}
+
 TEST(Verdict, WiringElectricalAngleForMechanicalSlipNearMinusOne)
 {
   Win x = build(paper_scene());
@@ -477,6 +489,22 @@ TEST(Verdict, ConstantsMismatchNoLoadLsLatched)
   EXPECT_VALID(judge(x1)); // without the no-load window the loaded one cannot tell
   x1.s = x0.s;
   EXPECT_TR_REASON(judge(x1), IMEST_REASON_CONSTANTS_MISMATCH);
+}
+
+TEST(Verdict, ConstantsMismatchNoLoadLsStaysLatched)
+{
+  // once L_S at no load disagreed, a later no-load window that agrees does not clear it
+  Scene sc = paper_scene();
+  sc.a = 0.05;
+  sc.m.ls = 1.10 * (double)sc.cfg.ls_h;
+  Win x0 = build(sc);
+  EXPECT_TR_REASON(judge(x0), IMEST_REASON_CONSTANTS_MISMATCH);
+  sc.m.ls = (double)sc.cfg.ls_h;
+  Win x1 = build(sc);
+  EXPECT_TR_REASON(judge(x1), IMEST_REASON_ZERO_SLIP);
+  x1.s = x0.s;
+  EXPECT_TR_REASON(judge(x1), IMEST_REASON_CONSTANTS_MISMATCH);
+  EXPECT_EQ(x1.s.ls_check, 2u);
 }
 
 TEST(Verdict, ConstantsMismatchNoLoadLsBoundaryIsSixPercent)
@@ -650,6 +678,43 @@ TEST(Verdict, RsOutOfRangeBoundaries)
 // ---------------------------------------------------------------------------
 // The error bounds
 // ---------------------------------------------------------------------------
+
+// An independent float64 replica of the bounds (docs/METHOD.md §18): Z and
+// dZ/dT_R of the equivalent circuit, the timing error tau (twice the stated),
+// the staircase eps (0.3 of it with the duty input), the voltage's error dv in
+// phase with the current (R_S) and the inverter's harmonics harm_v (T_R).
+struct Bounds {
+  double tr, rs;
+};
+Bounds expected_bounds(const Scene &sc, const Win &x, bool duty, double dv, double harm_v)
+{
+  const double ls = (double)sc.cfg.ls_h, sg = (double)sc.cfg.sigma, we = x.we, ws = x.ws;
+  const double tr = x.r.tr_s, rs = x.r.rs_ohm, a = ws * tr, den = 1.0 + a * a;
+  const double zr = rs + we * ls * a * (1.0 - sg) / den, zi = we * ls * (1.0 + sg * a * a) / den;
+  const double k = we * ls * ws * (1.0 - sg) / (den * den), dr = k * (1.0 - a * a), di = -2.0 * a * k;
+  const double tau = 2.0 * (double)sc.cfg.timing_uncertainty_s, t = 1.0 / (double)sc.cfg.fs_hz;
+  const double eps = (duty ? 0.3 : 1.0) * we * t * t / (12.0 * sg * ls);
+  const double i_pk = x.i_amp * std::sqrt(2.0 / 3.0);
+  const double dzr = we * tau * std::abs(zi) + 2.0 * eps * std::abs(zr * zi);
+  const double dzi =
+      we * tau * std::abs(zr) + eps * std::abs(zr * zr - zi * zi) + 0.5 * 4.0 / M_PI * harm_v / i_pk;
+  const double dt = dzi / std::abs(di);
+  return {dt / tr, (dzr + std::abs(dr) * dt + 4.0 / M_PI * dv / i_pk) / rs};
+}
+
+TEST(Verdict, BoundsFollowTheImpedanceModel)
+{
+  Scene sc = paper_scene();
+  for (double a : {0.3, 0.6, 1.5}) {
+    SCOPED_TRACE(a);
+    sc.a = a;
+    Win x = build(sc);
+    const imest_result_t r = judge(x);
+    const Bounds b = expected_bounds(sc, x, false, 0.0, 0.0);
+    EXPECT_NEAR(r.tr_bound_rel, b.tr, 1e-4 * b.tr);
+    EXPECT_NEAR(r.rs_bound_rel, b.rs, 1e-4 * b.rs);
+  }
+}
 
 TEST(Verdict, TrUncertainBoundaryIsTrTolerance)
 {
@@ -941,6 +1006,21 @@ TEST(VerdictDuty, RsBoundTakesTheModelsUncertainty)
   // the duty input's bound differs from the measured voltage's
   Win xm = build(s1);
   EXPECT_NE(judge(xm).rs_bound_rel, r1.rs_bound_rel);
+}
+
+TEST(VerdictDuty, BoundsFollowTheImpedanceModel)
+{
+  // R_S takes u e in phase, T_R the harmonics of max(u, 0.2) e
+  for (float u : {0.0f, 0.05f, 0.4f}) {
+    SCOPED_TRACE(u);
+    const Scene sc = duty_scene(u);
+    Win x = duty_window(sc);
+    const imest_result_t r = judge(x);
+    const double e = inverter_error(sc, x);
+    const Bounds b = expected_bounds(sc, x, true, (double)u * e, std::fmax((double)u, 0.2) * e);
+    EXPECT_NEAR(r.tr_bound_rel, b.tr, 1e-4 * b.tr);
+    EXPECT_NEAR(r.rs_bound_rel, b.rs, 1e-4 * b.rs);
+  }
 }
 
 TEST(VerdictDuty, RsUncertainBoundaryFromInverterUncertainty)
