@@ -275,7 +275,7 @@ typedef struct {
   /** uncertainty of the voltage/current alignment after pwm_timing and u_delay_s [s] (default 1e-6: an ADC sampling instant) */
   float timing_uncertainty_s;
   /** R_S at ambient temperature, from the data sheet or commissioning (0: unknown, default). A window
-   *  whose R_S lies outside what heating explains (0.7 .. 1.8 x this) is constants_mismatch */
+   *  whose R_S lies outside what heating explains (0.7 .. 1.9 x this) is constants_mismatch */
   float rs_nominal_ohm;
 
   /* Input plausibility (per sample, ISR). */
@@ -288,7 +288,8 @@ typedef struct {
   float speed_limit_rad_s;
 } imest_config_t;
 
-/** Fill a config with defaults (motor constants zero: the caller must set them). */
+/** Fill a config with defaults: every field is written (motor constants zero: the caller must
+ *  set them), so a config on the stack needs no initialiser. */
 void imest_config_default(imest_config_t *cfg);
 
 /** Check a config.

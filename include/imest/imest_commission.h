@@ -187,7 +187,8 @@ typedef struct {
   float ramp_s;     /**< frequency ramp time up and down [s] (default 2) */
 } imest_comm_config_t;
 
-/** Fill with defaults (fs 8 kHz, level 0.8, 300 s, standstill only; i_max_a must be set). */
+/** Fill with defaults (fs 8 kHz, level 0.8, 300 s, standstill only; i_max_a must be set); every
+ *  field is written. */
 void imest_comm_config_default(imest_comm_config_t *cc);
 
 /** Check a commissioning config.

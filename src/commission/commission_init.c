@@ -8,6 +8,9 @@
 void imest_comm_config_default(imest_comm_config_t *cc)
 {
   if (cc == NULL) return;
+  /* every field defined, those not named below 0 */
+  unsigned char *raw = (unsigned char *)cc;
+  for (size_t b = 0; b < sizeof *cc; ++b) raw[b] = 0u;
   cc->fs_hz = 8000.0f;
   cc->pwm_hz = 0.0f;
   cc->i_max_a = 0.0f; /* required */
