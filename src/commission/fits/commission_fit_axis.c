@@ -300,7 +300,7 @@ static double tau_passes(axis_ctx_t *x, double sl, const double d_p[CM_PLATEAUS]
 {
   const imest_comm_t *c = x->c;
   const double u0 = 0.0;
-  double u = u0, sse = 0.0, lm = 0.0;
+  double u = u0, sse = 0.0;
   for (int pass = 0; pass < 6; ++pass) {
     /* the first pass searches a factor e around the probe's tau, later ones close to the last */
     u = pass == 0 ? imest__cm_golden(axis_cost, x, u0 - 1.0, u0 + 1.0, 24u)
@@ -310,7 +310,7 @@ static double tau_passes(axis_ctx_t *x, double sl, const double d_p[CM_PLATEAUS]
     const double td = x->lumped ? 0.0 : x->beta[COL_TD];
     uint64_t skip = x->skip;
     const uint32_t clamped = skip_short_pulses(x, td, &skip);
-    lm = tail_lm(x, x->tau0 * exp(u), d_p, i_p);
+    const double lm = tail_lm(x, x->tau0 * exp(u), d_p, i_p);
     const double ishift =
         (!x->lumped && sl > 0.0) ? IMEST_SQRT2_3_LIT * (double)c->vdc0 * td / (2.0 * sl) : 0.0;
     const double dyn = lm > 0.0 ? lm * ishift : 0.0;
@@ -384,9 +384,7 @@ static int report_axis(axis_ctx_t *x, double u, double sse, const double d_p[CM_
 void imest__cm_fit_axis(imest_comm_t *c, uint32_t axis)
 {
   imest_comm_axis_fit_t *f = &c->fit[axis];
-  axis_ctx_t x;
-  x.c = c;
-  x.axis = axis;
+  axis_ctx_t x = {.c = c, .axis = axis}; /* the rest zero until set (the steps take x whole) */
   const uint32_t nb_job = c->job_nblk;
   x.nb = nb_job < (uint32_t)IMEST_COMM_NBLK ? nb_job : (uint32_t)IMEST_COMM_NBLK;
   double d_p[CM_PLATEAUS] = {0}, i_p[CM_PLATEAUS] = {0};
