@@ -212,42 +212,58 @@ static void fit_square_wave(imest_comm_t *c, uint32_t nb, imest_comm_axis_fit_t 
   f->rhf_ohm = -r[1] / r[0];
 }
 
-void imest__cm_fit_axis(imest_comm_t *c, uint32_t axis)
+/* The DC blocks' sums become means (the fits evaluate them many times); the buffer is the
+   background's until the job is done. */
+static void blocks_to_means(imest_comm_t *c, uint32_t nb)
 {
-  imest_comm_axis_fit_t *f = &c->fit[axis];
-  axis_ctx_t x;
-  x.c = c;
-  x.axis = axis;
-  const uint32_t nb_job = c->job_nblk;
-  x.nb = nb_job < (uint32_t)IMEST_COMM_NBLK ? nb_job : (uint32_t)IMEST_COMM_NBLK;
-  double d_p[CM_PLATEAUS] = {0}, i_p[CM_PLATEAUS] = {0}, w_p[CM_PLATEAUS] = {0};
-  int seen[CM_PLATEAUS] = {0};
-  /* the DC blocks' sums become means (the fits evaluate them many times); the buffer is the
-     background's until the job is done. (cppcheck 2.10 takes x.nb for < 1 here: it is the
-     job's block count, up to IMEST_COMM_NBLK.) */
+  /* (cppcheck 2.10 takes nb for < 1 here: it is the job's block count, up to IMEST_COMM_NBLK.) */
   // cppcheck-suppress knownConditionTrueFalse
-  for (uint32_t bi = 0; bi < x.nb; ++bi) {
+  for (uint32_t bi = 0; bi < nb; ++bi) {
     imest_comm_block_t *b = &c->blk[bi];
     if (!dc_block(b)) continue;
     const float inv = 1.0f / (float)b->n;
     for (int j = 0; j < IMEST_COMM_NSUM; ++j)
       if (j != CM_S_DELAY) b->s[j] *= inv;
   }
-  /* gains: zero sequence against the axis leg's current (weighted, with intercept) */
-  double gw = 0, gx = 0, gy = 0, gxx = 0, gxy = 0;
-  for (uint32_t bi = 0; bi < x.nb; ++bi) {
+}
+
+/* Each plateau's start sample (x->kp), current-step delay d_p and mean axis current i_p.
+   0, or -1 if a plateau has no DC block. */
+static int plateau_means(axis_ctx_t *x, double d_p[CM_PLATEAUS], double i_p[CM_PLATEAUS])
+{
+  const imest_comm_t *c = x->c;
+  double w_p[CM_PLATEAUS] = {0};
+  int seen[CM_PLATEAUS] = {0};
+  for (uint32_t bi = 0; bi < x->nb; ++bi) {
     const imest_comm_block_t *b = &c->blk[bi];
     if (!dc_block(b)) continue;
     const uint32_t p = CM_TAG_PLATEAU(b->tag);
     if (!seen[p]) {
       seen[p] = 1;
-      x.kp[p] = b->k0 - c->n_disc_level;
+      x->kp[p] = b->k0 - c->n_disc_level;
       d_p[p] = (double)b->s[CM_S_DELAY] - 0.5; /* left sum of the shortfall -> trapezoid */
     }
     const double w = (double)b->n;
-    i_p[p] += w * axis_current(b, axis);
+    i_p[p] += w * axis_current(b, x->axis);
     w_p[p] += w;
-    const double xm = (double)b->s[CM_S_MA + axis];
+  }
+  for (uint32_t p = 0; p < CM_PLATEAUS; ++p) {
+    if (!seen[p]) return -1;
+    i_p[p] /= w_p[p];
+  }
+  return 0;
+}
+
+/* gains: zero sequence against the axis leg's current (weighted, with intercept) */
+static double sensor_gain_dev(const axis_ctx_t *x)
+{
+  const imest_comm_t *c = x->c;
+  double gw = 0, gx = 0, gy = 0, gxx = 0, gxy = 0;
+  for (uint32_t bi = 0; bi < x->nb; ++bi) {
+    const imest_comm_block_t *b = &c->blk[bi];
+    if (!dc_block(b)) continue;
+    const double w = (double)b->n;
+    const double xm = (double)b->s[CM_S_MA + x->axis];
     const double z = (double)b->s[CM_S_MA] + (double)b->s[CM_S_MA + 1] + (double)b->s[CM_S_MA + 2];
     gw += w;
     gx += w * xm;
@@ -255,99 +271,145 @@ void imest__cm_fit_axis(imest_comm_t *c, uint32_t axis)
     gxx += w * xm * xm;
     gxy += w * xm * z;
   }
-  f->ok = 0;
-  for (uint32_t p = 0; p < CM_PLATEAUS; ++p) {
-    if (!seen[p]) {
-      c->bg_fail = IMEST_COMM_REASON_FIT;
-      return;
-    }
-    i_p[p] /= w_p[p];
-  }
   const double gdet = gw * gxx - gx * gx;
-  f->gain_dev = (c->cfg.n_sensors == 3u && gdet > 0.0) ? (gw * gxy - gx * gy) / gdet / 1.5 : 0.0;
+  return (c->cfg.n_sensors == 3u && gdet > 0.0) ? (gw * gxy - gx * gy) / gdet / 1.5 : 0.0;
+}
+
+/* Adds to skip the clamped blocks whose switching leg's pulse is shorter than 2.1 dead times;
+   returns how many clamped blocks remain. */
+static uint32_t skip_short_pulses(const axis_ctx_t *x, double td, uint64_t *skip)
+{
+  const imest_comm_t *c = x->c;
+  uint32_t clamped = 0u;
+  for (uint32_t bi = 0; bi < x->nb; ++bi) {
+    const imest_comm_block_t *b = &c->blk[bi];
+    if (!dc_block(b) || CM_TAG_PATTERN(b->tag) == CM_PAT_CENTRED) continue;
+    if ((double)b->s[CM_S_PULSE] < 2.1 * td * (double)c->fpwm) *skip |= (uint64_t)1u << bi;
+    if (!((*skip >> bi) & 1u)) clamped++;
+  }
+  return clamped;
+}
+
+/* tau by golden section on ln tau within a factor e of the probe's; then, in passes, the
+   clamped blocks whose switching leg's pulse is shorter than 2.1 dead times left out (a
+   pulse split at the sample instant, as double-update PWM units and the simulator do, is
+   partly eaten below 2 dead times) and the pulse-position correction updated. Returns u at
+   the minimum (tau = tau0 e^u) and its sse. */
+static double tau_passes(axis_ctx_t *x, double sl, const double d_p[CM_PLATEAUS],
+                         const double i_p[CM_PLATEAUS], double *sse_out)
+{
+  const imest_comm_t *c = x->c;
+  const double u0 = 0.0;
+  double u = u0, sse = 0.0;
+  for (int pass = 0; pass < 6; ++pass) {
+    /* the first pass searches a factor e around the probe's tau, later ones close to the last */
+    u = pass == 0 ? imest__cm_golden(axis_cost, x, u0 - 1.0, u0 + 1.0, 24u)
+                  : imest__cm_golden(axis_cost, x, u - 0.05, u + 0.05, 16u);
+    sse = axis_solve(x, x->tau0 * exp(u));
+    if (!x->ok) break;
+    const double td = x->lumped ? 0.0 : x->beta[COL_TD];
+    uint64_t skip = x->skip;
+    const uint32_t clamped = skip_short_pulses(x, td, &skip);
+    const double lm = tail_lm(x, x->tau0 * exp(u), d_p, i_p);
+    const double ishift =
+        (!x->lumped && sl > 0.0) ? IMEST_SQRT2_3_LIT * (double)c->vdc0 * td / (2.0 * sl) : 0.0;
+    const double dyn = lm > 0.0 ? lm * ishift : 0.0;
+    const int lumped = clamped == 0u;
+    const int settled = skip == x->skip && lumped == x->lumped &&
+                        fabs(ishift - x->ishift) <= 1e-3 * fabs(ishift) &&
+                        fabs(dyn - x->dyn) <= 1e-3 * fabs(dyn);
+    x->skip = skip;
+    x->lumped = lumped;
+    x->ishift = lumped ? 0.0 : ishift;
+    x->dyn = lumped ? 0.0 : dyn;
+    if (settled) break;
+  }
+  *sse_out = sse;
+  return u;
+}
+
+/* The inverter columns with their standard errors (s2: per-sample variance of the voltage). */
+static void report_inverter(const axis_ctx_t *x, double s2, imest_comm_axis_fit_t *f)
+{
+  const double ktd = (double)x->c->fpwm * (double)x->c->vdc0;
+  if (!x->lumped) {
+    f->td_s = x->beta[COL_TD];
+    f->td_std = sqrt(s2 * x->dinv[COL_TD]);
+    f->vth_v = x->beta[COL_VTH];
+    f->vth_std = sqrt(s2 * x->dinv[COL_VTH]);
+    f->dr_ohm = x->beta[COL_DR];
+    f->dr_std = sqrt(s2 * x->dinv[COL_DR]);
+  } else { /* all of it as dead time: it usually dominates, and scales with the bus */
+    f->td_s = x->beta[1] / ktd;
+    f->td_std = sqrt(s2 * x->dinv[1]) / ktd;
+    f->vth_v = 0.0;
+    f->vth_std = (double)NAN;
+    f->dr_ohm = 0.0;
+    f->dr_std = (double)NAN;
+  }
+}
+
+/* The axis's result at the minimum u (sse there): parameters, standard errors (tau's from the
+   cost's curvature), rms residual, L_m from the tails. 0, or -1 if the fit has no degrees of
+   freedom left. */
+static int report_axis(axis_ctx_t *x, double u, double sse, const double d_p[CM_PLATEAUS],
+                       const double i_p[CM_PLATEAUS], imest_comm_axis_fit_t *f)
+{
+  const imest_comm_t *c = x->c;
+  uint32_t n_dc = 0u;
+  for (uint32_t bi = 0; bi < x->nb; ++bi) n_dc += dc_used(x, bi) ? 1u : 0u;
+  if (!x->ok || n_dc <= x->npar) return -1;
+  const double h = 0.02;
+  const double d2 = (axis_cost(x, u + h) - 2.0 * sse + axis_cost(x, u - h)) / (h * h);
+  (void)axis_solve(x, x->tau0 * exp(u));            /* beta at the minimum again */
+  const double s2 = sse / (double)(n_dc - x->npar); /* per-sample variance of the voltage */
+  const double tau = x->tau0 * exp(u);
+  f->separable = !x->lumped;
+  f->r_ohm = x->beta[COL_R];
+  f->r_std = sqrt(s2 * x->dinv[COL_R]);
+  report_inverter(x, s2, f);
+  f->tau_s = tau;
+  f->tau_std = d2 > 0.0 ? tau * sqrt(2.0 * s2 / d2) : (double)NAN;
+  f->i_top_a = i_p[2];
+  {
+    double wsum = 0.0;
+    for (uint32_t bi = 0; bi < x->nb; ++bi)
+      if (dc_used(x, bi)) wsum += (double)c->blk[bi].n;
+    f->rms_v = wsum > 0.0 ? sqrt(sse / wsum) : (double)NAN;
+  }
+  f->lm_h = tail_lm(x, tau, d_p, i_p);
+  return 0;
+}
+
+void imest__cm_fit_axis(imest_comm_t *c, uint32_t axis)
+{
+  imest_comm_axis_fit_t *f = &c->fit[axis];
+  axis_ctx_t x = {.c = c, .axis = axis}; /* the rest zero until set (the steps take x whole) */
+  const uint32_t nb_job = c->job_nblk;
+  x.nb = nb_job < (uint32_t)IMEST_COMM_NBLK ? nb_job : (uint32_t)IMEST_COMM_NBLK;
+  double d_p[CM_PLATEAUS] = {0}, i_p[CM_PLATEAUS] = {0};
+  blocks_to_means(c, x.nb);
+  f->ok = 0;
+  if (plateau_means(&x, d_p, i_p) != 0) {
+    c->bg_fail = IMEST_COMM_REASON_FIT;
+    return;
+  }
+  f->gain_dev = sensor_gain_dev(&x);
   fit_square_wave(c, x.nb, f);
 
-  /* tau by golden section on ln tau within a factor e of the probe's; then, in passes, the
-     clamped blocks whose switching leg's pulse is shorter than 2.1 dead times left out (a
-     pulse split at the sample instant, as double-update PWM units and the simulator do, is
-     partly eaten below 2 dead times) and the pulse-position correction updated. */
   x.tau0 = (double)(c->tau > 0.0f ? c->tau : 0.1f);
-  const double u0 = 0.0;
   const double sl = f->slsig_h > 0.0 ? f->slsig_h : (double)c->sl_rough;
   x.skip = 0u;
   x.lumped = 0;
   x.shifted = c->cfg.pwm_on_centred ? CM_PAT_LOW : CM_PAT_HIGH;
   x.ishift = 0.0;
   x.dyn = 0.0;
-  double u = u0, sse = 0.0, lm = 0.0;
-  for (int pass = 0; pass < 6; ++pass) {
-    /* the first pass searches a factor e around the probe's tau, later ones close to the last */
-    u = pass == 0 ? imest__cm_golden(axis_cost, &x, u0 - 1.0, u0 + 1.0, 24u)
-                  : imest__cm_golden(axis_cost, &x, u - 0.05, u + 0.05, 16u);
-    sse = axis_solve(&x, x.tau0 * exp(u));
-    if (!x.ok) break;
-    const double td = x.lumped ? 0.0 : x.beta[COL_TD];
-    uint64_t skip = x.skip;
-    uint32_t clamped = 0u;
-    for (uint32_t bi = 0; bi < x.nb; ++bi) {
-      const imest_comm_block_t *b = &c->blk[bi];
-      if (!dc_block(b) || CM_TAG_PATTERN(b->tag) == CM_PAT_CENTRED) continue;
-      if ((double)b->s[CM_S_PULSE] < 2.1 * td * (double)c->fpwm) skip |= (uint64_t)1u << bi;
-      if (!((skip >> bi) & 1u)) clamped++;
-    }
-    lm = tail_lm(&x, x.tau0 * exp(u), d_p, i_p);
-    const double ishift =
-        (!x.lumped && sl > 0.0) ? IMEST_SQRT2_3_LIT * (double)c->vdc0 * td / (2.0 * sl) : 0.0;
-    const double dyn = lm > 0.0 ? lm * ishift : 0.0;
-    const int lumped = clamped == 0u;
-    const int settled = skip == x.skip && lumped == x.lumped &&
-                        fabs(ishift - x.ishift) <= 1e-3 * fabs(ishift) &&
-                        fabs(dyn - x.dyn) <= 1e-3 * fabs(dyn);
-    x.skip = skip;
-    x.lumped = lumped;
-    x.ishift = lumped ? 0.0 : ishift;
-    x.dyn = lumped ? 0.0 : dyn;
-    if (settled) break;
-  }
-  uint32_t n_dc = 0u;
-  for (uint32_t bi = 0; bi < x.nb; ++bi) n_dc += dc_used(&x, bi) ? 1u : 0u;
-  if (!x.ok || n_dc <= x.npar) {
+  double sse;
+  const double u = tau_passes(&x, sl, d_p, i_p, &sse);
+  if (report_axis(&x, u, sse, d_p, i_p, f) != 0) {
     c->bg_fail = IMEST_COMM_REASON_FIT;
     return;
   }
-  const double h = 0.02;
-  const double d2 = (axis_cost(&x, u + h) - 2.0 * sse + axis_cost(&x, u - h)) / (h * h);
-  (void)axis_solve(&x, x.tau0 * exp(u));           /* beta at the minimum again */
-  const double s2 = sse / (double)(n_dc - x.npar); /* per-sample variance of the voltage */
-  const double tau = x.tau0 * exp(u), ktd = (double)c->fpwm * (double)c->vdc0;
-  f->separable = !x.lumped;
-  f->r_ohm = x.beta[COL_R];
-  f->r_std = sqrt(s2 * x.dinv[COL_R]);
-  if (!x.lumped) {
-    f->td_s = x.beta[COL_TD];
-    f->td_std = sqrt(s2 * x.dinv[COL_TD]);
-    f->vth_v = x.beta[COL_VTH];
-    f->vth_std = sqrt(s2 * x.dinv[COL_VTH]);
-    f->dr_ohm = x.beta[COL_DR];
-    f->dr_std = sqrt(s2 * x.dinv[COL_DR]);
-  } else { /* all of it as dead time: it usually dominates, and scales with the bus */
-    f->td_s = x.beta[1] / ktd;
-    f->td_std = sqrt(s2 * x.dinv[1]) / ktd;
-    f->vth_v = 0.0;
-    f->vth_std = (double)NAN;
-    f->dr_ohm = 0.0;
-    f->dr_std = (double)NAN;
-  }
-  f->tau_s = tau;
-  f->tau_std = d2 > 0.0 ? tau * sqrt(2.0 * s2 / d2) : (double)NAN;
-  f->i_top_a = i_p[2];
-  {
-    double wsum = 0.0;
-    for (uint32_t bi = 0; bi < x.nb; ++bi)
-      if (dc_used(&x, bi)) wsum += (double)c->blk[bi].n;
-    f->rms_v = wsum > 0.0 ? sqrt(sse / wsum) : (double)NAN;
-  }
-  f->lm_h = tail_lm(&x, tau, d_p, i_p);
   f->ok = 1;
   if (f->slsig_h > 0.0) c->bg_sl = (float)f->slsig_h;
 }

@@ -28,26 +28,41 @@ static void set_value(imest_comm_value_t *out, double value, double std_rel, dou
   out->spread_rel = (float)spread;
 }
 
-void imest__cm_fit_standstill(imest_comm_t *c)
+/* The three axes' values (gain corrected): means, spreads, and the sums of the per-axis
+   variances. */
+typedef struct {
+  double rm, rsp, slm, slsp, taum, tausp, lmm, lmsp, tdm, tdsp, vthm, vthsp, drm, drsp;
+  double r_var, sl_var, td_var, vth_var, dr_var, tau_var, rms2;
+} axes_t;
+
+/* Sensor gains relative to their mean (three sensors only), and the correction factor each
+   axis's values take for its sensor. */
+static void sensor_gains(imest_comm_t *c, double corr[3])
 {
   imest_comm_result_t *r = &c->res;
   const imest_comm_axis_fit_t *f = c->fit;
-  double dev[3] = {0, 0, 0}, corr[3] = {1, 1, 1};
-  if (c->cfg.n_sensors == 3u) {
-    const double mean = (f[0].gain_dev + f[1].gain_dev + f[2].gain_dev) / 3.0;
-    double worst = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      dev[k] = f[k].gain_dev - mean;
-      corr[k] = 1.0 + 0.5 * dev[k];
-      r->i_gain_rel[k] = (float)(1.0 + dev[k]);
-      c->bg_ginv[k] = (float)(1.0 / (1.0 + dev[k]));
-      if (fabs(dev[k]) > worst) worst = fabs(dev[k]);
-    }
-    r->flags |= IMEST_COMM_FLAG_GAINS;
-    if (worst > 0.005) r->flags |= IMEST_COMM_FLAG_GAIN_MISMATCH;
+  double dev[3] = {0, 0, 0};
+  if (c->cfg.n_sensors != 3u) return;
+  const double mean = (f[0].gain_dev + f[1].gain_dev + f[2].gain_dev) / 3.0;
+  double worst = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    dev[k] = f[k].gain_dev - mean;
+    corr[k] = 1.0 + 0.5 * dev[k];
+    r->i_gain_rel[k] = (float)(1.0 + dev[k]);
+    c->bg_ginv[k] = (float)(1.0 / (1.0 + dev[k]));
+    if (fabs(dev[k]) > worst) worst = fabs(dev[k]);
   }
+  r->flags |= IMEST_COMM_FLAG_GAINS;
+  if (worst > 0.005) r->flags |= IMEST_COMM_FLAG_GAIN_MISMATCH;
+}
+
+/* Every per-axis value corrected for its sensor's gain, then means and spreads. */
+static void combine_axes(imest_comm_t *c, const double corr[3], axes_t *a)
+{
+  imest_comm_result_t *r = &c->res;
+  const imest_comm_axis_fit_t *f = c->fit;
   double rk[3], slk[3], tauk[3], lmk[3], tdk[3], vthk[3], drk[3];
-  double r_var = 0.0, sl_var = 0.0, td_var = 0.0, vth_var = 0.0, dr_var = 0.0, tau_var = 0.0, rms2 = 0.0;
+  a->r_var = a->sl_var = a->td_var = a->vth_var = a->dr_var = a->tau_var = a->rms2 = 0.0;
   for (int k = 0; k < 3; ++k) {
     rk[k] = f[k].r_ohm * corr[k];
     slk[k] = f[k].slsig_h * corr[k];
@@ -56,39 +71,49 @@ void imest__cm_fit_standstill(imest_comm_t *c)
     tdk[k] = f[k].td_s;
     vthk[k] = f[k].vth_v;
     drk[k] = f[k].dr_ohm * corr[k];
-    r_var += f[k].r_std * f[k].r_std;
-    sl_var += (f[k].slsig_std * f[k].slsig_h) * (f[k].slsig_std * f[k].slsig_h);
-    td_var += f[k].td_std * f[k].td_std;
-    vth_var += f[k].vth_std * f[k].vth_std;
-    dr_var += f[k].dr_std * f[k].dr_std;
-    tau_var += f[k].tau_std * f[k].tau_std;
-    rms2 += f[k].rms_v * f[k].rms_v;
+    a->r_var += f[k].r_std * f[k].r_std;
+    a->sl_var += (f[k].slsig_std * f[k].slsig_h) * (f[k].slsig_std * f[k].slsig_h);
+    a->td_var += f[k].td_std * f[k].td_std;
+    a->vth_var += f[k].vth_std * f[k].vth_std;
+    a->dr_var += f[k].dr_std * f[k].dr_std;
+    a->tau_var += f[k].tau_std * f[k].tau_std;
+    a->rms2 += f[k].rms_v * f[k].rms_v;
     r->rs_axis_ohm[k] = (float)(rk[k] - (double)c->cfg.r_series_ohm);
   }
-  double rm, rsp, slm, slsp, taum, tausp, lmm, lmsp, tdm, tdsp, vthm, vthsp, drm, drsp;
-  mean_spread(rk, &rm, &rsp);
-  mean_spread(slk, &slm, &slsp);
-  mean_spread(tauk, &taum, &tausp);
-  mean_spread(lmk, &lmm, &lmsp);
-  mean_spread(tdk, &tdm, &tdsp);
-  mean_spread(vthk, &vthm, &vthsp);
-  mean_spread(drk, &drm, &drsp);
-  const double rs = rm - 0.5 * fabs(drm) - (double)c->cfg.r_series_ohm;
-  for (int k = 0; k < 3; ++k) r->rs_axis_ohm[k] -= (float)(0.5 * fabs(drm));
-  set_value(&r->rs_ohm, rs, sqrt(r_var) / 3.0 / rs, rsp * rm / rs);
-  set_value(&r->sigma_ls_h, slm, sqrt(sl_var) / 3.0 / slm, slsp);
-  set_value(&r->tr_s, taum, sqrt(tau_var) / 3.0 / taum, tausp);
-  set_value(&r->dead_time_s, tdm, sqrt(td_var) / 3.0 / fabs(tdm), tdsp);
-  set_value(&r->v_threshold_v, vthm, sqrt(vth_var) / 3.0 / fabs(vthm), vthsp);
-  set_value(&r->dr_ohm, drm, sqrt(dr_var) / 3.0 / fabs(drm), drsp);
-  const double ls_ss = slm + lmm;
-  set_value(&r->ls_standstill_h, ls_ss, (double)NAN, (lmsp * lmm) / ls_ss);
-  set_value(&r->rr_ohm, lmm / taum, (double)NAN, (double)NAN);
-  r->dc_fit_rms_v = (float)sqrt(rms2 / 3.0);
+  mean_spread(rk, &a->rm, &a->rsp);
+  mean_spread(slk, &a->slm, &a->slsp);
+  mean_spread(tauk, &a->taum, &a->tausp);
+  mean_spread(lmk, &a->lmm, &a->lmsp);
+  mean_spread(tdk, &a->tdm, &a->tdsp);
+  mean_spread(vthk, &a->vthm, &a->vthsp);
+  mean_spread(drk, &a->drm, &a->drsp);
+}
 
-  /* the inverter model (imest_inverter_t) */
+/* The standstill values with their qualities; returns R_S. */
+static double report_values(imest_comm_t *c, const axes_t *a)
+{
+  imest_comm_result_t *r = &c->res;
+  const double rs = a->rm - 0.5 * fabs(a->drm) - (double)c->cfg.r_series_ohm;
+  for (int k = 0; k < 3; ++k) r->rs_axis_ohm[k] -= (float)(0.5 * fabs(a->drm));
+  set_value(&r->rs_ohm, rs, sqrt(a->r_var) / 3.0 / rs, a->rsp * a->rm / rs);
+  set_value(&r->sigma_ls_h, a->slm, sqrt(a->sl_var) / 3.0 / a->slm, a->slsp);
+  set_value(&r->tr_s, a->taum, sqrt(a->tau_var) / 3.0 / a->taum, a->tausp);
+  set_value(&r->dead_time_s, a->tdm, sqrt(a->td_var) / 3.0 / fabs(a->tdm), a->tdsp);
+  set_value(&r->v_threshold_v, a->vthm, sqrt(a->vth_var) / 3.0 / fabs(a->vthm), a->vthsp);
+  set_value(&r->dr_ohm, a->drm, sqrt(a->dr_var) / 3.0 / fabs(a->drm), a->drsp);
+  const double ls_ss = a->slm + a->lmm;
+  set_value(&r->ls_standstill_h, ls_ss, (double)NAN, (a->lmsp * a->lmm) / ls_ss);
+  set_value(&r->rr_ohm, a->lmm / a->taum, (double)NAN, (double)NAN);
+  r->dc_fit_rms_v = (float)sqrt(a->rms2 / 3.0);
+  return rs;
+}
+
+/* the inverter model (imest_inverter_t) */
+static void inverter_model(imest_comm_t *c, const axes_t *a)
+{
   const double vdc = (double)c->vdc0, fpwm = (double)c->fpwm;
-  imest_inverter_t *inv = &r->inverter;
+  const double tdm = a->tdm, vthm = a->vthm, drm = a->drm, slm = a->slm;
+  imest_inverter_t *inv = &c->res.inverter;
   inv->dead_time_s = (float)tdm;
   inv->v_switch_v = (float)vthm;
   inv->v_diode_v = (float)vthm;
@@ -99,36 +124,57 @@ void imest__cm_fit_standstill(imest_comm_t *c)
     /* relative uncertainty of the model's error: the fit (3 sigma), the spread between axes,
        and 0.1 V for the switch/diode threshold difference standstill cannot see */
     const double e_typ = fabs(tdm) * fpwm * vdc + fabs(vthm);
-    const double e_td = (3.0 * sqrt(td_var) / 3.0 + 0.5 * fabs(tdsp * tdm)) * fpwm * vdc;
-    const double e_v = 3.0 * sqrt(vth_var) / 3.0 + 0.5 * fabs(vthsp * vthm) + 0.1;
+    const double e_td = (3.0 * sqrt(a->td_var) / 3.0 + 0.5 * fabs(a->tdsp * tdm)) * fpwm * vdc;
+    const double e_v = 3.0 * sqrt(a->vth_var) / 3.0 + 0.5 * fabs(a->vthsp * vthm) + 0.1;
     double u = e_typ > 0.0 ? sqrt(e_td * e_td + e_v * e_v) / e_typ : 1.0;
     if (u < 0.02) u = 0.02;
     inv->uncertainty = (float)u;
   }
-  if (rsp > 0.03 || slsp > 0.03) r->flags |= IMEST_COMM_FLAG_AXIS_SPREAD;
+}
+
+/* for the rotating part: the loop's resistance and the inverter feed-forward; without it, L_S
+   and sigma from standstill and the result is ready */
+static void prepare_rotation(imest_comm_t *c, const axes_t *a, double rs)
+{
+  imest_comm_result_t *r = &c->res;
+  const imest_inverter_t *inv = &r->inverter;
+  const double ls_ss = a->slm + a->lmm;
+  c->rs_ff = (float)(rs + (double)c->cfg.r_series_ohm);
+  c->inv_td_f = (float)(a->tdm * (double)c->fpwm);
+  c->inv_v = (float)a->vthm;
+  c->inv_rsw = inv->r_switch_ohm;
+  c->inv_rd = inv->r_diode_ohm;
+  c->inv_band = inv->i_band_a > 0.0f ? inv->i_band_a : 1e-3f;
+  c->tau = (float)a->taum;
+  c->ls_ss = (float)ls_ss;
+  if (!c->cfg.allow_rotation) {
+    set_value(&r->ls_h, ls_ss, (double)NAN, (double)NAN);
+    set_value(&r->sigma, a->slm / ls_ss, (double)NAN, (double)NAN);
+    r->flags |= IMEST_COMM_FLAG_LS_STANDSTILL;
+    c->final_ready = 1;
+  }
+}
+
+void imest__cm_fit_standstill(imest_comm_t *c)
+{
+  imest_comm_result_t *r = &c->res;
+  const imest_comm_axis_fit_t *f = c->fit;
+  double corr[3] = {1, 1, 1};
+  axes_t a;
+  sensor_gains(c, corr);
+  combine_axes(c, corr, &a);
+  const double rs = report_values(c, &a);
+  inverter_model(c, &a);
+  if (a.rsp > 0.03 || a.slsp > 0.03) r->flags |= IMEST_COMM_FLAG_AXIS_SPREAD;
   if (!f[0].separable || !f[1].separable || !f[2].separable) r->flags |= IMEST_COMM_FLAG_INVERTER_LUMPED;
   r->flags |= IMEST_COMM_FLAG_STANDSTILL;
 
   /* plausibility */
-  const int ok = rs > 0.0 && rs < 1e3 && slm > 0.0 && slm < 10.0 && taum > 1e-3 && taum < 30.0 &&
-                 tdm > -0.5e-6 && tdm < 20e-6 && vthm > -0.5 && vthm < 5.0 && lmm > 0.0;
+  const int ok = rs > 0.0 && rs < 1e3 && a.slm > 0.0 && a.slm < 10.0 && a.taum > 1e-3 && a.taum < 30.0 &&
+                 a.tdm > -0.5e-6 && a.tdm < 20e-6 && a.vthm > -0.5 && a.vthm < 5.0 && a.lmm > 0.0;
   if (!ok) {
     c->bg_fail = IMEST_COMM_REASON_IMPLAUSIBLE;
     return;
   }
-  /* for the rotating part: the loop's resistance and the inverter feed-forward */
-  c->rs_ff = (float)(rs + (double)c->cfg.r_series_ohm);
-  c->inv_td_f = (float)(tdm * fpwm);
-  c->inv_v = (float)vthm;
-  c->inv_rsw = inv->r_switch_ohm;
-  c->inv_rd = inv->r_diode_ohm;
-  c->inv_band = inv->i_band_a > 0.0f ? inv->i_band_a : 1e-3f;
-  c->tau = (float)taum;
-  c->ls_ss = (float)ls_ss;
-  if (!c->cfg.allow_rotation) {
-    set_value(&r->ls_h, ls_ss, (double)NAN, (double)NAN);
-    set_value(&r->sigma, slm / ls_ss, (double)NAN, (double)NAN);
-    r->flags |= IMEST_COMM_FLAG_LS_STANDSTILL;
-    c->final_ready = 1;
-  }
+  prepare_rotation(c, &a, rs);
 }

@@ -86,71 +86,61 @@ void imest__cm_stage_wiring(imest_comm_t *c, const float m[3], float vdc)
   imest__cm_command(c, CM_PAT_CENTRED, u, vdc);
 }
 
-/* Background: which channel reads which leg. The true response of a pulse on axis k is
-   c_k (1 on leg k, -1/2 on the others); channel ch reads sign_ch x leg perm(ch). Every one of the
-   6 x 8 assignments is scored by its correlation with the measured 3 x 3 response; the best must
-   explain it (relative residual < 0.25) and be the identity with positive signs. */
-void imest__cm_fit_wiring(imest_comm_t *c)
+static const unsigned int k_perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+
+/* The response channel ch should show to a pulse on axis k under assignment (perm p, signs
+   sgn): +-1 on the channel reading leg k, -+1/2 on the others. */
+static double expected(int p, int sgn, int k, int ch)
 {
-  static const unsigned int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  double norm2 = 0.0, amax = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    double a = 0.0;
-    for (int x = 0; x < 3; ++x) {
-      norm2 += (double)c->pulse_resp[k][x] * (double)c->pulse_resp[k][x];
-      a += fabs((double)c->pulse_resp[k][x]);
-    }
-    if (a > amax) amax = a;
-  }
-  c->bg_fail = 0;
-  /* an axis that draws (almost) nothing: a leg or phase is open */
-  for (int k = 0; k < 3; ++k) {
-    double a = 0.0;
-    for (int x = 0; x < 3; ++x) a += fabs((double)c->pulse_resp[k][x]);
-    if (!(a > 0.1 * amax) || !(amax > 0.0)) c->bg_fail = IMEST_COMM_REASON_OPEN_PHASE;
-  }
+  return (k_perms[p][ch] == (unsigned int)k ? 1.0 : -0.5) * ((sgn >> ch) & 1 ? -1.0 : 1.0);
+}
+
+/* Sum of |response| over the channels for a pulse on axis k. */
+static double response_abs(const imest_comm_t *c, int k)
+{
+  double a = 0.0;
+  for (int x = 0; x < 3; ++x) a += fabs((double)c->pulse_resp[k][x]);
+  return a;
+}
+
+/* The assignment whose expected response correlates best with the measured one. */
+static void best_assignment(const imest_comm_t *c, int *best_p, int *best_s)
+{
   double best = -1.0;
-  int best_p = 0, best_s = 0;
+  *best_p = 0;
+  *best_s = 0;
   for (int p = 0; p < 6; ++p)
     for (int sgn = 0; sgn < 8; ++sgn) {
       double dot = 0.0;
       for (int k = 0; k < 3; ++k)
-        for (int ch = 0; ch < 3; ++ch) {
-          const double e = perms[p][ch] == (unsigned int)k ? 1.0 : -0.5;
-          const double s = (sgn >> ch) & 1 ? -1.0 : 1.0;
-          dot += s * e * (double)c->pulse_resp[k][ch];
-        }
+        for (int ch = 0; ch < 3; ++ch) dot += expected(p, sgn, k, ch) * (double)c->pulse_resp[k][ch];
       if (dot > best) {
         best = dot;
-        best_p = p;
-        best_s = sgn;
+        *best_p = p;
+        *best_s = sgn;
       }
     }
-  /* residual of the best assignment with one amplitude per axis */
+}
+
+/* residual of the assignment with one amplitude per axis (sum of squares) */
+static double assignment_residual(const imest_comm_t *c, int p, int sgn)
+{
   double res2 = 0.0;
   for (int k = 0; k < 3; ++k) {
     double num = 0.0;
-    for (int ch = 0; ch < 3; ++ch) {
-      const double e =
-          (perms[best_p][ch] == (unsigned int)k ? 1.0 : -0.5) * ((best_s >> ch) & 1 ? -1.0 : 1.0);
-      num += e * (double)c->pulse_resp[k][ch];
-    }
+    for (int ch = 0; ch < 3; ++ch) num += expected(p, sgn, k, ch) * (double)c->pulse_resp[k][ch];
     const double amp = num / 1.5; /* |e|^2 = 1.5 */
     for (int ch = 0; ch < 3; ++ch) {
-      const double e =
-          (perms[best_p][ch] == (unsigned int)k ? 1.0 : -0.5) * ((best_s >> ch) & 1 ? -1.0 : 1.0);
-      const double r = (double)c->pulse_resp[k][ch] - amp * e;
+      const double r = (double)c->pulse_resp[k][ch] - amp * expected(p, sgn, k, ch);
       res2 += r * r;
     }
   }
-  for (int ch = 0; ch < 3; ++ch) {
-    /* wiring_map[leg] = (channel + 1) * sign */
-    const unsigned int leg = perms[best_p][ch];
-    c->res.wiring_map[leg] = (ch + 1) * ((best_s >> ch) & 1 ? -1 : 1);
-  }
-  if (c->bg_fail == 0 && (best_p != 0 || best_s != 0)) c->bg_fail = IMEST_COMM_REASON_WIRING;
-  if (c->bg_fail == 0 && !(res2 < 0.0625 * norm2)) c->bg_fail = IMEST_COMM_REASON_OPEN_PHASE;
-  /* rough sigma*L_S: volt-seconds of the + half over the current it drove, median of three */
+  return res2;
+}
+
+/* rough sigma*L_S: volt-seconds of the + half over the current it drove, median of three */
+static double rough_sigma_ls(const imest_comm_t *c)
+{
   double sl[3];
   for (int k = 0; k < 3; ++k) {
     const double di = fabs((double)c->pulse_ik[k]);
@@ -159,6 +149,44 @@ void imest__cm_fit_wiring(imest_comm_t *c)
   double med = sl[0];
   if ((sl[1] - sl[0]) * (sl[1] - sl[2]) <= 0.0) med = sl[1];
   if ((sl[2] - sl[0]) * (sl[2] - sl[1]) <= 0.0) med = sl[2];
+  return med;
+}
+
+/* an axis that draws (almost) nothing (below a tenth of the largest): a leg or phase is open */
+static int axis_open(const imest_comm_t *c)
+{
+  double amax = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double a = response_abs(c, k);
+    if (a > amax) amax = a;
+  }
+  int open = 0;
+  for (int k = 0; k < 3; ++k)
+    if (!(response_abs(c, k) > 0.1 * amax) || !(amax > 0.0)) open = 1;
+  return open;
+}
+
+/* Background: which channel reads which leg. The true response of a pulse on axis k is
+   c_k (1 on leg k, -1/2 on the others); channel ch reads sign_ch x leg perm(ch). Every one of the
+   6 x 8 assignments is scored by its correlation with the measured 3 x 3 response; the best must
+   explain it (relative residual < 0.25) and be the identity with positive signs. */
+void imest__cm_fit_wiring(imest_comm_t *c)
+{
+  double norm2 = 0.0;
+  for (int k = 0; k < 3; ++k)
+    for (int x = 0; x < 3; ++x) norm2 += (double)c->pulse_resp[k][x] * (double)c->pulse_resp[k][x];
+  c->bg_fail = axis_open(c) ? IMEST_COMM_REASON_OPEN_PHASE : 0;
+  int best_p, best_s;
+  best_assignment(c, &best_p, &best_s);
+  const double res2 = assignment_residual(c, best_p, best_s);
+  for (int ch = 0; ch < 3; ++ch) {
+    /* wiring_map[leg] = (channel + 1) * sign */
+    const unsigned int leg = k_perms[best_p][ch];
+    c->res.wiring_map[leg] = (ch + 1) * ((best_s >> ch) & 1 ? -1 : 1);
+  }
+  if (c->bg_fail == 0 && (best_p != 0 || best_s != 0)) c->bg_fail = IMEST_COMM_REASON_WIRING;
+  if (c->bg_fail == 0 && !(res2 < 0.0625 * norm2)) c->bg_fail = IMEST_COMM_REASON_OPEN_PHASE;
+  const double med = rough_sigma_ls(c);
   if (c->bg_fail == 0 && !(med > 0.0 && med < 10.0)) c->bg_fail = IMEST_COMM_REASON_IMPLAUSIBLE;
   c->bg_sl = (float)med;
 }

@@ -156,10 +156,11 @@ static int finite_f(float x)
   return (x == x) && imest__abs(x) <= 3.0e38f;
 }
 
-int imest_comm_isr(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float theta_rad, float duty_abc[3])
+/* The run's start (first call), whether it runs, abort, input faults, the time limit. 1 if this
+   sample is to be processed. (static inline, as the helpers below: one call each, inlined into
+   the ISR entry.) */
+static inline int sample_admitted(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float theta_rad)
 {
-  if (c == NULL || i_abc_a == NULL || duty_abc == NULL) return IMEST_ERR_NULL;
-  duty_abc[0] = duty_abc[1] = duty_abc[2] = 0.5f;
   if (c->state == IMEST_COMM_IDLE) {
     c->state = IMEST_COMM_RUNNING;
     c->th0 = c->th_prev = theta_rad;
@@ -179,8 +180,13 @@ int imest_comm_isr(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float t
     imest__cm_fail(c, IMEST_COMM_REASON_TIMEOUT);
     return 0;
   }
-  /* currents: offsets off (once known), relative gains corrected (once known) */
-  float m[3];
+  return 1;
+}
+
+/* currents: offsets off (once known), relative gains corrected (once known); the peak and the
+   bus checked. 1 if within limits. */
+static inline int currents(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float m[3])
+{
   for (int x = 0; x < 3; ++x) {
     m[x] = (i_abc_a[x] - c->off[x]) * c->ginv[x];
     const float a = imest__abs(m[x]);
@@ -194,33 +200,32 @@ int imest_comm_isr(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float t
     imest__cm_fail(c, IMEST_COMM_REASON_INPUT_FAULT);
     return 0;
   }
-  /* encoder: wraps counted, so wrapped and unwrapped angles both work */
-  {
-    const float d = theta_rad - c->th_prev;
-    if (d > IMEST_PI_F) c->wraps--;
-    if (d < -IMEST_PI_F) c->wraps++;
-    c->th_prev = theta_rad;
-    if (c->stage < IMEST_COMM_STAGE_ROTATE) {
-      const float moved = imest__abs(theta_rad - c->th0 + IMEST_2PI_F * (float)c->wraps);
-      if (moved > c->th_dev) c->th_dev = moved;
-      if (moved > 1.0f) { /* a sixth of a turn: the rotor is driven, not creeping */
-        imest__cm_fail(c, IMEST_COMM_REASON_ROTOR_MOVED);
-        return 0;
-      }
+  return 1;
+}
+
+/* encoder: wraps counted, so wrapped and unwrapped angles both work. 0 if the rotor moved at
+   standstill. */
+static inline int track_encoder(imest_comm_t *c, float theta_rad)
+{
+  const float d = theta_rad - c->th_prev;
+  if (d > IMEST_PI_F) c->wraps--;
+  if (d < -IMEST_PI_F) c->wraps++;
+  c->th_prev = theta_rad;
+  if (c->stage < IMEST_COMM_STAGE_ROTATE) {
+    const float moved = imest__abs(theta_rad - c->th0 + IMEST_2PI_F * (float)c->wraps);
+    if (moved > c->th_dev) c->th_dev = moved;
+    if (moved > 1.0f) { /* a sixth of a turn: the rotor is driven, not creeping */
+      imest__cm_fail(c, IMEST_COMM_REASON_ROTOR_MOVED);
+      return 0;
     }
   }
-  /* the duty pipeline: what was returned last call applies from now on */
-  for (int x = 0; x < 3; ++x) c->d_app[x] = c->d_next[x];
-  const float v_ended = c->v_app; /* axis voltage of the period that just ended */
-  c->v_app = axis_voltage(c->axis, c->d_app, vdc_v);
+  return 1;
+}
 
-  /* alpha/beta and the axis frame */
-  const float ia = IMEST_SQRT2_3_F * (m[0] - 0.5f * (m[1] + m[2]));
-  const float ib = IMEST_SQRT2_3_F * IMEST_HALF_SQRT3_F * (m[1] - m[2]);
-  static const float cs[3][2] = {{1.0f, 0.0f}, {-0.5f, IMEST_HALF_SQRT3_F}, {-0.5f, -IMEST_HALF_SQRT3_F}};
-  const float cn = cs[c->axis][0], sn = cs[c->axis][1];
-  const float i_n = ia * cn + ib * sn;
-
+/* The present stage's sample (each sets c->d_next). */
+static inline void run_stage(imest_comm_t *c, const float i_abc_a[3], const float m[3], float vdc_v,
+                             float i_n, float v_ended)
+{
   switch (c->stage) {
   case IMEST_COMM_STAGE_OFFSETS: imest__cm_stage_offsets(c, i_abc_a, vdc_v); break;
   case IMEST_COMM_STAGE_WIRING: imest__cm_stage_wiring(c, m, vdc_v); break;
@@ -235,6 +240,29 @@ int imest_comm_isr(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float t
     if (c->state == IMEST_COMM_RUNNING) c->state = IMEST_COMM_COMPUTING;
     break;
   }
+}
+
+int imest_comm_isr(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float theta_rad, float duty_abc[3])
+{
+  if (c == NULL || i_abc_a == NULL || duty_abc == NULL) return IMEST_ERR_NULL;
+  duty_abc[0] = duty_abc[1] = duty_abc[2] = 0.5f;
+  if (!sample_admitted(c, i_abc_a, vdc_v, theta_rad)) return 0;
+  float m[3];
+  if (!currents(c, i_abc_a, vdc_v, m)) return 0;
+  if (!track_encoder(c, theta_rad)) return 0;
+  /* the duty pipeline: what was returned last call applies from now on */
+  for (int x = 0; x < 3; ++x) c->d_app[x] = c->d_next[x];
+  const float v_ended = c->v_app; /* axis voltage of the period that just ended */
+  c->v_app = axis_voltage(c->axis, c->d_app, vdc_v);
+
+  /* alpha/beta and the axis frame */
+  const float ia = IMEST_SQRT2_3_F * (m[0] - 0.5f * (m[1] + m[2]));
+  const float ib = IMEST_SQRT2_3_F * IMEST_HALF_SQRT3_F * (m[1] - m[2]);
+  static const float cs[3][2] = {{1.0f, 0.0f}, {-0.5f, IMEST_HALF_SQRT3_F}, {-0.5f, -IMEST_HALF_SQRT3_F}};
+  const float cn = cs[c->axis][0], sn = cs[c->axis][1];
+  const float i_n = ia * cn + ib * sn;
+
+  run_stage(c, i_abc_a, m, vdc_v, i_n, v_ended);
   c->i_prev = i_n;
   if (c->state != IMEST_COMM_RUNNING) return 0;
   duty_abc[0] = c->d_next[0];

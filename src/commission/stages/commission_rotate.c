@@ -75,17 +75,14 @@ static float leg_error(const imest_comm_t *c, float i, float d, float vdc)
   return s * (c->inv_td_f * vdc + c->inv_v + c->inv_rd * ai + dc * (c->inv_rsw - c->inv_rd) * ai);
 }
 
-void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
+/* The run's steps (magnetise, ramp, settle, measure, down, stop): their counters and
+   transitions. 1 if the sample is done (the duties set or the run stopped), 0 if the field
+   control runs. (static inline, as the helpers below: one call each, inlined into the stage.) */
+static inline int rotate_steps(imest_comm_t *c, int limited, float ia, float vdc)
 {
-  const float ts = c->ts_s;
-  c->cnt++;
-  const float i_hi = 0.9f * c->cfg.i_max_a;
-  const int limited = imest__abs(m[0]) > i_hi || imest__abs(m[1]) > i_hi || imest__abs(m[2]) > i_hi;
-  float ia, ib;
-  imest__clarke(m, &ia, &ib);
   switch (c->step) {
   case CM_ROT_MAGNETISE: {
-    if (imest__cm_current_loop(c, CM_PAT_CENTRED, c->i_ref - ia, vdc) != 0) return;
+    if (imest__cm_current_loop(c, CM_PAT_CENTRED, c->i_ref - ia, vdc) != 0) return 1;
     if (c->cnt >= c->n_settle) {
       /* the field frame starts on the a axis: the integrators continue from the DC loop */
       c->step = CM_ROT_RAMP;
@@ -93,14 +90,14 @@ void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
       c->integ[0] = c->integ[CM_PAT_CENTRED] - c->rs_ff * c->i_ref;
       c->integ[1] = 0.0f;
     }
-    return;
+    return 1;
   }
   case CM_ROT_RAMP:
     if (limited) {
       c->cnt--; /* hold the frequency while the current is high */
       if (++c->lim_cnt > (uint32_t)c->cfg.fs_hz) {
         imest__cm_fail(c, IMEST_COMM_REASON_CURRENT_LIMIT_ROTATING);
-        return;
+        return 1;
       }
     }
     c->we = c->we_test * (float)c->cnt / (float)c->n_ramp;
@@ -131,49 +128,50 @@ void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
   default:
     c->d_next[0] = c->d_next[1] = c->d_next[2] = 0.5f;
     if (c->cnt >= c->n_zero) imest__cm_finish(c);
-    return;
+    return 1;
   }
-  if (limited && c->step == CM_ROT_MEASURE) c->rot_sum[CM_R_LIM] += 1.0f;
+  return 0;
+}
 
-  /* field angle: rotate the unit phasor, renormalise to first order */
+/* field angle: rotate the unit phasor, renormalise to first order */
+static inline void advance_field(imest_comm_t *c, float ts)
+{
   float co, si;
   cs_small(c->we * ts, &co, &si);
   const float pc = c->ph_c * co - c->ph_s * si, ps = c->ph_s * co + c->ph_c * si;
   const float g = 1.5f - 0.5f * (pc * pc + ps * ps);
   c->ph_c = pc * g;
   c->ph_s = ps * g;
+}
 
-  /* current in the field frame, its control (the rated magnetising current on d; ramping down,
-     the current follows the frequency to zero) */
-  const float id = ia * c->ph_c + ib * c->ph_s, iq = -ia * c->ph_s + ib * c->ph_c;
-  const float ref = c->step == CM_ROT_DOWN ? c->i_ref * (1.0f - (float)c->cnt / (float)c->n_ramp) : c->i_ref;
-  const float ed = ref - id, eq = -iq;
-  const float fd = c->rs_ff * ref, fq = c->we * c->ls_ss * ref;
-  c->integ[0] += c->ki * ed;
-  c->integ[1] += c->ki * eq;
-  const float ud = fd + c->integ[0] + c->kp * ed, uq = fq + c->integ[1] + c->kp * eq;
-
-  if (c->step == CM_ROT_MEASURE) {
-    float *r = c->rot_sum;
-    r[CM_R_ID] += id;
-    r[CM_R_IQ] += iq;
-    r[CM_R_ND] += ia * c->ph_c - ib * c->ph_s;
-    r[CM_R_NQ] += ia * c->ph_s + ib * c->ph_c;
-    r[CM_R_UD] += ud;
-    r[CM_R_UQ] += uq;
-    r[CM_R_I2] += ia * ia + ib * ib;
-    r[CM_R_N] += 1.0f;
-    if (c->cnt >= c->n_meas) {
-      c->rot_th1 = c->th_prev;
-      c->rot_wraps = c->wraps - c->rot_w0;
-      r[CM_R_WE] = c->we;
-      imest__cm_post(c, CM_JOB_ROTATION, 0u);
-      c->step = CM_ROT_DOWN;
-      c->cnt = 0u;
-    }
+/* The measuring step's sums (current, negative sequence, voltage); at its end the encoder's
+   travel, and the job for the background. */
+static inline void measure(imest_comm_t *c, float ia, float ib, float id, float iq, float ud, float uq)
+{
+  float *r = c->rot_sum;
+  r[CM_R_ID] += id;
+  r[CM_R_IQ] += iq;
+  r[CM_R_ND] += ia * c->ph_c - ib * c->ph_s;
+  r[CM_R_NQ] += ia * c->ph_s + ib * c->ph_c;
+  r[CM_R_UD] += ud;
+  r[CM_R_UQ] += uq;
+  r[CM_R_I2] += ia * ia + ib * ib;
+  r[CM_R_N] += 1.0f;
+  if (c->cnt >= c->n_meas) {
+    c->rot_th1 = c->th_prev;
+    c->rot_wraps = c->wraps - c->rot_w0;
+    r[CM_R_WE] = c->we;
+    imest__cm_post(c, CM_JOB_ROTATION, 0u);
+    c->step = CM_ROT_DOWN;
+    c->cnt = 0u;
   }
+}
 
-  /* the voltage for the period after the next sample, at that period's centre angle */
+/* the voltage (field frame ud, uq) for the period after the next sample, at that period's
+   centre angle: min-max zero sequence, the inverter model added per leg, into c->d_next */
+static inline void modulate(imest_comm_t *c, float ia, float ib, float ud, float uq, float vdc, float ts)
+{
+  float co, si;
   cs_small(1.5f * c->we * ts, &co, &si);
   const float c2 = c->ph_c * co - c->ph_s * si, s2 = c->ph_s * co + c->ph_c * si;
   const float ua = ud * c2 - uq * s2, ub = ud * s2 + uq * c2;
@@ -200,4 +198,30 @@ void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
     d += leg_error(c, ip[x], d, vdc) * inv;
     c->d_next[x] = d < 0.0f ? 0.0f : (d > 1.0f ? 1.0f : d);
   }
+}
+
+void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
+{
+  const float ts = c->ts_s;
+  c->cnt++;
+  const float i_hi = 0.9f * c->cfg.i_max_a;
+  const int limited = imest__abs(m[0]) > i_hi || imest__abs(m[1]) > i_hi || imest__abs(m[2]) > i_hi;
+  float ia, ib;
+  imest__clarke(m, &ia, &ib);
+  if (rotate_steps(c, limited, ia, vdc)) return;
+  if (limited && c->step == CM_ROT_MEASURE) c->rot_sum[CM_R_LIM] += 1.0f;
+  advance_field(c, ts);
+
+  /* current in the field frame, its control (the rated magnetising current on d; ramping down,
+     the current follows the frequency to zero) */
+  const float id = ia * c->ph_c + ib * c->ph_s, iq = -ia * c->ph_s + ib * c->ph_c;
+  const float ref = c->step == CM_ROT_DOWN ? c->i_ref * (1.0f - (float)c->cnt / (float)c->n_ramp) : c->i_ref;
+  const float ed = ref - id, eq = -iq;
+  const float fd = c->rs_ff * ref, fq = c->we * c->ls_ss * ref;
+  c->integ[0] += c->ki * ed;
+  c->integ[1] += c->ki * eq;
+  const float ud = fd + c->integ[0] + c->kp * ed, uq = fq + c->integ[1] + c->kp * eq;
+
+  if (c->step == CM_ROT_MEASURE) measure(c, ia, ib, id, iq, ud, uq);
+  modulate(c, ia, ib, ud, uq, vdc, ts);
 }
