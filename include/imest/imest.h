@@ -48,10 +48,11 @@
  * indices are those of the minimised cost.
  *
  * Concurrency contract (ISR <-> background):
- *   - imest_isr_abc()/imest_isr_ab() are called from exactly one context (the
- *     sampling ISR); imest_background() from exactly one other context of
- *     lower priority (or the same one, e.g. in a host replay loop). Neither
- *     blocks nor waits for the other. No locks, no disabling of interrupts.
+ *   - imest_isr_abc()/imest_isr_ab()/imest_isr_duty()/imest_isr_flush() are
+ *     called from exactly one context (the sampling ISR); imest_background()
+ *     from exactly one other context of lower priority (or the same one, e.g.
+ *     in a host replay loop). Neither blocks nor waits for the other. No
+ *     locks, no disabling of interrupts.
  *   - Two window buffers: the ISR fills one while the background owns the
  *     other. When a window completes, the ISR hands its buffer over only if the
  *     background has released the previous one; otherwise the finished window
@@ -60,10 +61,22 @@
  *     A window is never torn: the background reads a buffer only after the ISR
  *     published it, and the ISR writes it again only after the background
  *     released it.
+ *   - The background reads nothing of the ISR's live state: what it judges a
+ *     window by (the input kind, the bus voltage, the offsets) travels in the
+ *     window, as it was at the window's end. Its one word back to the ISR
+ *     (engage the angle observer) travels in the buffer it releases, and the
+ *     ISR takes it when it refills that buffer: a window's decision applies
+ *     from the window after next, whenever the background ran. So the
+ *     results do not depend on when the background runs (as long as no window
+ *     is dropped), and a host replay reproduces the firmware exactly.
  *   - Publication uses one index written only by the ISR and one written only
- *     by the background, with a compiler barrier (IMEST_BARRIER). On a single
- *     core Cortex-M that is sufficient; on a multi-core or cached system define
- *     IMEST_BARRIER to a full memory barrier (e.g. __DMB()).
+ *     by the background, stored with release and loaded with acquire ordering
+ *     (GCC/Clang atomics: one DMB each at a window's end on a Cortex-M), which
+ *     holds on single- and multi-core, cached or not. With other compilers the
+ *     indices are volatile words ordered by IMEST_BARRIER (a compiler barrier
+ *     by default): on a multi-core or cached system define IMEST_BARRIER to a
+ *     full memory barrier (e.g. __DMB()). test/concurrency runs the two
+ *     contexts on two threads under ThreadSanitizer.
  *   - imest_init() must not run concurrently with either call.
  *
  * Numerics: the ISR path is float32 only (builds with -Wdouble-promotion
