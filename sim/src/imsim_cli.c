@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-sim: writes a simulated induction-motor record as CSV. A thin layer on the imsim API:
  * parse (flags -> imsim_config_t) and run (simulate, write rows, progress). */
 #define _POSIX_C_SOURCE 200809L

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-sim command line (internal to sim/ and test/sim/). */
 #ifndef IMSIM_CLI_H
 #define IMSIM_CLI_H

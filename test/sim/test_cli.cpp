@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // imest-sim command line: flag parsing, errors, CSV header and first row.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-commission: the library's self-commissioning routine run closed loop on the simulator
  * for a drive preset; prints what it identified against the simulator's truth, with the errors,
  * the time and the peak current of the routine, per stage.

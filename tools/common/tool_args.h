@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Command lines the same way in every host tool: "--opt value" and
  * "--opt=value", "-" as a file name (stdin), "--" ends the options, and one
  * exit-code convention. Host tool code (stdio). */

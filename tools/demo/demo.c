@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-demo: the paper's experiments end to end, with the library in the loop
  * exactly as a drive firmware runs it.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-monitor: decode imest CAN telemetry live from a SocketCAN interface or
  * from a candump -L log, print a table or CSV, and report lost, repeated,
  * late and corrupted frames, estimator overruns and sender restarts (each on
