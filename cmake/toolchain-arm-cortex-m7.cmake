@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Cross toolchain: arm-none-eabi, Cortex-M7 with double-precision FPU (FPv5-D16,
 # hard-float ABI).
 #   cmake --preset m7      (or -DCMAKE_TOOLCHAIN_FILE=cmake/toolchain-arm-cortex-m7.cmake)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Common part of the arm-none-eabi toolchain files (included by
 # toolchain-arm-cortex-m4f.cmake and toolchain-arm-cortex-m7.cmake, which set
 # IMEST_ARM_CPU_FLAGS first). Bare metal: no OS, no malloc, no stdio.

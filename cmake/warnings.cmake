@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # imest_warnings(target): the project's warning wall for C targets.
 set(IMEST_C_WARNINGS -Wall -Wextra -Wconversion -Wsign-conversion -Wdouble-promotion
     -Wshadow -Wcast-align -Wstrict-prototypes -Wmissing-prototypes -Wundef -Wswitch-enum)

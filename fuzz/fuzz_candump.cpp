@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Fuzz the candump -L line parser (port/candump): every line of the input.
 // Property (test/robustness/parser_property.h): a known return code, errors
 // with a message, parsed frames valid and round-tripping through the formatter.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Fuzz the CSV reader of imest-replay (tools/replay/csv_reader.c): the input
 // is the whole file. Property (test/robustness/parser_property.h): errors name
 // the file and, for content errors, the line; rows are finite; it stops.

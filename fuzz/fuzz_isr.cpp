@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Fuzz the whole public path: imest_isr_abc / imest_isr_ab with arbitrary
 // floats for a few windows, imest_background after every sample. Most samples
 // are a clean rotating field (so that windows reach the solve); a selector

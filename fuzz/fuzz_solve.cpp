@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Fuzz the background solve (internal imest__bg_solve) with arbitrary window sums:
 // the input bytes are the 73 doubles of R_W, R_Wy, R_y (NaN, Inf, huge,
 // denormal ...), optionally followed by the 5 doubles of the solve config.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Shared by the fuzz targets: reading typed values from the input, failing
 // loudly (abort: libFuzzer saves the input as a crash file).
 #pragma once

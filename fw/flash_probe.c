@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Flash probe: links every public function of the core a firmware calls,
  * and the CAN publisher (the telemetry a drive sends; the reader is host
  * code). Built twice, with and without the library calls (FW_FLASH_BASELINE);

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Host program: recorded samples for the firmware harness.
  *
  * Simulates the paper's induction motor (n_p = 2, L_S = L_R = 0.2908 H,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Firmware harness for the self-commissioning routine (include/imest/imest_commission.h): the
  * routine runs its whole sequence closed loop against a small motor model on the target, and
  * each of its calls is bracketed by the marker functions so that the icount plugin counts it

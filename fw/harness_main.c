@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Firmware harness: feeds recorded samples through imest_isr_abc() and
  * completes every background solve with imest_background(), bracketing each
  * call with marker functions so that the icount TCG plugin can count the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Marker functions: each is a single "bx lr" at its own address. The counting
  * plugin opens a channel when fw_mark_bN executes and closes it at fw_mark_eN. */
   .syntax unified

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Measurement helpers shared by the firmware harnesses (harness_measure.h). */
 #include "harness_measure.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Measurement helpers shared by the firmware harnesses (harness_main.c, harness_commission.c):
  * call statistics, SysTick, and a painted stack for one call's high-water mark. Harness code
  * (not counted by the plugin). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Minimal ARM semihosting: SYS_WRITE0 for output, SYS_EXIT to stop QEMU. */
 #include "harness_semihost.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Minimal ARM semihosting for the firmware harness (QEMU -semihosting). */
 #ifndef FW_HARNESS_SEMIHOST_H
 #define FW_HARNESS_SEMIHOST_H

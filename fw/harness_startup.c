@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Startup of the firmware harness: vector table, .data/.bss init, FPU enable
  * (CPACR), stack painting (to measure the stack high-water mark), main, exit
  * through semihosting. */

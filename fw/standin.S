@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Stand-in with a known instruction count, to validate the counting method:
  * fw_standin(n), n >= 1, executes exactly 3 + 3 n instructions (including its
  * bx lr) and returns n (n + 1) / 2. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * icount: a QEMU TCG plugin (QEMU 7.2 plugin API, version 1) that counts the
  * guest instructions executed between marker functions of the firmware

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file imest.h
  * @brief imest: online rotor time constant (T_R) and stator resistance (R_S)

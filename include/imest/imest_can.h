@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file imest_can.h
  * @brief CAN telemetry of imest: signal table, frame codec, publisher and reader.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file imest_commission.h
  * @brief imest self-commissioning: identifies, on the drive and before normal

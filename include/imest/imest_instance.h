@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file imest_instance.h
  * The estimator instance's layout: public only so that the caller can

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file imest_version.h
  * The library's version: the one place it is written (CMakeLists.txt reads it).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Firmware CAN port: forwards each frame to the HAL transmit hook. */
 #include "imest_can_callback.h"
 

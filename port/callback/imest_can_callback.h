@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file imest_can_callback.h
  * @brief Firmware CAN port: adapts imest's frames to a HAL transmit function.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* candump -L log lines: format, parse, and a port writing them to a FILE*. */
 #include "imest_candump.h"
 

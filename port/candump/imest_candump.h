@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file imest_candump.h
  * @brief Host library: write and parse `candump -L` log lines, and a CAN port

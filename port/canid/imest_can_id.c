@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* One parser for CAN base identifiers on command lines (see the header). */
 #include "imest_can_id.h"
 

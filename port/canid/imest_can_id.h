@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file imest_can_id.h
  * @brief Host tools: one parser for the CAN base identifier given on a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* SocketCAN (Linux CAN_RAW) port. */
 #define _GNU_SOURCE 1
 #include "imest_socketcan.h"

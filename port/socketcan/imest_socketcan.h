@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /**
  * @file imest_socketcan.h
  * @brief Host library (Linux): a CAN port on a SocketCAN CAN_RAW socket.

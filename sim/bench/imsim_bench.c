@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imsim-bench: motor-seconds simulated per CPU-second of this process (one core; CPU time so
  * that a busy machine does not distort the figure).
  * Default case: exp2, PWM inverter (10 kHz, event-exact), 12-bit sensors with noise, 4 kHz.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Configuration: defaults (the paper's motor), the paper's experiments, and the dispatch to the
  * industrial motor presets (motors.c). */
 #include <string.h>

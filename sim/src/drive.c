@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Firmware timing (sim/README.md, Firmware timing): the drive samples once every N carrier
  * periods, at a carrier valley t_k; from that sample it computes the duties that the PWM unit
  * loads at the next valley, t_k+1, and applies during [t_k+1, t_k+2). The duties come from

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Indirect field-oriented control: run once per sample from the measured currents and the
  * encoder angle, slip from the controller's T_R (which the estimator may update). */
 #include "imsim_internal.h"

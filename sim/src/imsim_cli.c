@@ -1,7 +1,10 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-sim: writes a simulated induction-motor record as CSV. A thin layer on the imsim API:
  * parse (flags -> imsim_config_t) and run (simulate, write rows, progress). */
 #define _POSIX_C_SOURCE 200809L
 #include "imsim_cli.h"
+
+#include "tool_args.h"
 
 #include <errno.h>
 #include <math.h>
@@ -43,7 +46,8 @@ static const char USAGE[] =
     "  --out FILE            output file, '-' = stdout (-)\n"
     "  --decimate N          write every N-th sample (1)\n"
     "  --progress, --no-progress   bar on stderr (default: when stderr is a terminal)\n"
-    "  --help                this text\n"
+    "  -h, --help            this text\n"
+    "  --version             the version and licence\n"
     "motor (default: the paper's motor; resistances cold, at --t-amb):\n"
     "  --pole-pairs N (2)  --ls H (0.2908)  --lr H (0.2908)  --sigma X (0.096)\n"
     "  --rs OHM (5.04)  --tr S (0.12)  --j KGM2 (1.2e-3)  --b NMS (1e-4, viscous friction)\n"
@@ -97,8 +101,8 @@ static const char USAGE[] =
     "  --integrator fast|rk4 (fast; rk4 = slow reference)  --rk4-substeps N (8)\n"
     "  --steps-per-sample N  steps per sample for the ideal supplies (0 = auto: 5; PWM: fixed)\n"
     "\n"
-    "Exit status: 0 done (a warning on stderr says when the PWM modulation was clipped),\n"
-    "1 the output cannot be written, 2 a bad flag or an impossible configuration.\n";
+    "Exit status: 0 done (a warning on stderr says when the PWM modulation was clipped);\n"
+    "1 the output cannot be written; 2 a bad flag or value, or an impossible configuration.\n";
 
 /* ---- parse ------------------------------------------------------------------------------ */
 
@@ -262,9 +266,9 @@ static void *field(imsim_config_t *c, size_t off)
 }
 
 /* Flags without a value, and the valued flags handled one by one in parse_valued. */
-static const char *const SWITCH_FLAGS[] = {
-    "--help",     "--ideal-sensors", "--no-thermal",  "--ifoc-ideal-stage",
-    "--progress", "--no-progress",   "--pwm-segments"};
+static const char *const SWITCH_FLAGS[] = {"--help",        "--version",          "--ideal-sensors",
+                                           "--no-thermal",  "--ifoc-ideal-stage", "--progress",
+                                           "--no-progress", "--pwm-segments"};
 static const char *const OTHER_FLAGS[] = {"--preset", "--out", "--decimate", "--seed"};
 
 size_t imsim_cli_flags(const char **names, size_t max)
@@ -295,6 +299,8 @@ static int parse_switch(const char *name, imsim_config_t *c, imsim_cli_opts_t *o
 {
   if (strcmp(name, "--help") == 0)
     o->help = 1;
+  else if (strcmp(name, "--version") == 0)
+    o->version = 1;
   else if (strcmp(name, "--ideal-sensors") == 0)
     c->ideal_sensors = true;
   else if (strcmp(name, "--no-thermal") == 0)
@@ -393,6 +399,29 @@ static int parse_valued(const char *name, const char *val, imsim_config_t *c, im
   return 1;
 }
 
+/* Whether name is a flag that takes a value (so that an unknown flag is not read as one missing
+   its value). */
+static int is_valued(const char *name)
+{
+  for (size_t k = 0; k < COUNT(OTHER_FLAGS); ++k)
+    if (strcmp(name, OTHER_FLAGS[k]) == 0) return 1;
+  for (size_t k = 0; k < COUNT(PHASE_FLAGS); ++k)
+    if (strcmp(name, PHASE_FLAGS[k].flag) == 0) return 1;
+  for (size_t k = 0; k < COUNT(CHOICE_FLAGS); ++k)
+    if (strcmp(name, CHOICE_FLAGS[k].flag) == 0) return 1;
+  for (size_t k = 0; k < COUNT(REAL_FLAGS); ++k)
+    if (strcmp(name, REAL_FLAGS[k].flag) == 0) return 1;
+  for (size_t k = 0; k < COUNT(INT_FLAGS); ++k)
+    if (strcmp(name, INT_FLAGS[k].flag) == 0) return 1;
+  return 0;
+}
+
+static int unknown(char *err, size_t n, const char *name)
+{
+  snprintf(err, n, "unknown option '%s'", name);
+  return -1;
+}
+
 /* Pass 1: the preset, wherever it stands, so that every other flag overrides it. */
 static int parse_preset(int argc, char **argv, imsim_config_t *c, char *err, size_t errlen)
 {
@@ -420,16 +449,24 @@ int imsim_cli_parse(int argc, char **argv, imsim_config_t *c, imsim_cli_opts_t *
   o->decimate = 1;
   o->progress = -1;
   o->help = 0;
+  o->version = 0;
   err[0] = '\0';
   if (parse_preset(argc, argv, c, err, errlen) != 0) return -1;
   /* pass 2: every flag, in order (--opt value or --opt=value) */
   for (int a = 1; a < argc; ++a) {
     char name[64];
     const char *arg = argv[a];
-    if (strncmp(arg, "--", 2) != 0) return perr(err, errlen, "unexpected argument: ", arg);
+    if (strcmp(arg, "-h") == 0) {
+      o->help = 1;
+      continue;
+    }
+    if (strncmp(arg, "--", 2) != 0) {
+      if (arg[0] == '-' && arg[1] != '\0') return unknown(err, errlen, arg);
+      return perr(err, errlen, "unexpected argument: ", arg);
+    }
     const char *eq = strchr(arg, '=');
     const size_t len = eq != NULL ? (size_t)(eq - arg) : strlen(arg);
-    if (len >= sizeof name) return perr(err, errlen, "unknown flag: ", arg);
+    if (len >= sizeof name) return unknown(err, errlen, arg);
     memcpy(name, arg, len);
     name[len] = '\0';
     const char *val = eq != NULL ? eq + 1 : NULL;
@@ -437,13 +474,14 @@ int imsim_cli_parse(int argc, char **argv, imsim_config_t *c, imsim_cli_opts_t *
       if (eq != NULL) return perr(err, errlen, "flag takes no value: ", name);
       continue;
     }
+    if (!is_valued(name)) return unknown(err, errlen, name);
     if (val == NULL) {
       if (a + 1 >= argc) return perr(err, errlen, "missing value for ", name);
       val = argv[++a];
     }
     const int r = parse_valued(name, val, c, o, err, errlen);
     if (r < 0) return -1;
-    if (r > 0) return perr(err, errlen, "unknown flag: ", name);
+    if (r > 0) return unknown(err, errlen, name);
   }
   return 0;
 }
@@ -572,12 +610,16 @@ int imsim_cli_main(int argc, char **argv)
   imsim_cli_opts_t o;
   char err[256];
   if (imsim_cli_parse(argc, argv, &c, &o, err, sizeof err) != 0) {
-    fprintf(stderr, "imest-sim: %s\n(try --help)\n", err);
-    return 2;
+    fprintf(stderr, "imest-sim: %s\nTry 'imest-sim --help'.\n", err);
+    return TOOL_EXIT_USAGE;
   }
   if (o.help) {
     fputs(USAGE, stdout);
-    return 0;
+    return TOOL_EXIT_OK;
+  }
+  if (o.version) {
+    tool_version("imest-sim");
+    return TOOL_EXIT_OK;
   }
   return run(&c, &o);
 }

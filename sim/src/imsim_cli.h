@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-sim command line (internal to sim/ and test/sim/). */
 #ifndef IMSIM_CLI_H
 #define IMSIM_CLI_H
@@ -15,7 +16,8 @@ typedef struct {
   const char *out; /* "-" = stdout */
   long decimate;   /* write every n-th sample (1 = all) */
   int progress;    /* -1 auto (isatty(stderr)), 0 off, 1 on */
-  int help;
+  int help;        /* -h, --help */
+  int version;     /* --version */
 } imsim_cli_opts_t;
 
 /* The CSV header line (no newline). */
@@ -28,7 +30,8 @@ const char *imsim_cli_usage(void);
 size_t imsim_cli_flags(const char **names, size_t max);
 
 /* Parses argv into c (preset applied first, then the other flags in order) and o.
-   Returns 0, or -1 with a message in err. */
+   Returns 0, or -1 with a message in err (a flag the parser does not know: "unknown option
+   '--x'"). */
 int imsim_cli_parse(int argc, char **argv, imsim_config_t *c, imsim_cli_opts_t *o, char *err, size_t errlen);
 
 /* Writes one CSV row (with newline). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imsim_t internals shared by the simulator's source files (not installed, not API).
  * One file per concern: config.c (defaults, exp presets), motors.c (drive presets),
  * transform.c, rng.c, thermal.c, load.c, supply.c (V/f reference), taylor.c (exact

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* One integration step of length h_s: the fast path (exact electrical propagation with a
  * predicted mean speed, Hermite mechanics; PWM by moments or piecewise) or the RK4 reference. */
 #include <stddef.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Load torque: 0 before load_on_s, linear ramp over load_ramp_s, then load_nm (opposing
  * positive rotation); imsim_set_load() overrides it. */
 #include "imsim_internal.h"

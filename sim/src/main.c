@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-sim entry point; everything is in imsim_cli.c. */
 #include "imsim_cli.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Industrial drive presets: 400 V, 50 Hz, 4-pole induction motors with public equivalent-circuit
  * data, each on the drive a user would put around it (sim/README.md, Presets).
  *

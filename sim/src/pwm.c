@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* PWM inverter, one half carrier period at a time: reference -> modulation -> edges (dead
  * time) -> leg voltages (device drops) -> the input moments of the fast path, or the voltage
  * on each piece between edges for the piecewise and RK4 paths.

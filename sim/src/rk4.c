@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Reference integrator: classic RK4 of the full nonlinear model (electrical and mechanical
  * states together), one constant-input piece at a time. Slow; used to measure the fast path. */
 #include "imsim_internal.h"

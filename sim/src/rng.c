@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Random numbers for the sensor noise: xoshiro256** seeded by splitmix64, Gaussian by the
  * polar method. Reproducible for a given seed. */
 #include "imsim_internal.h"

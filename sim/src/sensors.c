@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Sensors: ADCs (bits, range, clipping, seeded noise, offsets, gain errors), the optional
  * analog AA filter (its states are integrated with the motor), the encoder, and the sample
  * record with its truth columns. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Simulator set-up (validation, initial state) and the per-sample step. */
 #include <stdio.h>
 #include <string.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Phasor steady state of eq. (1) under a balanced sinusoidal supply: the operating point of
  * --start steady, the IFOC rated flux, and the presets' checks. */
 #include "imsim_internal.h"

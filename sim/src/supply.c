@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Reference of the open-loop supplies (sine, V/f; also the PWM inverter's reference). */
 #include "imsim_internal.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Fast propagator: x(h) = sum_k A^k [h^k/k! x0 + m_k B] by Horner, A frozen over the step:
  * the exact (to a Taylor tolerance) solution of the linear electrical part of eq. (1). */
 #include "imsim_internal.h"

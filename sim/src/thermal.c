@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Thermal drift of R_S and R_R: R(T) = R_cold (1 + alpha (T - T_amb)), each body a first-order
  * model driven by its own copper loss (see sim/README.md, Thermal drift). */
 #include "imsim_internal.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Power-invariant 3-2 transform (docs/METHOD.md §1). */
 #include "imsim_internal.h"
 

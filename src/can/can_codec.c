@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* CAN telemetry codec: the signal table (can_signals.c) turned into frames
  * and back, the CRC, and the identifier rules.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* CAN telemetry publisher: caller-owned, fed by the application with each
  * result imest_background() returns (the estimator itself knows nothing of
  * CAN). Packs the window's frames and hands each once to the port; a refusal

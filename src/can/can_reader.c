@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* CAN telemetry reader: assembles windows from frames and tells lost,
  * repeated, late and corrupted frames, estimator overruns and sender restarts
  * apart.

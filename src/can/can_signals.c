@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The CAN telemetry layout: one line per signal. Packing, decoding and the
  * saturation bits all read this table (can_codec.c); tools/imest.dbc names
  * the same signals for CAN tools, and test/can/test_dbc.py proves the two

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning, background call: runs the job the ISR handed over (one at a time: the ISR posts
  * the next only when this one is done), then, once the ISR has stopped commanding, completes the
  * result's state. The ISR never writes the state after COMPUTING, so the background may. */

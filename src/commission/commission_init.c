@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning: config defaults and checks, instance set-up, abort, progress and names.
  * Runs outside the ISR (init) or reads only: float64 and <math.h> are fine here. */
 #include <math.h>

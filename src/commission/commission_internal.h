@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning internals shared by the ISR stages (float32) and the
  * background fits (float64). Internal: not part of the public API. */
 #ifndef IMEST_COMMISSION_INTERNAL_H

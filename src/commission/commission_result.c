@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning result: the background's values with the ISR's live figures, and an estimator
  * config filled from it. Read-only calls, any context. */
 #include <math.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The estimator's hand-off between its two contexts (imest.h, concurrency
  * contract): the ISR publishes a finished window by a store-release of its
  * index, the background sees it by a load-acquire, and releases the buffer

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The library's one math header: its constants (each number written once),
  * the arithmetic type of the per-sample paths and the helpers they share
  * (absolute value, square root, the 3-2 transform, angle wrapping) without

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Configuration defaults and checks, filter design, instance initialisation.
  * Runs once, outside the ISR: float64 and <math.h> are fine here. */
 #include <math.h>

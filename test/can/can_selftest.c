@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-can-selftest: publishes N synthetic window results through the real
  * library path (imest_can_pub_init, imest_can_publish) over a SocketCAN
  * interface (--iface) or into a candump -L log (--log). The results are a

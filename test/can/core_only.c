@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The estimator without telemetry: this program calls only the core (init,
  * ISR, background) and runs it over a loaded motor's signals. The test
  * can_core_without_telemetry runs it and checks (nm) that no imest_can_*

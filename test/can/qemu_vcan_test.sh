@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Real SocketCAN end-to-end test (CTest label "socketcan").
 #
 # This machine's kernel has no CAN support, so the test boots a small Linux

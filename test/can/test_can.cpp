@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // CAN telemetry: codec, publisher, reader, candump, callback and SocketCAN ports.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """tools/imest.dbc against the C codec, in two ways:
 
 1. Structure: the C signal table (imest-can-selftest --table, i.e.

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """imest-monitor on candump logs: clean, lost, repeated, corrupted,
 malformed and truncated input, a sender restart, options, exit codes
 (0 decoded, 1 nothing decoded / input error, 2 usage) and the messages that

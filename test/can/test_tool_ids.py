@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """One identifier parser for every tool: imest-replay --can-id and
 imest-monitor --base-id take the same spellings (a 29-bit identifier above
 0x7FF without any flag, --can-ext / --ext for small 29-bit ones, the old

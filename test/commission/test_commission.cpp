@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Self-commissioning (include/imest/imest_commission.h): closed loop on the simulator
 // (tools/commission/commission_sim.c: imsim with external duties, firmware timing, 2 us dead
 // time, 1 V / 0.8 V drops with slopes, 12-bit sensors with offsets and gain errors, 4096-count

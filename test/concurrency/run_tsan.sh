@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Runs a ThreadSanitizer test program (test/concurrency): any report fails it
 # (halt_on_error=1). The caller's TSAN_OPTIONS come after these defaults and
 # override them, e.g. TSAN_OPTIONS=halt_on_error=0 to see every report.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // The concurrency contract (include/imest/imest.h) under ThreadSanitizer.
 //
 // The ISR entry point (imest_isr_abc, or imest_isr_duty with an inverter

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // A small, independent float64 induction-motor model (docs/METHOD.md eq. (1)) for the
 // core tests: RK4 with substeps, sinusoidal supply, constant load. The full
 // simulator lives in sim/; this one only needs to be obviously right.

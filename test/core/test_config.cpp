@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // The config defaults write every field: a config on the stack (garbage in
 // it) and a zeroed one come out of imest_config_default() byte for byte the
 // same. tr_nominal_known was once left as it was, and T_R was then judged

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // End to end on an independent float64 motor model: sample -> ISR -> background.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Window timing, the lock-free hand-off, overruns, warm-up and faults.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // ISR stages against float64 references, with stated tolerances.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Properties of the host parsers (CSV reader of imest-replay, candump -L line
  * parser) on arbitrary input: shared by the seeded random test
  * (test_parsers_random.cpp) and the libFuzzer targets (fuzz/). Each returns

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Test rig for the robustness tests: the simulator (imsim) in a loaded steady
 // state feeding imest through its public API, with a hook that lets a test
 // corrupt any sample on its way into the ISR call.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The property every background solve must have, whatever the sums: shared by
  * the seeded random test (test_solve_random.cpp) and the libFuzzer target
  * (fuzz/fuzz_solve.cpp). Internal interface: include src/ privately. */

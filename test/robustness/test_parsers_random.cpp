@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // The host parsers on seeded random and mutated input: the CSV reader of
 // imest-replay (tools/replay/csv_reader.c) and the candump -L line parser
 // (port/candump). Property (parser_property.h): no crash, no sanitizer error,

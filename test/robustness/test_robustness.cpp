@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Robustness of the whole public path (imest_isr_abc -> imest_background)
 // against bad samples and hard operating conditions, on realistic signals from
 // the simulator (exp2 operating point in steady state, 12-bit sensors with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // The background solve (internal imest__bg_solve) on 20 000 seeded random windows
 // of sums: raw bit patterns (NaN, Inf, denormal, huge), special values, and
 // structured sums R = sum W'W from random W (full rank, rank deficient, scaled

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // imest-sim command line: flag parsing, errors, CSV header and first row.
 #include <gtest/gtest.h>
 
@@ -184,7 +185,7 @@ TEST(SimCli, HelpAndReadmeListEveryFlag)
     const char *argv[] = {"imest-sim", fl.c_str(), "1"};
     char err[256];
     imsim_cli_parse(3, const_cast<char **>(argv), &c, &o, err, sizeof err);
-    EXPECT_EQ(std::string(err).find("unknown flag"), std::string::npos) << fl << ": " << err;
+    EXPECT_EQ(std::string(err).find("unknown option"), std::string::npos) << fl << ": " << err;
   }
 }
 

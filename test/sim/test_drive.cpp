@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // The drive of a sensorless-voltage inverter: firmware timing (duty computed at sample k,
 // applied during [t_k+1, t_k+2)), the duty and DC-bus columns, the inverter's voltage error
 // (dead time, switch and diode drops), external commands in closed loop, the bus ADC.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Integrator error against a converged RK4 reference (same supply events), convergence order,
 // PWM event-exactness.
 #include <gtest/gtest.h>

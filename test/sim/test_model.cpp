@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Model checks: steady state against an independent equivalent circuit, docs/METHOD.md §9
 // figures, DOL start, energy balance.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Industrial drive presets: each motor's rated point (phasor steady state at 400 V, 50 Hz,
 // rated torque) near the catalogue speed and current, and each drive running its default point
 // (390 V on the 560 V bus, firmware timing) without clipping, at the phasor solution's speed.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // y = W K (docs/METHOD.md §2) on simulated trajectories, with an independent double-precision
 // implementation of W and y written here from docs/METHOD.md.
 #include <gtest/gtest.h>

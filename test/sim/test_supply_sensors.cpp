@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Supplies, voltage measurement conventions, sensors (ADC quantisation, clipping, noise,
 // encoder), AA filter, IFOC with a detuned T_R.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Thermal drift: one hour of exp2 heats the motor as in the paper's experiment 2.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // imest-bench-solve: microseconds per imest__bg_solve on the testvector (not a
 // test; prints figures). Usage: imest-bench-solve [repetitions]
 #include <chrono>

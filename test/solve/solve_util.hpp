@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Helpers shared by the background-solve tests: the testvector, a float64
 // reference of the regressor (docs/METHOD.md §2) for realistic random sums, and an
 // independent long-double evaluation of E_p^2.

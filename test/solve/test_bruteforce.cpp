@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Brute-force check of the selection (docs/METHOD.md §7): the solver's minimiser
 // must be the global admissible minimum of E_p^2(K1, K2).
 // Reference, independent of the e-tables/resultant: for each K2 on a

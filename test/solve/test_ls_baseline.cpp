@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Over-parameterised least-squares baseline (docs/METHOD.md §9): minimum-norm SVD
 // solution of the 7-column reduced normal equations (columns 1,2,4..8,
 // column-scaled), T_R = 1/K2 from it, against the constrained estimate, on

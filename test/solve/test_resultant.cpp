@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Generic resultant (docs/METHOD.md §4) on random symmetric positive semi-definite
 // R_W = A'A (no structure): degree 20 with leading coefficient
 // 16 R44 (R33 R44 - R34^2) >= 0 and r(0) = -16 R77 (R77 R88 - R78^2) <= 0;

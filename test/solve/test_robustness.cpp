@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Robustness of imest__bg_solve: random and garbage sums (zeros, NaN, Inf, huge,
 // tiny, negative definite, rank 1, indefinite, unstructured), bad configs.
 // imest__bg_solve must always return, with a known status, and never report a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Sturm + bisection (bg_roots.c) against Eigen's companion-matrix roots
 // (Eigen::PolynomialSolver: balanced companion matrix, QR eigenvalues) on
 // seeded random polynomials of degree <= 20, in families.

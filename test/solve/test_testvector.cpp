@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Reproduce test/data/testvector.json (docs/METHOD.md §12) stage by stage from the
 // structure-fixed R_W, R_Wy, R_y. Tolerances:
 //  - tables and resultant: 1e-10 x the magnitude of the terms summed into each

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Installs the build into a temporary prefix and builds a consumer project
 # with find_package(imest): the exported CMake package works.
 set -eu

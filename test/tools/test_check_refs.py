@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 # check-refs: skip-file (this test writes a fixture tree full of dangling names)
 """tools/scripts/check-refs on a small fixture tree: it must report each dangling
 file, document, section and heading reference (file:line) and nothing that

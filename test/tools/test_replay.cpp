@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // imest-replay as a user runs it: bad input, column order, float32 vs float64.
 #include <gtest/gtest.h>
 

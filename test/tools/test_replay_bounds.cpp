@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Verdicts against the simulator's truth. The systematic error bounds: at rated speed
 // and light load the PWM staircase's aliased current moves T_R (and R_S) on
 // a small motor without raising any statistical index; the bound must refuse

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // imest-replay --voltage duty: a drive without voltage sensors, fed with the
 // duty cycles and the DC bus the simulator's 4 kW drive records with firmware
 // timing (row k's duties applied from t_k to t_k+1, v_dc sampled at t_k).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // imest-replay with the inputs users really have: each bad input gets a message
 // that says what is wrong and what to do, and the exit code of the convention
 // (0 ok, 1 unusable data, 2 bad option). One test per row of the matrix.

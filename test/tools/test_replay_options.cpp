@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // imest-replay's command line reaches the estimator's config: each option of
 // the duty-cycle input sets its field, the inverter model's default
 // uncertainty, and the options refused with the phase-voltage input

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // Running a host tool as a user does, for the tool tests: a temporary folder,
 // the command's exit code and output, recordings from the simulator.
 #pragma once

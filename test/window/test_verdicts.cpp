@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 // The background's verdict on one window, imest__bg_judge()
 // (src/estimator/window/bg_validity.c), on hand-built window fixtures: a clean
 // loaded window that is valid, and for every reason the judge gives a minimal

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commission, then estimate (online.c): the online estimator on the commissioned drive with the
  * duty-cycle input. Host code. */
 #ifndef IMEST_COMMISSION_ONLINE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The online estimator's sensitivity to the constants commissioning provides (sensitivity.c).
  * Host code. */
 #ifndef IMEST_COMMISSION_SENSITIVITY_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The commissioning routine closed loop on the simulator (commission_sim.h). */
 #include "commission_sim.h"
 

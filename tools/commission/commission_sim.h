@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The commissioning routine closed loop on the simulator: imsim with an external controller
  * (IMSIM_SUPPLY_EXT, firmware timing, PWM inverter with dead time and device drops, 12-bit
  * sensors with offsets and gain errors, encoder), the routine's ISR call per sample and its

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-commission: the library's self-commissioning routine run closed loop on the simulator
  * for a drive preset; prints what it identified against the simulator's truth, with the errors,
  * the time and the peak current of the routine, per stage.
@@ -59,7 +60,12 @@ static void usage(FILE *f)
           "  --online             then: the online estimator on the same drive at --load with the\n"
           "                       identified constants and inverter model (duty-cycle input),\n"
           "                       against the same with the true ones\n"
-          "  --help\n",
+          "  -h, --help           this text\n"
+          "  --version            the version and licence\n"
+          "\n"
+          "Exit status: 0 the routine completed with a valid result (--sensitivity: the runs\n"
+          "completed); 1 it failed or its result is not valid (the reason is printed), or a run\n"
+          "or the trace file failed; 2 bad option or argument.\n",
           k_prog);
 }
 
@@ -114,9 +120,9 @@ int main(int argc, char **argv)
       return 2;
     }
     double v;
-    if (tool_args_is(&a, "--help")) {
-      usage(stdout);
-      return 0;
+    const int std_rc = tool_args_standard(&a, usage);
+    if (std_rc >= 0) {
+      return std_rc;
     } else if (tool_args_is(&a, "--preset")) {
       if (tool_args_value(&a) == NULL) return 2;
     } else if (tool_args_is(&a, "--no-rotation")) {

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commission, then estimate: the routine identifies the drive (commission_sim.c), then the online
  * estimator runs on the same drive at a steady load with the identified constants and inverter
  * model and the duty-cycle input (imest_isr_duty), as a firmware without voltage sensors would.

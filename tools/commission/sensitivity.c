@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* How well to commission: the online estimator's T_R and R_S error per 1 % error in L_S and in
  * sigma and per 0.1 V error of the inverter's voltage-error model, measured on the simulator
  * (imest-commission --sensitivity). Host code. */

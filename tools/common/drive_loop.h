@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The firmware's loop, written once for every host tool that runs the
  * estimator on samples (imest-replay, imest-demo): per sample the float32 ISR
  * call (phase voltages or duty cycles) with the encoder angle wrapped to

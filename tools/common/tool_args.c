@@ -1,9 +1,12 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "tool_args.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "imest/imest_version.h"
 
 void tool_args_init(tool_args_t *a, const char *prog, int argc, char **argv)
 {
@@ -77,6 +80,25 @@ int tool_args_flag(tool_args_t *a)
 
 int tool_args_unknown(const tool_args_t *a)
 {
-  fprintf(stderr, "%s: unknown option '%s' (see --help)\n", a->prog, a->opt);
+  fprintf(stderr, "%s: unknown option '%s'\nTry '%s --help'.\n", a->prog, a->opt, a->prog);
   return TOOL_EXIT_USAGE;
+}
+
+void tool_version(const char *prog)
+{
+  printf("%s %s\n"
+         "Licence: Apache License 2.0 <https://www.apache.org/licenses/LICENSE-2.0>\n",
+         prog, IMEST_VERSION_STRING);
+}
+
+int tool_args_standard(tool_args_t *a, void (*usage)(FILE *))
+{
+  const int help = tool_args_is(a, "-h") || tool_args_is(a, "--help");
+  if (!help && !tool_args_is(a, "--version")) return -1;
+  if (tool_args_flag(a)) return TOOL_EXIT_USAGE;
+  if (help)
+    usage(stdout);
+  else
+    tool_version(a->prog);
+  return TOOL_EXIT_OK;
 }

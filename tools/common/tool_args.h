@@ -1,8 +1,11 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Command lines the same way in every host tool: "--opt value" and
  * "--opt=value", "-" as a file name (stdin), "--" ends the options, and one
  * exit-code convention. Host tool code (stdio). */
 #ifndef IMEST_TOOL_ARGS_H
 #define IMEST_TOOL_ARGS_H
+
+#include <stdio.h>
 
 /* Exit codes of every imest tool. */
 enum {
@@ -43,7 +46,18 @@ int tool_args_number(tool_args_t *a, double *out);
 /* A flag takes no value: 0, or -1 after printing "--flag takes no value". */
 int tool_args_flag(tool_args_t *a);
 
-/* Prints "prog: unknown option '--x' (see --help)"; returns TOOL_EXIT_USAGE. */
+/* Prints "prog: unknown option '--x'" and "Try 'prog --help'." on stderr;
+ * returns TOOL_EXIT_USAGE. */
 int tool_args_unknown(const tool_args_t *a);
+
+/* The options every tool has, handled the same way: -h and --help print
+ * usage(stdout), --version prints tool_version(); either returns TOOL_EXIT_OK
+ * (TOOL_EXIT_USAGE after a message for "--help=x"). -1 when the current
+ * option is none of them. */
+int tool_args_standard(tool_args_t *a, void (*usage)(FILE *));
+
+/* "prog VERSION" (imest_version.h) and the licence line, on stdout (GNU
+ * style: the first line is the program's name and version). */
+void tool_version(const char *prog);
 
 #endif

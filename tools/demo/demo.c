@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-demo: the paper's experiments end to end, with the library in the loop
  * exactly as a drive firmware runs it.
  *
@@ -706,10 +707,11 @@ static void usage(FILE *f)
              "  --no-commission     the estimators get the true constants (no commissioning)\n"
              "  --quiet             no progress on stderr (default: progress if it is a terminal)\n"
              "  -h, --help          this text\n"
+             "  --version           the version and licence\n"
              "\n"
              "stdout: one line per experiment, key=value pairs.\n"
-             "exit status: 0 done; 1 an experiment failed or the output cannot be written;\n"
-             "2 bad option.\n");
+             "Exit status: 0 done; 1 commissioning or an experiment failed, or the output cannot\n"
+             "be written; 2 bad option or argument.\n");
 }
 
 static int mkdir_p(const char *path)
@@ -765,13 +767,13 @@ static int parse_options(int argc, char **argv, options_t *o)
   tool_args_init(&a, "imest-demo", argc, argv);
   tool_arg_kind_t kind;
   double x;
+  int std_rc;
   while ((kind = tool_args_next(&a)) != TOOL_ARG_END) {
     if (kind == TOOL_ARG_OPERAND) {
       fprintf(stderr, "imest-demo: unexpected argument '%s' (see --help)\n", a.operand);
       return TOOL_EXIT_USAGE;
-    } else if (tool_args_is(&a, "-h") || tool_args_is(&a, "--help")) {
-      usage(stdout);
-      return TOOL_EXIT_OK;
+    } else if ((std_rc = tool_args_standard(&a, usage)) >= 0) {
+      return std_rc;
     } else if (tool_args_is(&a, "--out")) {
       if ((o->out = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--duration") || tool_args_is(&a, "--exp1-duration")) {

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """imest demo: windows tables, figures and summary from the raw run.
 
 Usage: /usr/bin/python3 tools/demo/make_results.py OUT_DIR [--timings FILE]

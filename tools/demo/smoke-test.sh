@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # CTest smoke test of the main job (label demo): 60 s of motor time through the
 # whole chain into a temporary folder; checks that the files exist, that every
 # window went over the CAN log and that summary.md parses.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-monitor: decode imest CAN telemetry live from a SocketCAN interface or
  * from a candump -L log, print a table or CSV, and report lost, repeated,
  * late and corrupted frames, estimator overruns and sender restarts (each on
@@ -72,6 +73,8 @@ static void usage(FILE *f)
         "  --csv          CSV (header t_s,seq,T_R_s,R_S_ohm,E_I,valid,status,...) instead of a table\n"
         "  --count N      stop after N windows (N >= 1)\n"
         "  --timeout SEC  live: stop after SEC seconds without any frame (default: never)\n"
+        "  -h, --help     this text\n"
+        "  --version      the version and licence\n"
         "Options take their value as '--opt value' or '--opt=value'. Events (lost, repeated,\n"
         "corrupted frames, incomplete windows, sequence gaps, restarts) and a summary go to\n"
         "stderr. A value clamped to its field's range is shown as a bound ('>1.31068').\n"
@@ -551,14 +554,14 @@ int main(int argc, char **argv)
   tool_arg_kind_t kind;
   memset(&m, 0, sizeof m);
   tool_args_init(&a, "imest-monitor", argc, argv);
+  int std_rc;
   while ((kind = tool_args_next(&a)) != TOOL_ARG_END) {
     if (kind == TOOL_ARG_OPERAND) {
       fprintf(stderr, "imest-monitor: unexpected argument '%s' (a log is given with --log; see --help)\n",
               a.operand);
       return TOOL_EXIT_USAGE;
-    } else if (tool_args_is(&a, "-h") || tool_args_is(&a, "--help")) {
-      usage(stdout);
-      return TOOL_EXIT_OK;
+    } else if ((std_rc = tool_args_standard(&a, usage)) >= 0) {
+      return std_rc;
     } else if (tool_args_is(&a, "--csv")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       m.csv = 1;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Minimal strict CSV reader for motor recordings: a header row naming the
  * columns, then numeric rows. Errors name the line. "-" reads stdin (copied
  * to a temporary file so that it can be read twice). A malformed last line

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-replay: runs a recorded CSV (t,u_a,u_b,u_c,i_a,i_b,i_c,theta, or
  * with --voltage duty t,d_a,d_b,d_c,v_dc,i_a,i_b,i_c,theta; any order, more
  * columns ignored) through exactly the code a firmware runs: the float32 ISR

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-replay's advice: a setting the estimator refuses, or a record whose
  * windows all fail for one reason, turned into what is wrong with the data
  * or the options and what to do (docs/feeding-logs.md has the long form). */

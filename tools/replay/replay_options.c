@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "replay_options.h"
 
 #include <math.h>
@@ -103,9 +104,11 @@ static void usage(FILE *o)
              "other:\n"
              "  --quiet             no notes or summary on stderr\n"
              "  -h, --help          this text\n"
+             "  --version           the version and licence\n"
              "\n"
-             "exit status: 0 windows estimated; 1 the file or its data are unusable (the\n"
-             "message says why and what to do); 2 bad option or argument.\n");
+             "Exit status: 0 windows estimated (valid or not); 1 the file or its data are\n"
+             "unusable, or an output cannot be written (the message says why and what to do);\n"
+             "2 bad option or argument.\n");
 }
 
 /* Which input an option belongs to. */
@@ -257,6 +260,7 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
   tool_args_t a;
   tool_args_init(&a, k_prog, argc, argv);
   tool_arg_kind_t kind;
+  int std_rc;
   while ((kind = tool_args_next(&a)) != TOOL_ARG_END) {
     if (kind == TOOL_ARG_OPERAND) {
       if (o->path != NULL) {
@@ -272,9 +276,8 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
       if (tool_args_number(&a, &d)) return TOOL_EXIT_USAGE;
       *(float *)(void *)((char *)&o->cfg + k_numeric[k].offset) = (float)d;
       o->given |= 1ul << k;
-    } else if (tool_args_is(&a, "-h") || tool_args_is(&a, "--help")) {
-      usage(stdout);
-      return TOOL_EXIT_OK;
+    } else if ((std_rc = tool_args_standard(&a, usage)) >= 0) {
+      return std_rc;
     } else if (tool_args_is(&a, "--pole-pairs")) {
       if (tool_args_number(&a, &d)) return TOOL_EXIT_USAGE;
       if (d < 1 || d > 64 || d != floor(d)) {

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-replay's command line: the options, --help, and which of them the
  * user gave (a bad setting the user chose is a usage error, one the data
  * forces is a data error). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* imest-replay's first pass over a recording: its time base (sample rate,
  * unit and rounding of t), ADC clipping, whether it starts at rest, and a
  * check of the sign conventions. Everything the run needs before the first

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Host run of the STM32 example: a publisher sends windows through the
  * callback port into the fake HAL. Windows 0 and 1 reach the "bus"; then the
  * controller goes bus-off, the software queue fills and further frames are

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Example: the transmit hook a firmware on an STM32 (bxCAN, vendor HAL)
  * gives to imest_can_callback_init(). bxCAN has only 3 transmit mailboxes and
  * imest sends 6 frames per window, so the hook puts frames into a small

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Example glue between imest's callback port and an STM32-HAL-style (bxCAN)
  * driver: a small software queue in front of the 3 hardware mailboxes, so
  * the IMEST_CAN_NFRAMES (6) frames of a window are accepted at once; the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 #include "stm32_hal_fake.h"
 
 #include <stddef.h>

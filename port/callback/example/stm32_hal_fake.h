@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* A host stand-in for the few STM32 HAL (bxCAN) calls the example uses, so
  * the example compiles and runs on the host. Same names and shapes as the
  * vendor HAL; behaviour: 3 transmit mailboxes, filled by AddTxMessage and

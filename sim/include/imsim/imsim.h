@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /*
  * imsim: host-side induction-motor simulator for the imest project.
  *

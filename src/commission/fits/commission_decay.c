@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Exponential decay sampled at the ISR rate, for the background fits: powers of
  * q = exp(-T / tau) by binary exponentiation with a small memo. The fits evaluate the same few
  * block lengths and spacings many times per tau; exp() in soft double (Cortex-M4) costs a few

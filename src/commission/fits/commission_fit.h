@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background helpers shared by the commissioning fits (float64). Internal. */
 #ifndef IMEST_COMMISSION_FIT_H
 #define IMEST_COMMISSION_FIT_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background: one axis of the standstill part (commission_staircase.c, commission_pulses.c).
  *
  * DC blocks: the mean axis voltage of block b (plateau p, pattern q) is modelled as

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background: the rotor time constant from the probe's voltage record (commission_probe.c).
  * Block means v_b over log-spaced blocks are fitted with c + A g_b(tau), g_b the block's mean
  * of exp(-(t - t_0)/tau); for each tau the two linear parameters are solved in closed form,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background: the rotating run (commission_rotate.c) -> L_S, sigma, n_p, the encoder's direction
  * and counts, the phase-order check.
  *

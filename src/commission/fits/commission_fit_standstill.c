@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background: the three axes combined into the standstill result. Sensor gains first (each
  * axis gives its sensor's gain relative to the mean of the three), then every per-axis value
  * corrected for them (an axis current read high by dev/2 makes R and the inductances read low

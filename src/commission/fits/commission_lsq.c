@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Small dense symmetric positive definite solve (Cholesky) for the commissioning fits.
  * Background only, float64, fixed loop bounds (n <= CM_LSQ_MAX). */
 #include <math.h>

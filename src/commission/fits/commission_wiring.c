@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning stage 2, wiring: a bipolar voltage pulse along each axis (+V then -V for the
  * same time, so the current returns to zero and the rotor flux stays ~0), doubled from 4 % of
  * the bus until the current responds. The current vector at the end of the +V half (its peak)

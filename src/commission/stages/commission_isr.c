@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning, ISR entry: input checks and protection, the duty pipeline (what is applied
  * now was returned one call ago), the axis current controller, the three modulation patterns
  * and the block sums handed to the background. float32 only; no data-dependent loop. */

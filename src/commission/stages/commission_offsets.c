@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning stage 1, current-sensor offsets: zero voltage (every duty 0.5, so no leg pair
  * drives a current whatever the dead time), 10 ms for any current to die, then the mean of each
  * channel over 0.25 s is its offset. A mean beyond 25 % of i_max_a, or a current that moves

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning stage 3, the rotor time constant: a DC current (1/3 of the top level) on the
  * a axis under PI control. As the rotor flux builds, the voltage decays as V_inf + A e^(-t/T_R).
  * The voltage is summed in rounds of 6 blocks whose length doubles every round (2 ms, 4 ms ...),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning stage 5, sigma*L_S: at the staircase's last plateau (1/3 of the top level) a
  * square-wave voltage of period 8 samples is added along the axis, with the current loop held
  * (its voltage frozen: the plant is passive, the DC current drifts only by the small remaining

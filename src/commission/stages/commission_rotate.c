@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning stage 7 (with allow_rotation): a rotating field at no load. The field angle
  * advances by a unit phasor rotated every sample (no sin/cos calls). The current is controlled
  * in the field frame to the rated magnetising current on d and zero on q (a current-fed field:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning stage 4, the DC current staircase on one axis, and stage 6, demagnetising:
  *
  * Five plateaus at 1/3, 2/3, 1, 2/3, 1/3 of the top level, each ~3 T_R long and cut into 9

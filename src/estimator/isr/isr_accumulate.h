@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ISR stage 4: accumulation of the 36 independent entries of
  * [W e]^T [W e] (upper triangle of an 8x8, row-major: R_W 7x7, R_We, R_ee),
  * then the window's other evidence (IMEST_ACC_*: the rotation of the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ISR stage: the encoder angle through a tracking observer (an alpha-beta-
  * gamma tracker, a type-3 loop). A quantised encoder gives the rotation and
  * the speed a sawtooth error whose beat with the sample rate can fall inside

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ISR stage 0 of the duty-cycle input: the phase voltage a drive without
  * voltage sensors knows, from its duty cycles and the DC bus, minus the
  * inverter's voltage error (include/imest/imest.h, imest_inverter_t). Each

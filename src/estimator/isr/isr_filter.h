@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ISR stage 2: Butterworth-3 low-pass as second-order sections and
  * time-aligned central differences (docs/METHOD.md §8). Every channel passes the same
  * filter so the delays are identical. */

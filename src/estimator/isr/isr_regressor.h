@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ISR stage 3: regressor W (2x7: columns 1,2,4,5,6,7,8 of docs/METHOD.md §2) and the
  * centred output e = y - W c0. Column 3 is not formed: W_3 = -m W_4 exactly,
  * so the background rebuilds it. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The ISR path: one call per sample, fixed instruction count, float32 only.
  * Stages: (duty cycles -> phase voltage) -> plausibility -> 3-2 transform ->
  * offsets -> alignment -> angle observer -> rotation -> filters and

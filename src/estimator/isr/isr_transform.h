@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* ISR stage 1: rotation into the rotor frame (docs/METHOD.md §1); the 3-2
  * transform itself is common/imest_math.h's imest__clarke(). */
 #ifndef IMEST_ISR_TRANSFORM_H

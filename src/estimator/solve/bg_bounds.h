@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Every iteration bound of the background solve, in one place: the loops of
  * bg_roots.c and bg_quality.c are bounded by these, out->work is bounded by
  * BG_SOLVE_WORK_BOUND, and the tests and the fuzzer check against the same

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Exact power-of-two and IEEE-754 helpers of the background path: bit
  * operations on the binary64 representation, no libm (ldexp, frexp and
  * isfinite cost ~70 instructions per call on a soft-double core, a bit test a

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Exact power-of-two and IEEE-754 helpers of the background path (no libm:
  * ldexp/frexp/isfinite cost ~70 instructions per call on a soft-double core).
  * Internal: not part of the public API. */

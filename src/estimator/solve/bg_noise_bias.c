@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background solve stage: the sensors' white-noise bias on the window sums
  * (as window/bg_noise.c estimated it), taken out of the sums, and the
  * residual it explains at a given K (docs/METHOD.md §16). Takes sums, knows

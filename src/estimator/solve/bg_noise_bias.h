@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background solve stage: the white noise's bias on the window sums and the
  * residual it explains (docs/METHOD.md §16). Internal: not part of the public
  * API. */

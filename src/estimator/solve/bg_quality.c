@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Stage 5 of the background solve: quality of the selected minimiser
  * (docs/METHOD.md §7), float64, in the scaled unknowns (k, kappa) and scaled back
  * exactly (powers of two) to (K1, K2). Everything here refers to the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: Hessian and parametric error indices at the selected
  * candidate (docs/METHOD.md §7). Internal: not part of the public API. */
 #ifndef IMEST_BG_QUALITY_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Stage 2 of the background solve: the resultant r_w(kappa) of p1 and p2w with
  * respect to k (docs/METHOD.md §4, eq. 27, with the weighted p2w of bg_tables.h), float64:
  *   r_w = a0^2 bw2 - a0 a1 bw1 + a1^2 bw0 = a0 (a0 bw2 - a1 bw1) + (a1 a1) bw0,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: the resultant of p1 and p2 (docs/METHOD.md §4).
  * Internal: not part of the public API. */
 #ifndef IMEST_BG_RESULTANT_H

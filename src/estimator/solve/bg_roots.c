@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Stage 3 of the background solve: every distinct positive root of a real
  * polynomial of degree <= 20 by Sturm sequences and bisection (docs/METHOD.md §6).
  * No companion matrix, no eigenvalues, no allocation, no static mutable data.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: every positive root of a polynomial by Sturm sequences
  * and bisection (docs/METHOD.md §6). Internal: not part of the public API. */
 #ifndef IMEST_BG_ROOTS_H

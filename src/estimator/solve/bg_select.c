@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Stage 4 of the background solve: candidates and selection (docs/METHOD.md §7).
  * For every positive root kappa of the resultant: k = -a0/a1 (a1 > 0 for
  * K2 > 0 with a positive semi-definite R_W), K1 = g k, K2 = s kappa,

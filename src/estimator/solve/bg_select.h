@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: candidates and selection (docs/METHOD.md §7).
  * Internal: not part of the public API. */
 #ifndef IMEST_BG_SELECT_H

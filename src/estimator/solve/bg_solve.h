@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background solve: from one window's sums to T_R, R_S and their quality.
  * Internal interface between the window bookkeeping (bg_task.c) and the solve
  * stages (bg_tables.c, bg_resultant.c, bg_roots.c, bg_select.c, bg_quality.c).

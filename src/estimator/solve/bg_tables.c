@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Stage 1 of the background solve: power-of-two scaling (docs/METHOD.md §5), the
  * scaled cost tables e2, e1, e0 (§3) and the p1/p2w coefficients (§4, with the
  * speed-normalised cost of bg_tables.h). float64 throughout. Every scaling is a

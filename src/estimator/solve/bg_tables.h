@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: power-of-two scaling, cost tables and p1/p2 coefficients
  * (docs/METHOD.md §3..§5). Internal: not part of the public API. */
 #ifndef IMEST_BG_TABLES_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: consecutive windows combined where one window has too
  * little information (partial load, low speed: the parametric error index
  * above its bound while nothing else is wrong). The noise-compensated sums of

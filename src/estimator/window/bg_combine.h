@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: consecutive windows combined where one has too little
  * information (docs/METHOD.md §19). Internal: not part of the public API. */
 #ifndef IMEST_BG_COMBINE_H

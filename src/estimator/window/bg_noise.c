@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: the bias that white sensor noise puts into the window
  * sums, and its removal (bias-compensated least squares, docs/METHOD.md §16).
  *

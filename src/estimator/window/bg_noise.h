@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: the sensors' white noise and the bias it puts into the
  * window sums (errors in the variables, docs/METHOD.md §16). Internal: not
  * part of the public API. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* The background task: once per finished window, take the buffer from the
  * ISR, solve, judge, and release the buffer with the centring for a later
  * window. Telemetry is the caller's (imest_can_publish()). imest_background()

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: is this window's estimate trustworthy, and for which
  * parameter? The first reason found, most fundamental first, becomes the
  * reason; T_R and R_S get their own verdicts (R_S is far more sensitive to

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: the verdict on one window (docs/METHOD.md §7; README "When
  * is a window valid"). Internal: not part of the public API. */
 #ifndef IMEST_BG_VALIDITY_H

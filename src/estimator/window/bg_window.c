@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage 1: take one window's ISR sums to float64 8x8 form.
  * The ISR accumulated Z = [W1 W2 W4 W5 W6 W7 W8 e] with e = y - W c0; here
  * R_Wy = R_We + R_W c0 and R_y = R_ee + 2 c0.R_We + c0' R_W c0 (float64), and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: one window's ISR sums to the float64 8x8 form the solve
  * takes, the window's statistics, and the centring vector the ISR uses for
  * the next windows (docs/METHOD.md §2, §10). Internal: not part of the public

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Accuracy of imest-replay on the simulator's recordings of the paper's two
 # experiments, ideal and 12-bit sensors: per-window error of T_R and R_S
 # against the truth averaged over the same window, valid/invalid counts.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Joins the replayed windows with the truth, classifies them and computes the summary.
 
 Per window: e_TR = T_R / T_R,true - 1 and e_RS likewise (truth: the simulator's columns averaged

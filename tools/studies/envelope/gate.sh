@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # CTest form of the envelope benchmark (label envelope): the reduced run, then the gate
 # false_valid_gross == 0 (no window with T_R valid and > 10 % off or R_S valid and > 25 % off).
 # Usage: gate.sh IMEST_SIM IMEST_REPLAY OUT_DIR

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The motors of the envelope benchmark and the supply voltage of each operating point.
 
 Each motor runs on the drive the simulator's presets model (PWM inverter, space-vector

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The coverage map of the envelope benchmark (coverage.png): motor x frequency x load.
 
 Top row T_R, bottom row R_S; one panel per motor, frequency (% of rated) across, load (% of

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The sampling design of the envelope benchmark: which operating points are simulated.
 
 A full factorial (6 motors x 8 frequencies x 6 loads x 3 sensor sets x 4 encoders x inputs) is

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The Markdown report of the envelope benchmark (results.md)."""
 import math
 from collections import Counter, defaultdict

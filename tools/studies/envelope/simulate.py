@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """One recording of the envelope benchmark: simulate it, replay it, average the truth per window.
 
 The simulator writes a CSV to a temporary file; imest-replay reads it exactly as a user's log;

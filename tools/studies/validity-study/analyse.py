@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Analysis of the validity study (run.sh): joins every replayed window with the
 simulator's truth averaged over the same window, classifies it, and measures
 how well the validity rule separates good from bad windows, for the defaults

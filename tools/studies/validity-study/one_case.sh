@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
 # One case of the validity study: simulate, optionally cut the first rows,
 # replay, and write per-window truth means next to the replay output.
 # usage: one_case.sh OUT_DIR BUILD_DIR 'name|sim args|replay args|cut_s'

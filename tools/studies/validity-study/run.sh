@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
 # Validity study: simulate a matrix of recordings with imest-sim, replay each
 # with imest-replay (default configuration, the motor constants only), compare
 # every window with the simulator's truth and report how well the validity

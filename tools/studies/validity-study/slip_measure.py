@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Offline check of two zero-slip measures on a sim CSV (per 1 s window):
   rms:   rms|di/dt| / rms|i| in the rotor frame (what the estimator uses now; noise
          enters squared, so it has a noise floor),
