@@ -74,14 +74,30 @@ static inline imest_real_t imest__abs(imest_real_t x)
 }
 #endif
 
-/* Square root as one instruction (VSQRT.F32): the ISR file is compiled with
- * -fno-math-errno (src/CMakeLists.txt), so GCC and Clang expand the builtin
- * inline instead of calling sqrtf for a negative argument. */
+/* Square root as one instruction (VSQRT.F32 on Cortex-M4F/M7), whatever the
+ * flags: the ISR calls no library function. With -fno-math-errno (what
+ * src/CMakeLists.txt gives the per-sample folders; GCC and Clang then define
+ * __NO_MATH_ERRNO__) the builtin is that one instruction. Without it (an IDE
+ * project, docs/integrating.md) GCC and Clang expand the builtin to VSQRT, a
+ * compare and a call to sqrtf for a negative or NaN argument (to set errno),
+ * so on 32-bit ARM with a single-precision FPU (__ARM_FP bit 2) the
+ * instruction is written out: the same VSQRT.F32, IEEE-754 correctly rounded
+ * as sqrtf, the default NaN for a negative argument as the builtin's
+ * instruction gives. The builtin is kept where the flag is given (the
+ * compiler schedules it, the code the firmware budgets measure) and off ARM
+ * (the host build). */
 #if defined(__GNUC__) || defined(__clang__)
 #ifdef IMEST_REAL_DOUBLE
 static inline imest_real_t imest__sqrt(imest_real_t x)
 {
   return __builtin_sqrt(x);
+}
+#elif defined(__arm__) && defined(__ARM_FP) && (__ARM_FP & 4) && !defined(__NO_MATH_ERRNO__)
+static inline imest_real_t imest__sqrt(imest_real_t x)
+{
+  imest_real_t r;
+  __asm__("vsqrt.f32 %0, %1" : "=t"(r) : "t"(x)); /* "t": a single-precision VFP register */
+  return r;
 }
 #else
 static inline imest_real_t imest__sqrt(imest_real_t x)
