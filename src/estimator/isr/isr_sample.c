@@ -73,24 +73,6 @@ isr_complete_pending(imest_t *s, imest_window_t *w)
   }
 }
 
-/* The angle observer smooths only at a steady speed (isr_angle.h): engaged
- * for the next window when this one's mean speed was the previous one's. The
- * ISR decides it from its own sums at the window's end, so the decision is
- * the same whenever the background runs (the test of the background's noise
- * model, bg_task.c, in float32). */
-static void isr_engage_observer(imest_t *s, const imest_window_t *w)
-{
-  const imest_real_t n_used = w->used > 0u ? (imest_real_t)w->used : RL(1);
-  const imest_real_t w_mean = w->rot * s->fs / n_used, w_before = s->w_win_prev;
-  const imest_real_t a = imest__abs(w_mean), b = imest__abs(w_before);
-  const int steady = w->used > 0u && s->w_win_prev_ok &&
-                     imest__abs(w_mean - w_before) <=
-                         RL(IMEST_STEADY_REL_LIT) * (a > b ? a : b) + RL(IMEST_STEADY_ABS_RAD_S_LIT);
-  s->w_win_prev = w_mean;
-  s->w_win_prev_ok = w->used > 0u;
-  s->obs.engaged = (s->obs.enabled && steady) ? 1u : 0u;
-}
-
 /* Window complete: hand it over if the background has released the other
  * buffer, else drop it (counted, never torn). Returns 1 if handed over. */
 static int isr_close_window(imest_t *s)
@@ -104,12 +86,16 @@ static int isr_close_window(imest_t *s)
   w->off_ia = s->off_ia;
   w->off_ib = s->off_ib;
   s->seq++;
-  isr_engage_observer(s, w);
   const uint32_t pub = s->published; /* the ISR's own index */
   if (pub == IMEST_LOAD_ACQUIRE(&s->released)) {
-    /* the window's contents before the index; the ISR now fills the other buffer */
+    /* the window's contents before the index; the ISR now fills the other
+     * buffer, and takes the background's word on the angle observer from
+     * it (decided on the window that buffer held: deterministic, two
+     * windows on) */
     IMEST_STORE_RELEASE(&s->published, pub + 1u);
-    isr_open_window(s, &s->win[(pub + 1u) & 1u], 0u);
+    imest_window_t *next = &s->win[(pub + 1u) & 1u];
+    s->obs.engaged = next->engage;
+    isr_open_window(s, next, 0u);
     return 1;
   }
   /* overrun: the background still owns the other buffer */
