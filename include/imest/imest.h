@@ -64,12 +64,11 @@
  *     released it.
  *   - The background reads nothing of the ISR's live state: what it judges a
  *     window by (the input kind, the bus voltage, the offsets) travels in the
- *     window, as it was at the window's end. Its one word back to the ISR
- *     (engage the angle observer) travels in the buffer it releases, and the
- *     ISR takes it when it refills that buffer: a window's decision applies
- *     from the window after next, whenever the background ran. So the
- *     results do not depend on when the background runs (as long as no window
- *     is dropped), and a host replay reproduces the firmware exactly.
+ *     window, as it was at the window's end; and it writes nothing the ISR
+ *     reads but its release index (the ISR engages the angle observer itself,
+ *     from its own window sums). So the results do not depend on when the
+ *     background runs (as long as no window is dropped), and a host replay
+ *     reproduces the firmware exactly.
  *   - Publication uses one index written only by the ISR and one written only
  *     by the background, stored with release and loaded with acquire ordering
  *     (GCC/Clang atomics: one DMB each at a window's end on a Cortex-M), which

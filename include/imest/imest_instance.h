@@ -63,8 +63,6 @@ typedef struct {
   uint32_t duty_input;         /**< the window's last sample came through imest_isr_duty */
   imest_real_t vdc_v;          /**< duty input: the bus voltage of the window's last sample [V] */
   imest_real_t off_ia, off_ib; /**< the offsets the high-pass tracked at the window's end [A] */
-  /* What the background tells the ISR, written before it releases the buffer: */
-  uint32_t engage; /**< engage the angle observer (the window's speed was steady) */
 } imest_window_t;
 
 /** Butterworth-3 as a first-order and a second-order section (transposed DF-II).
@@ -106,8 +104,8 @@ typedef struct {
   imest_real_t d;          /**< estimated angle minus encoder angle [rad] */
   imest_real_t dth;        /**< estimated angle step per sample [rad] */
   imest_real_t ddth;       /**< estimated change of the step per sample [rad] */
-  uint32_t engaged;        /**< the observer's estimate in use (0: the encoder as it is); the ISR
-                                  takes it from the background's word in a buffer it refills */
+  uint32_t engaged;        /**< the observer's estimate in use (0: the encoder as it is): set
+                                  by the ISR from the last two windows' mean speeds */
   uint32_t enabled;        /**< configured (angle_observer_hz >= 0) */
 } imest_angle_t;
 
@@ -156,10 +154,15 @@ typedef struct {
   imest_real_t dleg[3];      /* duty input: previous call's duties */
   imest_real_t vdc_prev;     /* duty input: previous call's bus voltage [V] */
   uint32_t duty_input;       /* the last call was imest_isr_duty (copied into the window at its end) */
-  uint32_t k;                /* sample index in the current window */
-  uint32_t warm;             /* warm-up samples still to discard */
-  uint32_t seq;              /* sequence number of the window being filled */
-  uint32_t started;          /* first sample seen */
+  imest_real_t w_win_prev;   /* the last window's mean speed [rad/s] (angle observer) */
+  uint32_t w_win_prev_ok;    /* ... and it had used samples */
+  imest_real_t obs_rot;      /* the window just ended: rotation and used samples, for */
+  uint32_t obs_used;         /* the observer's decision on the next odd sample */
+  uint32_t obs_pending;
+  uint32_t k;       /* sample index in the current window */
+  uint32_t warm;    /* warm-up samples still to discard */
+  uint32_t seq;     /* sequence number of the window being filled */
+  uint32_t started; /* first sample seen */
   /* hand-off (imest.h, concurrency contract): each index has one writer */
   volatile uint32_t published; /* written by the ISR: count of buffers handed over; the
                                   ISR fills win[published & 1] */
@@ -176,7 +179,7 @@ typedef struct {
   imest_inverter_t inverter; /* as configured: the R_S verdict weighs its uncertainty */
   float pwm_hz;
   float noise_g[6];   /* the front end's noise gains (bg_noise.h) */
-  float w_prev_rad_s; /* the previous window's mean speed (angle observer) */
+  float w_prev_rad_s; /* the previous processed window's mean speed (noise model) */
   uint32_t w_prev_valid;
   imest_combo_t combo;    /* windows combined where one has too little information */
   float last_k1, last_k2; /* last valid estimate: centring of later windows */

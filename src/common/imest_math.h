@@ -22,6 +22,12 @@
 #define IMEST_HALF_SQRT3_LIT 0.86602540378443864676 /* sqrt(3)/2 */
 #define IMEST_SQRT2_LIT      1.41421356237309504880
 
+/* A window's speed is steady when its mean is within this share of the
+ * previous window's, plus this many rad/s: the angle observer (ISR) and the
+ * noise model (background) are models of steady operation. */
+#define IMEST_STEADY_REL_LIT       0.02
+#define IMEST_STEADY_ABS_RAD_S_LIT 1.0
+
 #define RL(x)              ((imest_real_t)(x))
 #define IMEST_PI_R         RL(IMEST_PI_LIT)
 #define IMEST_2PI_R        RL(IMEST_2PI_LIT)

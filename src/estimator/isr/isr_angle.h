@@ -11,9 +11,9 @@
  *
  * Any causal smoother distorts a fast change of acceleration (a direct-on-line
  * start: measured, the run-up window becomes poorly determined), so the
- * observer is engaged only while the rotor turns at a steady speed: the
- * background engages it after a window whose speed did not change and
- * disengages it after one whose speed did (bg_task.c). */
+ * observer is engaged only while the rotor turns at a steady speed: the ISR
+ * engages it after a window whose mean speed did not change and disengages
+ * it after one whose speed did (isr_engage_observer, isr_sample.c). */
 #ifndef IMEST_ISR_ANGLE_H
 #define IMEST_ISR_ANGLE_H
 

@@ -59,6 +59,33 @@ static void isr_open_window(imest_t *s, imest_window_t *w, uint32_t pending_flag
   s->k = 0;
 }
 
+/* The angle observer smooths only at a steady speed (isr_angle.h): engaged
+ * when the window before had the mean speed of the one before that. The ISR
+ * decides it from its own sums (the test of the background's noise model,
+ * bg_task.c, in float32), so the decision is the same whenever the
+ * background runs. It runs on the next window's first even sample (the
+ * lighter kind: the odd ones complete the regressor's sums) after its angle
+ * step, not on the window's last sample, which is the ISR's longest: the
+ * observer follows from the next sample on. Not inlined: the other samples
+ * pay only the test of obs_pending. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static void
+isr_engage_observer(imest_t *s)
+{
+  const imest_real_t n_used = s->obs_used > 0u ? (imest_real_t)s->obs_used : RL(1);
+  const imest_real_t w_mean = s->obs_rot * s->fs / n_used, w_before = s->w_win_prev;
+  const imest_real_t a = imest__abs(w_mean), b = imest__abs(w_before);
+  const int steady = s->obs_used > 0u && s->w_win_prev_ok &&
+                     imest__abs(w_mean - w_before) <=
+                         RL(IMEST_STEADY_REL_LIT) * (a > b ? a : b) + RL(IMEST_STEADY_ABS_RAD_S_LIT);
+  s->w_win_prev = w_mean;
+  s->w_win_prev_ok = s->obs_used > 0u;
+  s->obs.engaged = (s->obs.enabled && steady) ? 1u : 0u;
+  s->obs_pending = 0u;
+}
+
 /* The second half of a pending regressor sample's sums (isr_accumulate.h):
  * a window's sums always hold whole samples. */
 #if defined(__GNUC__)
@@ -86,16 +113,14 @@ static int isr_close_window(imest_t *s)
   w->off_ia = s->off_ia;
   w->off_ib = s->off_ib;
   s->seq++;
+  s->obs_rot = w->rot; /* for the observer's decision (isr_engage_observer) */
+  s->obs_used = w->used;
+  s->obs_pending = 1u;
   const uint32_t pub = s->published; /* the ISR's own index */
   if (pub == IMEST_LOAD_ACQUIRE(&s->released)) {
-    /* the window's contents before the index; the ISR now fills the other
-     * buffer, and takes the background's word on the angle observer from
-     * it (decided on the window that buffer held: deterministic, two
-     * windows on) */
+    /* the window's contents before the index; the ISR now fills the other buffer */
     IMEST_STORE_RELEASE(&s->published, pub + 1u);
-    imest_window_t *next = &s->win[(pub + 1u) & 1u];
-    s->obs.engaged = next->engage;
-    isr_open_window(s, next, 0u);
+    isr_open_window(s, &s->win[(pub + 1u) & 1u], 0u);
     return 1;
   }
   /* overrun: the background still owns the other buffer */
@@ -243,6 +268,7 @@ static inline void isr_window_sample(imest_t *s, imest_window_t *w, const isr_in
     return;
   }
   if ((s->k & 1u) == 0u) {
+    if (s->obs_pending) isr_engage_observer(s); /* the first even sample after a window's end */
     isr_regressor(s, g, w->c0, s->zx, s->zy);
     isr_extra_t x;
     /* i x di/dt: in steady state |i|^2 times the slip frequency */

@@ -11,13 +11,8 @@
 #include "bg_noise.h"
 #include "bg_validity.h"
 
-/* The speed is steady when the window's mean is within this share of the
- * previous window's (and STEADY_SPEED_ABS_RAD_S): the noise compensation and
- * the angle observer are models of steady operation. */
-#define STEADY_SPEED_REL       0.02
-#define STEADY_SPEED_ABS_RAD_S 1.0
 /* Fewer used samples than this: the sums cannot determine the 7 columns. */
-#define MIN_USED_SAMPLES       16u
+#define MIN_USED_SAMPLES 16u
 
 /* What one window's steps hand on to the next step. */
 typedef struct {
@@ -59,9 +54,10 @@ static void window_sums(imest_t *s, const imest_window_t *w, double m, bg_step_t
 {
   imest__bg_window_sums(w, m, (double)s->fs, &x->sums, &x->st);
   const double w_before = (double)s->w_prev_rad_s;
-  x->steady = w->used > 0u && s->w_prev_valid &&
-              fabs(x->st.w_mean - w_before) <=
-                  STEADY_SPEED_REL * fmax(fabs(x->st.w_mean), fabs(w_before)) + STEADY_SPEED_ABS_RAD_S;
+  x->steady =
+      w->used > 0u && s->w_prev_valid &&
+      fabs(x->st.w_mean - w_before) <=
+          IMEST_STEADY_REL_LIT * fmax(fabs(x->st.w_mean), fabs(w_before)) + IMEST_STEADY_ABS_RAD_S_LIT;
   s->w_prev_rad_s = (float)x->st.w_mean;
   s->w_prev_valid = w->used > 0u;
   imest__bg_noise_estimate(s, w, &x->st, &x->sums, x->steady, &x->nz);
@@ -173,20 +169,15 @@ static void combine_after(imest_t *s, const imest_window_t *w, const bg_step_t *
 }
 
 /* Centre later windows on the latest trusted K (T_R valid: R_S may be
- * refused for its own bound while K1, K2 are well determined); tell the
- * angle observer whether the speed is steady; clear the buffer and release
- * it to the ISR. */
-static void release_window(imest_t *s, imest_window_t *w, double m, const bg_step_t *x,
-                           const imest_result_t *out)
+ * refused for its own bound while K1, K2 are well determined); clear the
+ * buffer and release it to the ISR. */
+static void release_window(imest_t *s, imest_window_t *w, double m, const imest_result_t *out)
 {
   if (out->tr_valid) {
     s->last_k1 = (float)out->k1;
     s->last_k2 = (float)out->k2;
   }
   if (s->last_k2 > 0.0f) imest__bg_centre_from_k(w->c0, (double)s->last_k1, (double)s->last_k2, m);
-  /* the angle observer smooths only at a steady speed (src/estimator/isr/isr_angle.h);
-   * the word travels in the buffer, the ISR takes it when it refills it */
-  w->engage = (s->obs.enabled && x->steady) ? 1u : 0u;
   for (unsigned int p = 0; p < IMEST_NACC; ++p) {
     w->sum[p] = 0;
     w->blk[p] = 0;
@@ -211,6 +202,6 @@ int imest_background(imest_t *s, imest_result_t *out)
   result_from_solve(&x, s, &so, out);
   imest__bg_judge(s, w, &x.st, &x.sums, &so, x.steady, out);
   combine_after(s, w, &x, out);
-  release_window(s, w, m, &x, out);
+  release_window(s, w, m, out);
   return 1;
 }
