@@ -429,6 +429,9 @@ static int parse_preset(int argc, char **argv, imsim_config_t *c, char *err, siz
   for (int a = 1; a < argc; ++a) {
     const char *arg = argv[a];
     const char *val = NULL;
+    // argv[a] for a < argc is never NULL (C11 5.1.2.2.1); the analyzer infers one from the test of
+    // val = argv[a + 1] below
+    // NOLINTNEXTLINE(clang-analyzer-core.NonNullParamChecker): see the line above
     if (strncmp(arg, "--preset=", 9) == 0)
       val = arg + 9;
     else if (strcmp(arg, "--preset") == 0) {

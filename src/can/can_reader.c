@@ -60,7 +60,7 @@ static unsigned int close_window(imest_can_rx_t *rx, imest_can_window_t *out, im
   const imest_can_window_t *w = &rx->cur;
   const unsigned int n = (unsigned int)IMEST_CAN_NFRAMES;
   unsigned int ev = IMEST_CAN_EV_WINDOW;
-  const int have_seq = (w->have >> IMEST_CAN_FRAME_STAT) & 1u;
+  const int have_seq = (int)((w->have >> IMEST_CAN_FRAME_STAT) & 1u);
   const uint32_t seq = w->result.seq;
   int restart = 0;
 

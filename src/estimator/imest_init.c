@@ -123,6 +123,7 @@ static int check_ok(const check_t *c, float x, float fs)
   return !(c->below > 0.0f && !(ax < c->below));
 }
 
+// NOLINTNEXTLINE(readability-function-cognitive-complexity): a flat else-if list, one bound per field
 int imest_config_check(const imest_config_t *cfg, const char **field)
 {
   if (cfg == NULL) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -280,7 +281,7 @@ TEST(CanCodec, NonFiniteAndOutOfRangeFloats)
   EXPECT_EQ(w.result.rs_ohm, -static_cast<double>(FLT_MAX));
   EXPECT_EQ(w.sat, IMEST_CAN_SAT_TR | IMEST_CAN_SAT_RS);
 
-  r.tr_s = -INFINITY;
+  r.tr_s = -std::numeric_limits<double>::infinity();
   r.rs_ohm = static_cast<double>(FLT_MAX); // the largest in-range value is not saturated
   w = roundtrip(r);
   EXPECT_TRUE(std::isinf(w.result.tr_s) && w.result.tr_s < 0);

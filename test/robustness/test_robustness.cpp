@@ -376,7 +376,8 @@ TEST(RobustEncoder, OneCountGlitchesDoNotMatter)
   r.run(3);
   const double pre = mean_tr(r, 1, 2);
   r.run(4, [&](Sample &s) {
-    if (s.window >= 3 && s.pos % 97 == 0) s.theta = wrap(s.theta + ((s.pos / 97) % 2 ? 1 : -1) * k2Pi / 4096);
+    if (s.window >= 3 && s.pos % 97 == 0)
+      s.theta = wrap(s.theta + ((s.pos / 97) % 2 ? 1.0f : -1.0f) * k2Pi / 4096);
   });
   for (uint32_t k = 3; k <= 6; ++k) {
     ASSERT_NE(r.window(k), nullptr);

@@ -24,6 +24,7 @@ int parse(std::vector<std::string> in, imsim_config_t &c, imsim_cli_opts_t &o, s
   args = std::move(in);
   args.insert(args.begin(), "imest-sim");
   std::vector<char *> argv;
+  argv.reserve(args.size());
   for (auto &a : args) argv.push_back(a.data());
   char e[256];
   const int r = imsim_cli_parse(int(argv.size()), argv.data(), &c, &o, e, sizeof e);

@@ -20,7 +20,7 @@ Err compare(imsim_config_t fast, double seconds, int ref_substeps)
   imsim_sample_t x, y;
   Err e{0, 0, 0, 0, 0};
   if (imsim_init(&a, &fast, &x) != 0 || imsim_init(&b, &ref, &y) != 0) return {1e9, 1e9, 1e9, 1e9, 0};
-  const long n = long(seconds * fast.fs_hz + 0.5);
+  const long n = std::lround(seconds * fast.fs_hz);
   for (long k = 0; k < n; ++k) {
     imsim_step(&a, &x);
     imsim_step(&b, &y);

@@ -14,6 +14,7 @@
 #include "bg_select.h"
 #include "bg_tables.h"
 
+// NOLINTNEXTLINE(bugprone-exception-escape): a benchmark; a JSON or file error ends it in terminate()
 int main(int argc, char **argv)
 {
   const long reps = (argc > 1) ? std::atol(argv[1]) : 20000;

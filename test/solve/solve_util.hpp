@@ -156,6 +156,7 @@ inline bg_sums_t synthetic_sums(std::mt19937_64 &rng, const Motor &mo, double no
   };
   auto mk = [&](double amp, double fmax) {
     std::vector<Sin> v;
+    v.reserve(3);
     for (int k = 0; k < 3; ++k) v.push_back({amp * (0.2 + U(rng)), fmax * (0.05 + U(rng)), 6.283 * U(rng)});
     return v;
   };
@@ -220,6 +221,7 @@ inline bg_sums_t eiv_sums(std::mt19937_64 &rng, const Motor &mo, double d2_noise
   };
   auto mk = [&](double amp, double fmax) {
     std::vector<Sin> v;
+    v.reserve(3);
     for (int k = 0; k < 3; ++k) v.push_back({amp * (0.2 + U(rng)), fmax * (0.05 + U(rng)), 6.283 * U(rng)});
     return v;
   };

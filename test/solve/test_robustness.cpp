@@ -82,9 +82,9 @@ TEST(Robustness, GarbageSums)
   std::normal_distribution<double> N(0, 1);
   std::uniform_real_distribution<double> U(0, 1);
   int n_ok = 0, n = 0;
+  const double inf = std::numeric_limits<double>::infinity();
   const double specials[] = {
-      0.0, std::numeric_limits<double>::quiet_NaN(), INFINITY, -INFINITY, 1e308, -1e308, 1e-308, 5e-324, 1.0,
-      -1.0};
+      0.0, std::numeric_limits<double>::quiet_NaN(), inf, -inf, 1e308, -1e308, 1e-308, 5e-324, 1.0, -1.0};
   for (double v : specials) {
     check(fill(v), cfg, "constant", &n_ok);
     ++n;

@@ -103,7 +103,7 @@ Poly make_poly(std::mt19937_64 &rng, int family)
     return p;
   }
   case 1: { // separated positive roots in [1e-3, 1e3]
-    const int np = (int)(U(rng) * std::min(deg, 8) + 0.5);
+    const int np = (int)std::lround(U(rng) * std::min(deg, 8));
     for (int k = 0; k < np; ++k) real.push_back(logu(-3, 3));
     fill_rest(np);
     break;

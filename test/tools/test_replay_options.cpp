@@ -25,6 +25,7 @@ Parsed parse(const std::vector<std::string> &extra)
   args.insert(args.end(), extra.begin(), extra.end());
   args.push_back("x.csv");
   std::vector<char *> argv;
+  argv.reserve(args.size());
   for (auto &a : args) argv.push_back(a.data());
   Parsed p;
   p.rc = replay_parse((int)argv.size(), argv.data(), &p.o);

@@ -52,7 +52,7 @@ inline Out run(const std::string &cmd)
 
 inline std::string write(const std::string &name, const std::string &text)
 {
-  const std::string p = tmpdir() + "/" + name;
+  std::string p = tmpdir() + "/" + name; // not const: returned by move
   std::ofstream(p) << text;
   return p;
 }

@@ -920,7 +920,7 @@ int main(int argc, char **argv)
   }
   static job_t jobs[NEXP];
   pthread_t th[NEXP];
-  int started[NEXP];
+  int started[NEXP] = {0}; /* start_jobs stops at a failed thread: the rest stay 0 */
   const double t0 = now_s();
   const int bad_start = start_jobs(&o, &k, jobs, th, started);
   wait_jobs(&o, jobs, th, started, t0);

@@ -129,10 +129,12 @@ static void fmt_reason(char *buf, size_t n, int have, int reason)
 static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
 {
   const imest_result_t *r = &w->result;
-  const int h_tr = (w->have >> IMEST_CAN_FRAME_TR) & 1u, h_rs = (w->have >> IMEST_CAN_FRAME_RS) & 1u;
-  const int h_q = (w->have >> IMEST_CAN_FRAME_QUAL) & 1u, h_st = (w->have >> IMEST_CAN_FRAME_STAT) & 1u;
-  const int h_v = (w->have >> IMEST_CAN_FRAME_VERDICT) & 1u;
-  const int h_b = (w->have >> IMEST_CAN_FRAME_BOUNDS) & 1u;
+  const int h_tr = (int)((w->have >> IMEST_CAN_FRAME_TR) & 1u);
+  const int h_rs = (int)((w->have >> IMEST_CAN_FRAME_RS) & 1u);
+  const int h_q = (int)((w->have >> IMEST_CAN_FRAME_QUAL) & 1u);
+  const int h_st = (int)((w->have >> IMEST_CAN_FRAME_STAT) & 1u);
+  const int h_v = (int)((w->have >> IMEST_CAN_FRAME_VERDICT) & 1u);
+  const int h_b = (int)((w->have >> IMEST_CAN_FRAME_BOUNDS) & 1u);
   const unsigned int sat = w->sat;
   char seq[16], tr[32], rs[32], ei[32], valid[8], status[32], pk1[32], pk2[32];
   char nr[8], na[8], flags[16], satb[8], txf[16];

@@ -134,6 +134,9 @@ BG_NOINLINE static int crossing(pe_ctx_t *c, double xs, double fs, double d0, do
 
 /* Maximum of kbound(., sign) on [a, b] by successive parabolic interpolation
  * from x0 with spacing h (see the file comment). */
+// One numeric iteration on shared state: a split would move arithmetic across calls (FMA
+// contraction; the results must stay bit-identical).
+// NOLINTNEXTLINE(readability-function-cognitive-complexity): see the line above
 BG_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, double x0, double h)
 {
   if (!(b > a)) return kbound(c, a, sign);

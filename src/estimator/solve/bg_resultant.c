@@ -27,6 +27,7 @@ void imest__bg_resultant(const bg_tables_t *t, double r[22], int generic)
   /* a1 a1, symmetric: diagonal plus twice each off-diagonal product */
   for (int k = 0; k < 13; ++k) sq[k] = 0.0;
   for (int i = 0; i < 7; ++i) {
+    // NOLINTNEXTLINE(bugprone-implicit-widening-of-multiplication-result): i < 7, 2 * i cannot overflow
     sq[2 * i] += t->a1[i] * t->a1[i];
     const double ai2 = 2.0 * t->a1[i];
     for (int j = i + 1; j < 7; ++j) sq[i + j] += ai2 * t->a1[j];

@@ -274,6 +274,9 @@ BG_NOINLINE static double newton_bracketed(const double *c, int n, int order, do
 
 /* Find a float64 sign change of p^(order) on [a,b] or a widening of it within
  * [lo,hi]; then polish. Returns 1 and *root on success. */
+// One numeric iteration on shared state: a split would move arithmetic across calls (FMA
+// contraction; the results must stay bit-identical).
+// NOLINTNEXTLINE(readability-function-cognitive-complexity): see the line above
 BG_NOINLINE static int polish_order(const double *c, int n, int order, double a, double b, double lo,
                                     double hi, double *root, bg_roots_stats_t *st)
 {
@@ -355,6 +358,9 @@ static int polish(const double *c, int n, double a, double b, double lo, double 
 
 /* Refine one interval (count >= 1) in chain precision and polish it in float64.
  * Returns 0 (rejected), 1 (float64 sign change: odd multiplicity) or 2 (even). */
+// One numeric iteration on shared state: a split would move arithmetic across calls (FMA
+// contraction; the results must stay bit-identical).
+// NOLINTNEXTLINE(readability-function-cognitive-complexity): see the line above
 BG_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t iv, double *root,
                               bg_roots_stats_t *st)
 {
@@ -523,6 +529,9 @@ BG_NOINLINE static void merge_root(double x, double *roots, int *nr, int max, bg
   if (*nr < max) ++*nr;
 }
 
+// The input checks, the normalisation and the domain loop share their state: a split would move
+// arithmetic across calls (FMA contraction; the results must stay bit-identical).
+// NOLINTNEXTLINE(readability-function-cognitive-complexity): see the line above
 int imest__bg_roots_positive_ex(const double *c, int deg, double *roots, int max, bg_roots_stats_t *st)
 {
   bg_roots_stats_t dummy;

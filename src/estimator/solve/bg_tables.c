@@ -125,16 +125,16 @@ int imest__bg_tables_build(const bg_sums_t *in, double tr_nominal_s, bg_tables_t
   return IMEST_OK;
 }
 
-void imest__bg_tables_values(const bg_tables_t *t, double x, double v[3])
+void imest__bg_tables_values(const bg_tables_t *t, double kappa, double v[3])
 {
   double p2 = t->e2[6], p1 = t->e1[7], p0 = t->e0[8];
-  p1 = p1 * x + t->e1[6];
-  p0 = p0 * x + t->e0[7];
-  p0 = p0 * x + t->e0[6];
+  p1 = p1 * kappa + t->e1[6];
+  p0 = p0 * kappa + t->e0[7];
+  p0 = p0 * kappa + t->e0[6];
   for (int m = 5; m >= 0; --m) {
-    p2 = p2 * x + t->e2[m];
-    p1 = p1 * x + t->e1[m];
-    p0 = p0 * x + t->e0[m];
+    p2 = p2 * kappa + t->e2[m];
+    p1 = p1 * kappa + t->e1[m];
+    p0 = p0 * kappa + t->e0[m];
   }
   v[0] = p2;
   v[1] = p1;

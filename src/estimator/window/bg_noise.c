@@ -27,11 +27,11 @@ typedef struct {
 
 static float bw3_step(const imest_bw3_t *f, bw3_state_t *c, float x)
 {
-  const float t = f->b0 * x, v = t + c->s1;
-  c->s1 = t - f->a1 * v;
-  const float t2 = f->c0 * v, y = t2 + c->s2a;
-  c->s2a = (t2 + t2) - f->d1 * y + c->s2b;
-  c->s2b = t2 - f->d2 * y;
+  const float t = (float)(f->b0 * x), v = t + c->s1;
+  c->s1 = (float)(t - f->a1 * v);
+  const float t2 = (float)(f->c0 * v), y = t2 + c->s2a;
+  c->s2a = (float)((t2 + t2) - f->d1 * y + c->s2b);
+  c->s2b = (float)(t2 - f->d2 * y);
   return y;
 }
 
@@ -102,7 +102,7 @@ void imest__bg_noise_estimate(const imest_t *s, const imest_window_t *w, const b
   nz->steady = steady;
   /* the columns W1 W2 W4 W5 W6 W7 W8 y in one row (docs/METHOD.md §2, b = n w' = 0) */
   const float a = (float)(np * st->w_mean), a2 = a * a, a3 = a2 * a;
-  const float m = s->m, m1 = 1.0f + m;
+  const float m = (float)s->m, m1 = 1.0f + m;
   static const coef_t zero = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, {0.0f, 0.0f}};
   coef_t c[8];
   for (unsigned int k = 0; k < 8u; ++k) c[k] = zero;
@@ -124,7 +124,7 @@ void imest__bg_noise_estimate(const imest_t *s, const imest_window_t *w, const b
   c[7].cross[1] = -a;
   c[7].v[1] = -1.0f;
 
-  const float inv_s = s->inv_s;
+  const float inv_s = (float)s->inv_s;
   const float vi = (float)nz->var_i, vv = (float)nz->var_u * inv_s * inv_s;
   const float *g = s->noise_g;
   const float twice_n = (float)(2.0 * n); /* two rows, every sample */

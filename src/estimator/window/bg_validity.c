@@ -57,10 +57,10 @@ static void operating_point(const imest_t *s, const bg_window_stats_t *st, const
 {
   const float n = nreg > 0u ? (float)nreg : 1.0f;
   const float slip_rate = (float)st->slip_rate;
-  op->we = slip_rate + s->n * (float)st->w_mean;
+  op->we = (float)(slip_rate + s->n * (float)st->w_mean);
   op->slip = fabsf(op->we) > 0.0f ? slip_rate / op->we : 0.0f;
   /* W1.W4 - W2.W4 = u.i / (sigma L_S) exactly (i_perp.i = 0) */
-  op->p_w = (float)(sm->rw[0][3] - sm->rw[1][3]) / s->inv_s / n;
+  op->p_w = (float)((float)(sm->rw[0][3] - sm->rw[1][3]) / s->inv_s / n);
   const float i2 = fmaxf((float)sm->rw[3][3] / n, 0.0f), u2 = fmaxf(2.0f * (float)st->u_ms, 0.0f);
   op->i2 = i2;
   op->s_va = sqrtf(i2 * u2); /* balanced: |u|^2 = 2 u_alpha^2 */
@@ -181,8 +181,8 @@ static float gain_mismatch(const imest_window_t *w, const bg_sums_t *sm)
 {
   const float s2 = (float)sm->rw[3][3];
   if (!(s2 > 0.0f)) return 0.0f;
-  const float ca = w->sum[IMEST_ACC_I0A] + w->blk[IMEST_ACC_I0A];
-  const float cb = w->sum[IMEST_ACC_I0B] + w->blk[IMEST_ACC_I0B];
+  const float ca = (float)(w->sum[IMEST_ACC_I0A] + w->blk[IMEST_ACC_I0A]);
+  const float cb = (float)(w->sum[IMEST_ACC_I0B] + w->blk[IMEST_ACC_I0B]);
   return IMEST_SQRT3_2_F * sqrtf(ca * ca + cb * cb) / s2;
 }
 
