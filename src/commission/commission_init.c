@@ -36,6 +36,7 @@ static int pos(float x)
   return isfinite(x) && x > 0.0f;
 }
 
+// NOLINTNEXTLINE(readability-function-cognitive-complexity): a flat else-if list, one bound per field
 int imest_comm_config_check(const imest_comm_config_t *cc, const char **field)
 {
   const char *bad = NULL;

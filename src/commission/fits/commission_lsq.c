@@ -6,6 +6,9 @@
 
 #include "commission_internal.h"
 
+// The textbook Cholesky loops (factor, two substitutions, the inverse's diagonal) stay one function:
+// split, the arithmetic would cross calls.
+// NOLINTNEXTLINE(readability-function-cognitive-complexity)
 int imest__cm_chol_solve(double a[CM_LSQ_MAX][CM_LSQ_MAX], double b[CM_LSQ_MAX], unsigned int n,
                          double dinv[CM_LSQ_MAX])
 {

@@ -19,6 +19,8 @@ static uint32_t pulse_len(const imest_comm_t *c)
   return n < 4u ? 4u : n;
 }
 
+// A per-sample stage as one switch over its steps: the ISR path, its instruction count budgeted.
+// NOLINTNEXTLINE(readability-function-cognitive-complexity)
 void imest__cm_stage_wiring(imest_comm_t *c, const float m[3], float vdc)
 {
   float u = 0.0f;
