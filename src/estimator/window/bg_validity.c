@@ -396,8 +396,9 @@ static int rs_verdict(judge_t *j)
  * model's harmonics) and R_S's: the voltage's uncertainty (the inverter
  * model's, or none known), the timing's, the staircase's, the current
  * sensors' gain mismatch (|E| |Z| / R_S, measured: the paper motor, 1 %
- * between two sensors, R_S -3.5 %). Infinite without an estimate. */
-static void bounds(judge_t *j, const bg_sums_t *sm)
+ * between two sensors, R_S -3.5 %). Infinite without an estimate (have: the
+ * solve gave a positive, finite T_R). */
+static void bounds(judge_t *j, const bg_sums_t *sm, int have)
 {
   imest_result_t *r = j->r;
   const float mism = gain_mismatch(j->w, sm);
@@ -405,7 +406,6 @@ static void bounds(judge_t *j, const bg_sums_t *sm)
   j->tr_b = INFINITY;
   j->rs_b = INFINITY;
   j->g_b = 0.0f;
-  const int have = j->so->status == IMEST_OK && isfinite(r->tr_s) && r->tr_s > 0.0;
   if (have && isfinite(r->rs_ohm) && r->rs_ohm > 0.0) {
     const float rs = (float)r->rs_ohm;
     float harm_v;
@@ -433,7 +433,7 @@ void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_
    * T_R (the motor's, for any size; the nominal T_R where there is none). */
   r->slip_ratio = (double)(fabsf((float)st->slip_rate) * (have ? (float)r->tr_s : s->tr_nominal_s));
   r->ls_noload_h = (double)NAN; /* the no-load check fills it where it runs */
-  bounds(&j, sm);
+  bounds(&j, sm, have);
   const int status = tr_verdict(&j);
   const int rs_status = status != IMEST_REASON_NONE ? status : rs_verdict(&j);
   r->tr_reason = status;
