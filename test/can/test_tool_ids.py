@@ -89,6 +89,22 @@ for rl, ml in zip(rep_out.splitlines()[1:], mon_out.splitlines()[1:]):
             step = {"E_I": 1e-4, "span_s": 1e-3}.get(c, 0.0 if c in ("T_R_s", "R_S_ohm") else 2e-5)
             check(a == b or (math.isnan(a) and math.isnan(b)) or abs(a - b) <= max(step, 1e-6 * abs(b)),
                   f"{c}: monitor {m[c]} replay {r[c]}")
+# --require-valid: exit 3 when no window has the column at 1, 0 otherwise; without it 0
+short = os.path.join(work, "ids_short.csv")
+with open(rec) as fh, open(short, "w") as out_f:
+    out_f.writelines(fh.readlines()[:4001])  # one window, started mid-run: warmup, not valid
+for which, col in (("", "valid"), ("=tr", "tr_valid"), ("=rs", "rs_valid")):
+    rc, out, err = run([replay] + MOTOR + ["--from-rest", "no", "--require-valid" + which, short])
+    check(rc == 3 and len(out.splitlines()) == 2 and f"none of the 1 window(s) has {col} = 1" in err,
+          f"replay --require-valid{which} on a warm-up window: rc {rc} {err}")
+rc, out, err = run([replay] + MOTOR + ["--from-rest", "no", short])
+check(rc == 0, f"replay without --require-valid, no window valid: rc {rc} {err}")
+rc, out, err = run([replay] + MOTOR + ["--require-valid=both", short])
+check(rc == 2 and "takes valid, tr or rs" in err, f"replay --require-valid=both: rc {rc} {err}")
+valid_any = any(line.split(",")[4] == "1" for line in rep_out.splitlines()[1:])
+rc, out, err = run([replay] + MOTOR + ["--require-valid", rec])
+check(rc == (0 if valid_any else 3), f"replay --require-valid on {rec}: rc {rc} {err}")
+
 rc, out, err = run([replay] + MOTOR + ["--candump", log, "--can-iface", "vcan0", rec])
 check(rc == 2 and "--can-iface is now --candump-iface" in err and out == "", f"replay --can-iface: rc {rc} {err}")
 

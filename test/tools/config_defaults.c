@@ -9,7 +9,10 @@
 
 #include "imest/imest.h"
 
-#define F(name) {#name, offsetof(imest_config_t, name)}
+#define F(name)                                                                                              \
+  {                                                                                                          \
+#name, offsetof(imest_config_t, name)                                                                    \
+  }
 
 static const struct {
   const char *name;

@@ -226,7 +226,7 @@ def main():
     stated += [("fw/README.md", m) for m in re.findall(r"`sizeof\(imest_t\)`\) \|[^|]*\| (\d+) ", fw)]
     stated += [("include/imest/imest_instance.h", m) for m in re.findall(r"sizeof\(imest_t\) is (\d+) B", inst)]
     if len(stated) < 4:
-        fails.append("sizeof(imest_t): found %d statements of it, expected 4 (README x2, fw/README, "
+        fails.append("sizeof(imest_t): found %d statements of it, expected 4 (README.md x2, fw/README.md, "
                      "imest_instance.h)" % len(stated))
     for where, m in stated:
         checked.append((where, "sizeof(imest_t)", int(m), size))

@@ -9,8 +9,8 @@
 
 /* Exit codes of every imest tool. */
 enum {
-  TOOL_EXIT_OK = 0,   /* success */
-  TOOL_EXIT_DATA = 1, /* the input or data is unusable (bad content, nothing decoded, I/O) */
+  TOOL_EXIT_OK = 0,       /* success */
+  TOOL_EXIT_DATA = 1,     /* the input or data is unusable (bad content, nothing decoded, I/O) */
   TOOL_EXIT_USAGE = 2,    /* bad option or argument */
   TOOL_EXIT_NOT_VALID = 3 /* --require-valid: windows estimated or decoded, none valid */
 };

@@ -149,10 +149,10 @@ static void fmt_reason(char *buf, size_t n, int have, int reason)
 static const struct {
   unsigned int bit;
   const char *column;
-} k_clamp[] = {{IMEST_CAN_SAT_TR, "T_R_s"},          {IMEST_CAN_SAT_RS, "R_S_ohm"},
-               {IMEST_CAN_SAT_EI, "E_I"},            {IMEST_CAN_SAT_PEK1, "pe_k1_rel"},
-               {IMEST_CAN_SAT_PEK2, "pe_k2_rel"},    {IMEST_CAN_SAT_SPAN, "span_s"},
-               {IMEST_CAN_SAT_TRB, "tr_bound_rel"},  {IMEST_CAN_SAT_RSB, "rs_bound_rel"}};
+} k_clamp[] = {{IMEST_CAN_SAT_TR, "T_R_s"},         {IMEST_CAN_SAT_RS, "R_S_ohm"},
+               {IMEST_CAN_SAT_EI, "E_I"},           {IMEST_CAN_SAT_PEK1, "pe_k1_rel"},
+               {IMEST_CAN_SAT_PEK2, "pe_k2_rel"},   {IMEST_CAN_SAT_SPAN, "span_s"},
+               {IMEST_CAN_SAT_TRB, "tr_bound_rel"}, {IMEST_CAN_SAT_RSB, "rs_bound_rel"}};
 
 /* A CSV cell: the number (a clamped one as its limit: the 'clamped' column
  * says so), empty when its frame is missing. */
@@ -176,7 +176,8 @@ static void csv_reason(int have, int reason)
 
 /* One CSV row: imest-replay's columns and order for what the frames carry
  * (print_header lists them), then the monitor's own. */
-static void print_csv_row(const imest_can_window_t *w, double t, int h_tr, int h_rs, int h_q, int h_v, int h_b)
+static void print_csv_row(const imest_can_window_t *w, double t, int h_tr, int h_rs, int h_q, int h_v,
+                          int h_b)
 {
   const imest_result_t *r = &w->result;
   const int h_st = (int)((w->have >> IMEST_CAN_FRAME_STAT) & 1u);
@@ -220,7 +221,8 @@ static void count_valid(monitor_t *m, const imest_can_window_t *w, int h_q, int 
 {
   const imest_result_t *r = &w->result;
   if ((m->require == TOOL_REQUIRE_VALID && h_q && r->valid) ||
-      (m->require == TOOL_REQUIRE_TR && h_v && r->tr_valid) || (m->require == TOOL_REQUIRE_RS && h_v && r->rs_valid))
+      (m->require == TOOL_REQUIRE_TR && h_v && r->tr_valid) ||
+      (m->require == TOOL_REQUIRE_RS && h_v && r->rs_valid))
     m->n_valid++;
 }
 
@@ -512,8 +514,8 @@ static int finish(monitor_t *m, int live)
     return TOOL_EXIT_DATA;
   }
   if (m->require != TOOL_REQUIRE_NONE && m->n_valid == 0u) {
-    fprintf(stderr, "imest-monitor: --require-valid: none of the %lu window(s) decoded has %s = 1\n", m->windows,
-            tool_require_column(m->require));
+    fprintf(stderr, "imest-monitor: --require-valid: none of the %lu window(s) decoded has %s = 1\n",
+            m->windows, tool_require_column(m->require));
     return TOOL_EXIT_NOT_VALID;
   }
   return TOOL_EXIT_OK;
