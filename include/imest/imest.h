@@ -234,15 +234,15 @@ typedef struct {
    *  a period (50 us at 10 kHz): uncompensated, that biases R_S by about +5 % at 30 Hz. Compensated
    *  by linear interpolation of whichever side leads. */
   float u_delay_s;
-  /** cut-off [Hz] of a first-order high-pass applied alike to the alpha/beta voltages and currents
-   *  before the rotation: it removes sensor offsets (default 1; 0 = off). Applied to both, it
-   *  leaves the motor's equations intact at constant speed; see README "Method" (sensor offsets).
-   *  The first start (unless start_at_rest) waits 5 time constants more for it: 0.8 s at 1 Hz. */
   /** natural frequency [Hz] of the tracking observer between the encoder and the rotation
    *  (src/estimator/isr/isr_angle.h), engaged while the speed is steady: it attenuates an encoder's
    *  quantisation steps above this (1024 counts, paper motor at 30 Hz: R_S +6.6 % -> -0.02 %)
    *  (default 0: filter_hz / 4; negative: off, the encoder angle as it is; at most fs_hz / 4) */
   float angle_observer_hz;
+  /** cut-off [Hz] of a first-order high-pass applied alike to the alpha/beta voltages and currents
+   *  before the rotation: it removes sensor offsets (default 1; 0 = off). Applied to both, it
+   *  leaves the motor's equations intact at constant speed; see README "Method" (sensor offsets).
+   *  The first start (unless start_at_rest) waits 5 time constants more for it: 0.8 s at 1 Hz. */
   float dc_block_hz;
   /** samples discarded after start/fault while the filters settle [s] (default 0: derived from
    *  filter_hz) */
@@ -292,8 +292,8 @@ typedef struct {
   float rs_nominal_ohm;
 
   /* Input plausibility (per sample, ISR). */
-  float i_limit_a;  /**< |phase current| >= this counts as ADC saturation (0 = off) */
-  float u_limit_v;  /**< |phase voltage| >= this counts as ADC saturation (0 = off) */
+  float i_limit_a;  /**< |phase current| >= this counts as ADC saturation (default 0 = off) */
+  float u_limit_v;  /**< |phase voltage| >= this counts as ADC saturation (default 0 = off) */
   float i_absurd_a; /**< |current| beyond this (or non-finite) is an input fault (default 1e4) */
   float u_absurd_v; /**< |voltage| beyond this (or non-finite) is an input fault (default 1e5) */
   /** |mechanical angle step| * fs beyond this is an encoder fault (default 3000 rad/s, about 28 600

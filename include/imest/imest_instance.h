@@ -122,7 +122,10 @@ typedef struct {
   uint32_t centred; /**< every window had the same centring: rwe, ree hold */
 } imest_combo_t;
 
-/** Estimator instance. All fields are private; sizes are what the ISR needs. */
+/** Estimator instance. All fields are private; sizes are what the ISR needs.
+ *  sizeof(imest_t) is 1928 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
+ *  fw/README.md) and on an x86-64 host too (every member is 32-bit: no pointers, no padding that
+ *  differs); the test tools_documented_defaults checks this figure against the host's sizeof. */
 typedef struct {
   /* init: constants derived by imest_init(), read by both contexts */
   imest_real_t fs, inv2t, invt2;                    /* fs, 1/(2T), 1/T^2 */

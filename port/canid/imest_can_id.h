@@ -2,12 +2,12 @@
 /**
  * @file imest_can_id.h
  * @brief Host tools: one parser for the CAN base identifier given on a
- *        command line (imest-monitor --base-id, imest-replay --can-id, the
+ *        command line (--can-base-id of imest-monitor and imest-replay, the
  *        test publisher), so every tool takes the same spellings.
  *
  *   "0x6A0", "1696"      11-bit standard identifier (default kind up to 0x7FF)
  *   "0x18FF5000"         above 0x7FF: a 29-bit extended identifier, automatically
- *   "0x100" + force_ext  a small number as a 29-bit extended identifier (--ext)
+ *   "0x100" + force_ext  a small number as a 29-bit extended identifier (--can-ext)
  *   "0x98FF5000"         bit 31 set (Linux CAN_EFF_FLAG, imest's IMEST_CAN_ID_EXT):
  *                        the extended identifier 0x18FF5000, as older scripts wrote it
  *
@@ -30,7 +30,7 @@ extern "C" {
  * Parse a base identifier.
  * @param text        the option's value
  * @param force_ext   nonzero: extended even if the number fits 11 bits
- * @param ext_option  the tool's name for force_ext (e.g. "--ext"), used in messages
+ * @param ext_option  the tool's name for force_ext (e.g. "--can-ext"), used in messages
  * @param base_id     receives the identifier, | IMEST_CAN_ID_EXT when extended
  * @param err, n      receive a message naming the problem and the remedy on error
  * @retval IMEST_OK        parsed

@@ -43,7 +43,8 @@ static const char USAGE[] =
     "                        rated load, 390 V 50 Hz, 10 s (see sim/README.md, Presets)\n"
     "  --duration S          simulated time, rows t = 0 .. S (exp1 2, exp2 3600)\n"
     "  --fs HZ               sample rate (4000)\n"
-    "  --out FILE            output file, '-' = stdout (-)\n"
+    "  -o, --output FILE     output file, '-' = stdout (-); --out FILE is the same (the older\n"
+    "                        spelling; in the other tools --out names a folder)\n"
     "  --decimate N          write every N-th sample (1)\n"
     "  --progress, --no-progress   bar on stderr (default: when stderr is a terminal)\n"
     "  -h, --help            this text\n"
@@ -269,7 +270,7 @@ static void *field(imsim_config_t *c, size_t off)
 static const char *const SWITCH_FLAGS[] = {"--help",        "--version",          "--ideal-sensors",
                                            "--no-thermal",  "--ifoc-ideal-stage", "--progress",
                                            "--no-progress", "--pwm-segments"};
-static const char *const OTHER_FLAGS[] = {"--preset", "--out", "--decimate", "--seed"};
+static const char *const OTHER_FLAGS[] = {"--preset", "--output", "--out", "--decimate", "--seed"};
 
 size_t imsim_cli_flags(const char **names, size_t max)
 {
@@ -323,7 +324,7 @@ static int parse_valued(const char *name, const char *val, imsim_config_t *c, im
                         size_t errlen)
 {
   if (strcmp(name, "--preset") == 0) return 0; /* applied in the first pass */
-  if (strcmp(name, "--out") == 0) {
+  if (strcmp(name, "--output") == 0 || strcmp(name, "--out") == 0) {
     if (val[0] == '\0') return perr(err, errlen, "empty value for ", name);
     o->out = val;
     return 0;
@@ -461,6 +462,12 @@ int imsim_cli_parse(int argc, char **argv, imsim_config_t *c, imsim_cli_opts_t *
     const char *arg = argv[a];
     if (strcmp(arg, "-h") == 0) {
       o->help = 1;
+      continue;
+    }
+    if (strcmp(arg, "-o") == 0) { /* -o FILE: --output FILE */
+      if (a + 1 >= argc) return perr(err, errlen, "missing value for ", arg);
+      const int r = parse_valued("--output", argv[++a], c, o, err, errlen);
+      if (r != 0) return -1;
       continue;
     }
     if (strncmp(arg, "--", 2) != 0) {

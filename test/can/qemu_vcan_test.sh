@@ -10,7 +10,7 @@
 # can-raw, and two statically linked programs of this project:
 #   imest-can-selftest  an imest instance with the SocketCAN port attached,
 #                       publishing N synthetic windows via imest_can_publish
-#   imest-monitor       reading vcan0 live (--iface vcan0 --csv)
+#   imest-monitor       reading vcan0 live (--can-iface vcan0 --csv)
 # The guest prints the monitor's CSV and messages on its serial console; the
 # host compares the CSV with the same windows decoded from a candump log
 # written by the same selftest on the host (every column but t_s), and checks
@@ -109,7 +109,7 @@ ip link set up lo
 for i in nosuch0 lo vcan1; do
   imest-can-selftest --iface \$i --count 1 2>/tmp/e; echo "IMEST-ERRPATH \$i rc=\$?: \$(cat /tmp/e)"
 done
-imest-monitor --iface vcan0 --csv --count $N --timeout 30 >/tmp/mon.csv 2>/tmp/mon.err &
+imest-monitor --can-iface vcan0 --csv --count $N --timeout 30 >/tmp/mon.csv 2>/tmp/mon.err &
 MON=\$!
 i=0
 while ! grep -q listening /tmp/mon.err; do

@@ -215,21 +215,26 @@ def same_float(a, b):
     return a == b
 
 
-def c_value(text, sat_bit_set, field, k):
-    """The C decoder's text: a bound ('>x', '<x') exactly when saturated."""
-    bound = text[:1] in "<>" and text != ""
-    check(bound == sat_bit_set, f"window {k}: {field} printed {text!r}, saturation bit {sat_bit_set}")
-    return float(text[1:] if bound else text)
+def c_value(text, sat_bit_set, field, k, clamped=None):
+    """The C decoder's cell: a number (a clamped one as its field's limit), its column
+    named in 'clamped' exactly when saturated."""
+    check(text[:1] not in "<>", f"window {k}: {field} printed {text!r}: a number, not a bound")
+    if clamped is not None:
+        check((field in clamped.split(";")) == sat_bit_set,
+              f"window {k}: {field} in clamped {clamped!r}, saturation bit {sat_bit_set}")
+    return float(text)
 
 
-def scaled(w, name, row_val, sat_name, k):
+def scaled(w, name, row, col, sat_name, k):
+    row_val = row[col]
     dec = w[name]
     sat = bool(int(w[sat_name].raw_value))
     if int(dec.raw_value) == 65535:
         check(row_val == "nan", f"window {k}: {name} raw 65535 (n/a) but C printed {row_val}")
     else:
         phys = float(dec.phys_value)
-        check(abs(phys - c_value(row_val, sat, name, k)) <= 1e-9, f"window {k}: {name} DBC {phys} C {row_val}")
+        check(abs(phys - c_value(row_val, sat, col, k, row["clamped"])) <= 1e-9,
+              f"window {k}: {name} DBC {phys} C {row_val}")
 
 
 def reason(w, name, row_val, k):
@@ -240,21 +245,23 @@ def reason(w, name, row_val, k):
 
 for k, (w, row) in enumerate(zip(windows, rows)):
     check(sorted(w["_ids"]) == list(range(NF)), f"window {k}: frames {w['_ids']}")
-    check(row["frames"] == "0x%X" % ((1 << NF) - 1), f"window {k}: frames mask {row['frames']}")
+    check(row["frames"] == "0x%x" % ((1 << NF) - 1), f"window {k}: frames mask {row['frames']}")
     check(abs(w["t"] - float(row["t_s"])) < 1e-6, f"window {k}: t {w['t']} vs {row['t_s']}")
     check(int(w["Seq"].raw_value) == int(row["seq"]), f"window {k}: seq")
     tr = float(w["TR_s"].phys_value)
     rs = float(w["RS_ohm"].phys_value)
-    check(same_float(tr, f32(c_value(row["T_R_s"], bool(int(w["Sat_TR"].raw_value)), "T_R", k))),
+    check(same_float(tr, f32(c_value(row["T_R_s"], bool(int(w["Sat_TR"].raw_value)), "T_R_s", k,
+                                     row["clamped"]))),
           f"window {k}: T_R DBC {tr} C {row['T_R_s']}")
-    check(same_float(rs, f32(c_value(row["R_S_ohm"], bool(int(w["Sat_RS"].raw_value)), "R_S", k))),
+    check(same_float(rs, f32(c_value(row["R_S_ohm"], bool(int(w["Sat_RS"].raw_value)), "R_S_ohm", k,
+                                     row["clamped"]))),
           f"window {k}: R_S DBC {rs} C {row['R_S_ohm']}")
-    scaled(w, "EI", row["E_I"], "Sat_EI", k)
-    scaled(w, "PE_K1_rel", row["pe_k1_rel"], "Sat_PE_K1", k)
-    scaled(w, "PE_K2_rel", row["pe_k2_rel"], "Sat_PE_K2", k)
-    scaled(w, "TR_bound_rel", row["tr_bound_rel"], "Sat_TR_bound", k)
-    scaled(w, "RS_bound_rel", row["rs_bound_rel"], "Sat_RS_bound", k)
-    scaled(w, "Span_s", row["span_s"], "Sat_Span", k)
+    scaled(w, "EI", row, "E_I", "Sat_EI", k)
+    scaled(w, "PE_K1_rel", row, "pe_k1_rel", "Sat_PE_K1", k)
+    scaled(w, "PE_K2_rel", row, "pe_k2_rel", "Sat_PE_K2", k)
+    scaled(w, "TR_bound_rel", row, "tr_bound_rel", "Sat_TR_bound", k)
+    scaled(w, "RS_bound_rel", row, "rs_bound_rel", "Sat_RS_bound", k)
+    scaled(w, "Span_s", row, "span_s", "Sat_Span", k)
     check(int(w["Valid"].raw_value) == int(row["valid"]), f"window {k}: valid")
     check(int(w["TR_valid"].raw_value) == int(row["tr_valid"]), f"window {k}: tr_valid")
     check(int(w["RS_valid"].raw_value) == int(row["rs_valid"]), f"window {k}: rs_valid")
@@ -287,8 +294,10 @@ for k, (w, row) in enumerate(zip(windows, rows)):
         # R_S -inf is carried as -inf; RS_reason 300 is out of range; 300 windows -> 255
         check(sat == 0xFD, f"window {k}: saturation bits 0x{sat:X}, expected 0xFD")
         check(tr == 3.4028234663852886e38 and rs == -math.inf, f"window {k}: {tr} {rs}")
-        check(row["T_R_s"].startswith(">") and row["pe_k1_rel"] == ">1.31068"
-              and row["rs_bound_rel"] == "<0.00000" and row["span_s"] == ">65.534", f"window {k}: {row}")
+        check(float(row["T_R_s"]) > 1e38 and row["pe_k1_rel"] == "1.31068"
+              and row["rs_bound_rel"] == "0.00000" and row["span_s"] == "65.534"
+              and row["clamped"] == "T_R_s;E_I;pe_k1_rel;pe_k2_rel;span_s;tr_bound_rel;rs_bound_rel",
+              f"window {k}: {row}")
         check(row["rs_reason"] == "out_of_range" and row["windows"] == "255", f"window {k}: {row}")
     if k % 10 == 7:
         check(row["tr_valid"] == "1" and row["rs_valid"] == "0" and row["rs_reason"] == "rs_out_of_range"

@@ -2,8 +2,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """imest-monitor on candump logs: clean, lost, repeated, corrupted,
 malformed and truncated input, a sender restart, options, exit codes
-(0 decoded, 1 nothing decoded / input error, 2 usage) and the messages that
-say what is wrong when nothing decodes.
+(0 decoded, 1 nothing decoded / input error, 2 usage, 3 --require-valid and
+none valid), the CSV's columns (imest-replay's names and order, numbers only:
+a clamped value is named in 'clamped') and the messages that say what is wrong
+when nothing decodes.
 
 usage: test_monitor.py SELFTEST MONITOR WORKDIR
 """
@@ -16,7 +18,11 @@ os.makedirs(work, exist_ok=True)
 fails = []
 N = 20
 NF = 6  # frames per window
-HEADER = "t_s,seq,T_R_s,R_S_ohm,E_I,valid,status"
+HEADER = "t_s,T_R_s,R_S_ohm,E_I,valid,status,seq"
+# imest-replay's columns the frames carry, in its order (tools/replay/replay.c), then the monitor's own
+COLUMNS = ("t_s,T_R_s,R_S_ohm,E_I,valid,status,seq,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,flags,"
+           "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel,"
+           "clamped,sat,tx_failed,counter,frames")
 
 
 def check(cond, msg):
@@ -55,8 +61,7 @@ check(len(good) == NF * N, f"selftest wrote {len(good)} lines")
 rc, out, err = run(["--log", clean, "--csv"])
 check(rc == 0, f"clean: rc {rc}")
 check(out.splitlines()[0].startswith(HEADER + ","), "CSV header: " + out.splitlines()[0])
-check(out.splitlines()[0].endswith(",tr_valid,tr_reason,rs_valid,rs_reason,tr_bound_rel,rs_bound_rel,span_s,windows"),
-      "CSV header, verdict columns: " + out.splitlines()[0])
+check(out.splitlines()[0] == COLUMNS, "CSV header: " + out.splitlines()[0])
 r = rows(out)
 check(len(r) == N, f"clean: {len(r)} rows")
 check("lost 0, repeated 0, corrupted 0" in err, "clean summary: " + err)
@@ -64,12 +69,24 @@ check("no_root" in out and "high_residual" in out and ",ok," in out, "status nam
 cols = out.splitlines()[0].split(",")
 first = dict(zip(cols, r[0].split(",")))
 check(first["t_s"] == "1700000001.000000" and first["seq"] == "0" and first["valid"] == "1"
-      and first["status"] == "ok" and first["frames"] == "0x3F", f"first row {r[0]}")
-sat_row = dict(zip(cols, r[5].split(",")))  # window 5: every field clamped
-check(sat_row["pe_k1_rel"] == ">1.31068" and sat_row["pe_k2_rel"] == ">1.31068" and sat_row["E_I"] == ">6.5534"
-      and sat_row["T_R_s"].startswith(">") and sat_row["span_s"] == ">65.534"
-      and sat_row["tr_bound_rel"] == ">1.31068" and sat_row["rs_bound_rel"] == "<0.00000",
-      f"saturated values must read as bounds: {r[5]}")
+      and first["status"] == "ok" and first["frames"] == "0x3f" and first["clamped"] == ""
+      and first["sat"] == "0x0", f"first row {r[0]}")
+sat_row = dict(zip(cols, r[5].split(",")))  # window 5: every field but R_S clamped
+check(sat_row["pe_k1_rel"] == "1.31068" and sat_row["pe_k2_rel"] == "1.31068" and sat_row["E_I"] == "6.5534"
+      and float(sat_row["T_R_s"]) > 1e38 and sat_row["span_s"] == "65.534"
+      and sat_row["tr_bound_rel"] == "1.31068" and sat_row["rs_bound_rel"] == "0.00000",
+      f"clamped values are printed as the limit, a number: {r[5]}")
+check(sat_row["clamped"] == "T_R_s;E_I;pe_k1_rel;pe_k2_rel;span_s;tr_bound_rel;rs_bound_rel"
+      and sat_row["sat"] == "0xfd", f"the clamped columns named in 'clamped': {r[5]}")
+for k, line in enumerate(r):  # numeric columns hold numbers (or are empty)
+    row = dict(zip(cols, line.split(",")))
+    for c in ("t_s", "T_R_s", "R_S_ohm", "E_I", "valid", "seq", "pe_k1_rel", "pe_k2_rel", "n_roots",
+              "n_admissible", "tr_valid", "rs_valid", "span_s", "windows", "tr_bound_rel", "rs_bound_rel",
+              "tx_failed", "counter"):
+        try:
+            float(row[c])
+        except ValueError:
+            check(False, f"window {k}: {c} = {row[c]!r} is not a number")
 check(sat_row["R_S_ohm"] == "-inf", "an infinity is carried as such, not saturated")
 row7 = dict(zip(cols, r[7].split(",")))  # window 7: T_R trusted, R_S not
 check(row7["tr_valid"] == "1" and row7["tr_reason"] == "ok" and row7["rs_valid"] == "0"
@@ -89,7 +106,9 @@ rc, out, err = run(["--log", write("mon_lost.log", good[:2 * NF + 1] + good[2 * 
 check(rc == 0 and len(rows(out)) == N, f"lost: rc {rc}, {len(rows(out))} rows")
 check("lost 1 frame(s) up to the window with counter 2" in err, "lost event: " + err)
 check("incomplete window (counter 2, seq 2): missing IMEST_RS" in err, "incomplete event: " + err)
-check(",0x3D," in out, "incomplete row frames mask")
+inc = dict(zip(COLUMNS.split(","), rows(out)[2].split(",")))
+check(inc["frames"] == "0x3d" and inc["R_S_ohm"] == "" and inc["pe_k2_rel"] == "" and inc["T_R_s"] != "",
+      f"incomplete row: frames mask, the missing frame's columns empty: {rows(out)[2]}")
 check("lost 1," in err and "windows 20 (incomplete 1)" in err, "lost summary: " + err)
 # a whole window lost
 rc, out, err = run(["--log", write("mon_lost_win.log", good[:3 * NF] + good[4 * NF:]), "--csv"])
@@ -136,7 +155,7 @@ check(len(rows(out)) == N and "lost 0," in err, "truncated: rows, and the unreco
 # 8. stdin, and --opt=value
 rc, out, err = run(["--log", "-", "--csv"], stdin="".join(good))
 check(rc == 0 and len(rows(out)) == N, "stdin")
-rc, out, err = run(["--log=-", "--csv", "--count=3", "--base-id=0x6A0"], stdin="".join(good))
+rc, out, err = run(["--log=-", "--csv", "--count=3", "--can-base-id=0x6A0"], stdin="".join(good))
 check(rc == 0 and len(rows(out)) == 3, f"--opt=value: rc {rc} {err}")
 
 # 9. a sender restart is a restart, not hundreds of lost frames
@@ -152,8 +171,11 @@ ext, _ = publish("mon_ext.log", "--count", "5", "--base-id", "0x18FF5000")
 with open(ext) as fh:
     check(" 18FF5005#" in fh.read(), "extended id in log")
 for base in ("0x18FF5000", "0x98FF5000", "419385344"):
-    rc, out, err = run(["--log", ext, "--csv", "--base-id", base])
+    rc, out, err = run(["--log", ext, "--csv", "--can-base-id", base])
     check(rc == 0 and len(rows(out)) == 5 and "lost 0," in err, f"extended {base}: " + err)
+# the older spellings --base-id and --ext are the same options
+rc, out, err = run(["--log", ext, "--csv", "--base-id", "0x18FF5000"])
+check(rc == 0 and len(rows(out)) == 5, f"--base-id (older spelling): rc {rc} {err}")
 
 # 11. --count
 rc, out, err = run(["--log", clean, "--csv", "--count", "5"])
@@ -174,18 +196,20 @@ for line in good:
     plain.append("  vcan0  %s   [8]  %s\n" % (ident, " ".join(data[i:i + 2] for i in range(0, 16, 2))))
 nothing(["--log", write("mon_plain.log", plain)], "look like plain candump output", "plain candump")
 nothing(["--log", write("mon_plain.log", plain)], "candump -L", "plain candump remedy")
-nothing(["--log", clean, "--base-id", "0x100"],
+nothing(["--log", clean, "--can-base-id", "0x100"],
         f"{NF * N} frame(s) read, none with identifiers 0x100..0x105; frames seen: 0x6A0 ({N}),",
         "wrong base id")
-nothing(["--log", clean, "--base-id", "0x100"], "is --base-id right? 0x6A0 .. +5 look like an imest node: "
-        "--base-id 0x6A0", "wrong base id: the likely base")
-nothing(["--log", clean, "--ext"], "the log has 11-bit (standard) identifiers at that base: drop --ext",
-        "--ext on an 11-bit log")
+nothing(["--log", clean, "--can-base-id", "0x100"], "is --can-base-id right? 0x6A0 .. +5 look like an imest "
+        "node: --can-base-id 0x6A0", "wrong base id: the likely base")
+nothing(["--log", clean, "--can-ext"], "the log has 11-bit (standard) identifiers at that base: drop --can-ext",
+        "--can-ext on an 11-bit log")
 small_ext, _ = publish("mon_small_ext.log", "--count", "3", "--base-id", "0x500", "--ext")
-nothing(["--log", small_ext, "--base-id", "0x500"], "29-bit (extended) identifiers at that base: add --ext",
-        "29-bit log without --ext")
+nothing(["--log", small_ext, "--can-base-id", "0x500"], "29-bit (extended) identifiers at that base: add --can-ext",
+        "29-bit log without --can-ext")
+rc, out, err = run(["--log", small_ext, "--can-base-id", "0x500", "--can-ext"])
+check(rc == 0 and len(rows(out) or out.splitlines()[1:]) == 3, f"29-bit log with --can-ext: {err}")
 rc, out, err = run(["--log", small_ext, "--base-id", "0x500", "--ext"])
-check(rc == 0 and len(rows(out) or out.splitlines()[1:]) == 3, f"29-bit log with --ext: {err}")
+check(rc == 0 and len(rows(out) or out.splitlines()[1:]) == 3, f"29-bit log with --ext (older spelling): {err}")
 nothing(["--log", write("mon_empty.log", [])], "the log is empty", "empty log")
 nothing(["--log", "-"], "the log is empty", "empty stdin", stdin="")
 nothing(["--log", write("mon_text.log", ["hello\n", "world\n"])], "2 line(s) read, none a candump -L frame line",
@@ -197,10 +221,31 @@ check(rc == 1 and "is a directory" in err, f"directory as --log: rc {rc} {err}")
 rc, out, err = run(["--log", os.path.join(work, "does-not-exist.log")])
 check(rc == 1 and "cannot open log" in err and "No such file" in err, "missing log: " + err)
 
+# 12b. --require-valid: exit 3 when windows decode but none has the column asked for at 1
+rc, out, err = run(["--log", clean, "--csv", "--require-valid"])
+check(rc == 0, f"--require-valid on a log with valid windows: rc {rc} {err}")
+one_bad = write("mon_one_bad.log", good[3 * NF:4 * NF])  # window 3 only: no_root
+for which, col in (("", "valid"), ("=valid", "valid"), ("=tr", "tr_valid"), ("=rs", "rs_valid")):
+    rc, out, err = run(["--log", one_bad, "--csv", "--require-valid" + which])
+    check(rc == 3 and len(rows(out)) == 1 and f"none of the 1 window(s) decoded has {col} = 1" in err,
+          f"--require-valid{which} on a window not valid: rc {rc} {err}")
+rc, out, err = run(["--log", one_bad, "--csv"])
+check(rc == 0, f"without --require-valid a window not valid is success: rc {rc}")
+t_only = write("mon_tr_only.log", good[7 * NF:8 * NF])  # window 7: T_R valid, R_S not
+rc, _, err = run(["--log", t_only, "--require-valid=tr"])
+check(rc == 0, f"--require-valid=tr, T_R valid: rc {rc} {err}")
+rc, _, err = run(["--log", t_only, "--require-valid=rs"])
+check(rc == 3, f"--require-valid=rs, R_S not valid: rc {rc} {err}")
+nothing(["--log", write("mon_empty2.log", []), "--require-valid"], "the log is empty",
+        "--require-valid, nothing decoded: still exit 1")
+
 # 13. usage errors: exit 2
 for args, want in ((["--log", clean, "--iface", "vcan0"], "exactly one of"),
+                   (["--log", clean, "--can-iface", "vcan0"], "exactly one of --can-iface NAME or --log FILE"),
+                   (["--log", clean, "--require-valid=both"], "takes valid, tr or rs"),
                    ([], "exactly one of"),
-                   (["--log", clean, "--base-id", "0x7FB"], "beyond the 11-bit range (largest base 0x7FA)"),
+                   (["--log", clean, "--can-base-id", "0x7FB"], "beyond the 11-bit range (largest base 0x7FA); "
+                    "use a lower base, or --can-ext"),
                    (["--log", clean, "--base-id", "0x20000000"], "beyond the 29-bit range"),
                    (["--log", clean, "--base-id", "zz"], "not an identifier"),
                    (["--log", clean, "--base-id", "-5"], "negative"),
@@ -214,7 +259,7 @@ rc, out, err = run(["--help"])
 check(rc == 0 and "usage: imest-monitor" in out and "Exit status" in out, "--help")
 
 # 14. live on this machine: no CAN in the kernel -> clear message, exit 1
-rc, out, err = run(["--iface", "vcan0", "--timeout", "1"])
+rc, out, err = run(["--can-iface", "vcan0", "--timeout", "1"])
 check((rc == 1 and ("no SocketCAN support" in err or "no such network interface" in err))
       or (rc == 1 and "listening" in err and "no frame received" in err), f"iface error: rc {rc} {err} {out}")
 

@@ -78,6 +78,27 @@ int tool_args_flag(tool_args_t *a)
   return -1;
 }
 
+int tool_args_require_valid(const tool_args_t *a, tool_require_t *out)
+{
+  const char *v = a->inline_value;
+  if (v == NULL || strcmp(v, "valid") == 0)
+    *out = TOOL_REQUIRE_VALID;
+  else if (strcmp(v, "tr") == 0)
+    *out = TOOL_REQUIRE_TR;
+  else if (strcmp(v, "rs") == 0)
+    *out = TOOL_REQUIRE_RS;
+  else {
+    fprintf(stderr, "%s: %s takes valid, tr or rs (as %s=WHICH), not '%s'\n", a->prog, a->opt, a->opt, v);
+    return -1;
+  }
+  return 0;
+}
+
+const char *tool_require_column(tool_require_t r)
+{
+  return r == TOOL_REQUIRE_TR ? "tr_valid" : r == TOOL_REQUIRE_RS ? "rs_valid" : "valid";
+}
+
 int tool_args_unknown(const tool_args_t *a)
 {
   fprintf(stderr, "%s: unknown option '%s'\nTry '%s --help'.\n", a->prog, a->opt, a->prog);

@@ -9,10 +9,20 @@
 
 /* Exit codes of every imest tool. */
 enum {
-  TOOL_EXIT_OK = 0,   /* success */
-  TOOL_EXIT_DATA = 1, /* the input or data is unusable (bad content, nothing decoded, I/O) */
-  TOOL_EXIT_USAGE = 2 /* bad option or argument */
+  TOOL_EXIT_OK = 0,       /* success */
+  TOOL_EXIT_DATA = 1,     /* the input or data is unusable (bad content, nothing decoded, I/O) */
+  TOOL_EXIT_USAGE = 2,    /* bad option or argument */
+  TOOL_EXIT_NOT_VALID = 3 /* --require-valid: windows estimated or decoded, none valid */
 };
+
+/* What --require-valid asks of at least one window (imest-replay,
+ * imest-monitor): the column of that name is 1. */
+typedef enum {
+  TOOL_REQUIRE_NONE = 0, /* option not given: any window is success */
+  TOOL_REQUIRE_VALID,    /* "valid" (the default): T_R and R_S both valid */
+  TOOL_REQUIRE_TR,       /* "tr": tr_valid */
+  TOOL_REQUIRE_RS        /* "rs": rs_valid */
+} tool_require_t;
 
 typedef enum { TOOL_ARG_END = 0, TOOL_ARG_OPTION, TOOL_ARG_OPERAND } tool_arg_kind_t;
 
@@ -45,6 +55,13 @@ int tool_args_number(tool_args_t *a, double *out);
 
 /* A flag takes no value: 0, or -1 after printing "--flag takes no value". */
 int tool_args_flag(tool_args_t *a);
+
+/* --require-valid[=valid|tr|rs]: the value only after '=' (the next argument
+ * stays an operand). 0 with *out set, or -1 after printing the reason. */
+int tool_args_require_valid(const tool_args_t *a, tool_require_t *out);
+
+/* The column --require-valid checks ("valid", "tr_valid", "rs_valid"). */
+const char *tool_require_column(tool_require_t r);
 
 /* Prints "prog: unknown option '--x'" and "Try 'prog --help'." on stderr;
  * returns TOOL_EXIT_USAGE. */

@@ -6,7 +6,8 @@
  * what the input held and what is likely wrong, and exits 1.
  *
  * Exit codes: 0 windows decoded; 1 unusable input (nothing decoded, cannot
- * open or read the log, interface error); 2 usage error. */
+ * open or read the log, interface error); 2 usage error; 3 with
+ * --require-valid, windows decoded but none valid. */
 #define _GNU_SOURCE 1
 #include <errno.h>
 #include <float.h>
@@ -49,6 +50,8 @@ typedef struct {
 
 typedef struct {
   int csv;
+  tool_require_t require; /* --require-valid */
+  unsigned long n_valid;  /* windows whose required column is 1 */
   uint32_t base_id;
   unsigned long count; /* stop after this many windows (0: never) */
   unsigned long windows;
@@ -63,22 +66,38 @@ typedef struct {
 
 static void usage(FILE *f)
 {
-  fputs("usage: imest-monitor (--iface NAME | --log FILE|-) [--base-id ID] [--ext] [--csv]\n"
-        "                     [--count N] [--timeout SEC]\n"
-        "  --iface NAME   read live from a SocketCAN interface (e.g. can0, vcan0)\n"
-        "  --log FILE     read a candump -L log ('-' = stdin); record one with candump -L\n"
-        "  --base-id ID   base identifier of the node (default 0x6A0); its frames are ID..ID+5.\n"
-        "                 Values above 0x7FF are 29-bit extended identifiers\n"
-        "  --ext          the base identifier is a 29-bit extended one even if it is small\n"
-        "  --csv          CSV (header t_s,seq,T_R_s,R_S_ohm,E_I,valid,status,...) instead of a table\n"
-        "  --count N      stop after N windows (N >= 1)\n"
-        "  --timeout SEC  live: stop after SEC seconds without any frame (default: never)\n"
-        "  -h, --help     this text\n"
-        "  --version      the version and licence\n"
+  fputs("usage: imest-monitor (--can-iface NAME | --log FILE|-) [--can-base-id ID] [--can-ext]\n"
+        "                     [--csv] [--count N] [--timeout SEC] [--require-valid[=WHICH]]\n"
+        "  --can-iface NAME    read live from a SocketCAN interface (e.g. can0, vcan0);\n"
+        "                      --iface NAME is the same (the older spelling)\n"
+        "  --log FILE          read a candump -L log ('-' = stdin); record one with candump -L\n"
+        "  --can-base-id ID    base identifier of the node (default 0x6A0); its frames are\n"
+        "                      ID..ID+5. Values above 0x7FF are 29-bit extended identifiers\n"
+        "                      (--base-id ID is the same, the older spelling)\n"
+        "  --can-ext           the base identifier is a 29-bit extended one even if it is\n"
+        "                      small (--ext is the same, the older spelling)\n"
+        "  --csv               CSV instead of a table: t_s, then the columns imest-replay\n"
+        "                      prints, in its order, for what the frames carry: T_R_s,R_S_ohm,\n"
+        "                      E_I,valid,status,seq,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,\n"
+        "                      flags,tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,\n"
+        "                      tr_bound_rel,rs_bound_rel; then the monitor's own: clamped,sat,\n"
+        "                      tx_failed,counter,frames. t_s is the time of the window's last\n"
+        "                      frame (for a log of imest-replay --candump: its t_end_s). A value\n"
+        "                      the sender clamped to its field's range is printed as that\n"
+        "                      limit, and its column is named in 'clamped' (';'-separated;\n"
+        "                      'sat' is the same as a bit mask). Empty: its frame is missing\n"
+        "  --count N           stop after N windows (N >= 1)\n"
+        "  --timeout SEC       live: stop after SEC seconds without any frame (default: never)\n"
+        "  --require-valid[=WHICH]  exit 3 when windows were decoded but none has WHICH = 1:\n"
+        "                      valid (the default: T_R and R_S), tr (tr_valid) or rs\n"
+        "                      (rs_valid); the value only as --require-valid=WHICH\n"
+        "  -h, --help          this text\n"
+        "  --version           the version and licence\n"
         "Options take their value as '--opt value' or '--opt=value'. Events (lost, repeated,\n"
         "corrupted frames, incomplete windows, sequence gaps, restarts) and a summary go to\n"
-        "stderr. A value clamped to its field's range is shown as a bound ('>1.31068').\n"
-        "Exit status: 0 windows decoded, 1 nothing decoded or an input error, 2 usage error.\n",
+        "stderr. The table shows a clamped value as a bound ('>1.31068').\n"
+        "Exit status: 0 windows decoded; 1 nothing decoded or an input error; 2 usage error;\n"
+        "3 --require-valid given and no decoded window valid (the message names the column).\n",
         f);
 }
 
@@ -126,6 +145,87 @@ static void fmt_reason(char *buf, size_t n, int have, int reason)
   }
 }
 
+/* The clamped columns, in the order of the saturation bits (IMEST_CAN_SAT_*). */
+static const struct {
+  unsigned int bit;
+  const char *column;
+} k_clamp[] = {{IMEST_CAN_SAT_TR, "T_R_s"},         {IMEST_CAN_SAT_RS, "R_S_ohm"},
+               {IMEST_CAN_SAT_EI, "E_I"},           {IMEST_CAN_SAT_PEK1, "pe_k1_rel"},
+               {IMEST_CAN_SAT_PEK2, "pe_k2_rel"},   {IMEST_CAN_SAT_SPAN, "span_s"},
+               {IMEST_CAN_SAT_TRB, "tr_bound_rel"}, {IMEST_CAN_SAT_RSB, "rs_bound_rel"}};
+
+/* A CSV cell: the number (a clamped one as its limit: the 'clamped' column
+ * says so), empty when its frame is missing. */
+static void csv_num(int have, const char *fmt, double v)
+{
+  putchar(',');
+  if (have) printf(fmt, v);
+}
+
+static void csv_uint(int have, unsigned long v)
+{
+  putchar(',');
+  if (have) printf("%lu", v);
+}
+
+static void csv_reason(int have, int reason)
+{
+  putchar(',');
+  if (have) fputs(reason == 255 ? "out_of_range" : imest_reason_name(reason), stdout);
+}
+
+/* One CSV row: imest-replay's columns and order for what the frames carry
+ * (print_header lists them), then the monitor's own. */
+static void print_csv_row(const imest_can_window_t *w, double t, int h_tr, int h_rs, int h_q, int h_v,
+                          int h_b)
+{
+  const imest_result_t *r = &w->result;
+  const int h_st = (int)((w->have >> IMEST_CAN_FRAME_STAT) & 1u);
+  printf("%.6f", t);
+  csv_num(h_tr, "%.9g", r->tr_s);
+  csv_num(h_rs, "%.9g", r->rs_ohm);
+  csv_num(h_tr, "%.4f", r->e_i);
+  csv_uint(h_q, (unsigned long)r->valid);
+  csv_reason(h_q, r->status);
+  csv_uint(h_st, (unsigned long)r->seq);
+  csv_num(h_q, "%.5f", r->pe_k1_rel);
+  csv_num(h_rs, "%.5f", r->pe_k2_rel);
+  csv_uint(h_q, r->n_roots);
+  csv_uint(h_q, r->n_admissible);
+  putchar(',');
+  if (h_q) printf("0x%x", r->flags);
+  csv_uint(h_v, (unsigned long)r->tr_valid);
+  csv_uint(h_v, (unsigned long)r->rs_valid);
+  csv_reason(h_v, r->tr_reason);
+  csv_reason(h_v, r->rs_reason);
+  csv_num(h_v, "%.3f", r->span_s);
+  csv_uint(h_v, r->windows);
+  csv_num(h_b, "%.5f", r->tr_bound_rel);
+  csv_num(h_b, "%.5f", r->rs_bound_rel);
+  putchar(',');
+  const char *sep = "";
+  for (size_t k = 0; k < sizeof k_clamp / sizeof k_clamp[0]; ++k) {
+    if (w->sat & k_clamp[k].bit) {
+      printf("%s%s", sep, k_clamp[k].column);
+      sep = ";";
+    }
+  }
+  putchar(',');
+  if (h_q) printf("0x%x", w->sat);
+  csv_uint(h_st, (unsigned long)w->tx_failed);
+  printf(",%u,0x%x\n", w->counter, w->have);
+}
+
+/* --require-valid: whether the window has the column asked for at 1. */
+static void count_valid(monitor_t *m, const imest_can_window_t *w, int h_q, int h_v)
+{
+  const imest_result_t *r = &w->result;
+  if ((m->require == TOOL_REQUIRE_VALID && h_q && r->valid) ||
+      (m->require == TOOL_REQUIRE_TR && h_v && r->tr_valid) ||
+      (m->require == TOOL_REQUIRE_RS && h_v && r->rs_valid))
+    m->n_valid++;
+}
+
 static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
 {
   const imest_result_t *r = &w->result;
@@ -137,7 +237,7 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
   const int h_b = (int)((w->have >> IMEST_CAN_FRAME_BOUNDS) & 1u);
   const unsigned int sat = w->sat;
   char seq[16], tr[32], rs[32], ei[32], valid[8], status[32], pk1[32], pk2[32];
-  char nr[8], na[8], flags[16], satb[8], txf[16];
+  char nr[8], na[8], flags[16], txf[16];
   char trv[8], rsv[8], trr[32], rsr[32], trb[32], rsb[32], span[32], nw[8];
   if (h_st) {
     snprintf(seq, sizeof seq, "%lu", (unsigned long)r->seq);
@@ -145,6 +245,7 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
   } else {
     seq[0] = txf[0] = '\0';
   }
+  count_valid(m, w, h_q, h_v);
   fmt_value(tr, sizeof tr, h_tr, "%.9g", r->tr_s, sat, IMEST_CAN_SAT_TR);
   fmt_value(ei, sizeof ei, h_tr, "%.4f", r->e_i, sat, IMEST_CAN_SAT_EI);
   fmt_value(rs, sizeof rs, h_rs, "%.9g", r->rs_ohm, sat, IMEST_CAN_SAT_RS);
@@ -155,9 +256,8 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
     snprintf(nr, sizeof nr, "%u", r->n_roots);
     snprintf(na, sizeof na, "%u", r->n_admissible);
     snprintf(flags, sizeof flags, "0x%04X", r->flags);
-    snprintf(satb, sizeof satb, "0x%02X", sat);
   } else {
-    valid[0] = nr[0] = na[0] = flags[0] = satb[0] = '\0';
+    valid[0] = nr[0] = na[0] = flags[0] = '\0';
   }
   fmt_reason(status, sizeof status, h_q, r->status);
   trv[0] = rsv[0] = nw[0] = '\0'; /* empty without the validity group */
@@ -170,11 +270,7 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
   fmt_reason(rsr, sizeof rsr, h_v, r->rs_reason);
   fmt_value(span, sizeof span, h_v, "%.3f", r->span_s, sat, IMEST_CAN_SAT_SPAN);
   if (m->csv) {
-    fmt_value(trb, sizeof trb, h_b, "%.5f", r->tr_bound_rel, sat, IMEST_CAN_SAT_TRB);
-    fmt_value(rsb, sizeof rsb, h_b, "%.5f", r->rs_bound_rel, sat, IMEST_CAN_SAT_RSB);
-    printf("%.6f,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%u,0x%X,%s,%s,%s,%s,%s,%s,%s,%s\n", t, seq, tr, rs,
-           ei, valid, status, pk1, pk2, nr, na, flags, satb, txf, w->counter, w->have, trv, trr, rsv, rsr,
-           trb, rsb, span, nw);
+    print_csv_row(w, t, h_tr, h_rs, h_q, h_v, h_b);
   } else {
     /* verdict per parameter: "ok", or why not; bounds in % */
     const char *trw = !h_v ? "" : r->tr_valid ? "ok" : trr;
@@ -196,9 +292,10 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
 static void print_header(const monitor_t *m)
 {
   if (m->csv) {
-    puts("t_s,seq,T_R_s,R_S_ohm,E_I,valid,status,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,flags,sat,"
-         "tx_failed,counter,frames,tr_valid,tr_reason,rs_valid,rs_reason,tr_bound_rel,rs_bound_rel,"
-         "span_s,windows");
+    /* imest-replay's names and order (tools/replay/replay.c), then the monitor's own */
+    puts("t_s,T_R_s,R_S_ohm,E_I,valid,status,seq,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,flags,"
+         "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel,"
+         "clamped,sat,tx_failed,counter,frames");
   } else {
     printf("%17s %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %5s %6s %5s\n", "t [s]", "seq", "T_R [s]",
            "+-T_R", "T_R verdict", "R_S [ohm]", "+-R_S", "R_S verdict", "E_I", "PE_K1", "PE_K2", "span [s]",
@@ -326,8 +423,8 @@ static void explain_ids(const monitor_t *m)
   for (unsigned int i = 0u; i < c->used; i++) {
     const uint32_t id = c->id[i];
     if ((id & IMEST_CAN_ID_EXT) != kind && (id & IMEST_CAN_EFF_MASK) - base < (uint32_t)IMEST_CAN_NFRAMES) {
-      fprintf(stderr, kind ? "; the log has 11-bit (standard) identifiers at that base: drop --ext\n"
-                           : "; the log has 29-bit (extended) identifiers at that base: add --ext\n");
+      fprintf(stderr, kind ? "; the log has 11-bit (standard) identifiers at that base: drop --can-ext\n"
+                           : "; the log has 29-bit (extended) identifiers at that base: add --can-ext\n");
       return;
     }
   }
@@ -343,13 +440,13 @@ static void explain_ids(const monitor_t *m)
       }
     }
     if (run == (unsigned int)IMEST_CAN_NFRAMES) {
-      fprintf(stderr, "; is --base-id right? %s .. +%d look like an imest node: --base-id %s\n",
+      fprintf(stderr, "; is --can-base-id right? %s .. +%d look like an imest node: --can-base-id %s\n",
               imest_can_id_format(c->id[i], buf, sizeof buf), IMEST_CAN_NFRAMES - 1,
               imest_can_id_format(c->id[i], buf, sizeof buf));
       return;
     }
   }
-  fputs("; is --base-id right?\n", stderr);
+  fputs("; is --can-base-id right?\n", stderr);
 }
 
 /* Nothing decoded: name the likely cause. */
@@ -415,6 +512,11 @@ static int finish(monitor_t *m, int live)
   if (m->windows == 0u) {
     explain_nothing(m, live);
     return TOOL_EXIT_DATA;
+  }
+  if (m->require != TOOL_REQUIRE_NONE && m->n_valid == 0u) {
+    fprintf(stderr, "imest-monitor: --require-valid: none of the %lu window(s) decoded has %s = 1\n",
+            m->windows, tool_require_column(m->require));
+    return TOOL_EXIT_NOT_VALID;
   }
   return TOOL_EXIT_OK;
 }
@@ -567,14 +669,16 @@ int main(int argc, char **argv)
     } else if (tool_args_is(&a, "--csv")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       m.csv = 1;
-    } else if (tool_args_is(&a, "--ext")) {
+    } else if (tool_args_is(&a, "--require-valid")) {
+      if (tool_args_require_valid(&a, &m.require)) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--can-ext") || tool_args_is(&a, "--ext")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       ext = 1;
-    } else if (tool_args_is(&a, "--iface")) {
+    } else if (tool_args_is(&a, "--can-iface") || tool_args_is(&a, "--iface")) {
       if ((iface = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--log")) {
       if ((log = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
-    } else if (tool_args_is(&a, "--base-id")) {
+    } else if (tool_args_is(&a, "--can-base-id") || tool_args_is(&a, "--base-id")) {
       if ((base_text = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--count")) {
       if ((v = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
@@ -593,14 +697,14 @@ int main(int argc, char **argv)
     }
   }
   if ((iface == NULL) == (log == NULL)) {
-    fprintf(stderr, "imest-monitor: give exactly one of --iface NAME or --log FILE (see --help)\n");
+    fprintf(stderr, "imest-monitor: give exactly one of --can-iface NAME or --log FILE (see --help)\n");
     return TOOL_EXIT_USAGE;
   }
   m.base_id = IMEST_CAN_DEFAULT_BASE_ID | (ext ? IMEST_CAN_ID_EXT : 0u);
   if (base_text != NULL) {
     char err[256];
-    if (imest_can_id_parse(base_text, ext, "--ext", &m.base_id, err, sizeof err) != IMEST_OK) {
-      fprintf(stderr, "imest-monitor: bad --base-id %s\n", err);
+    if (imest_can_id_parse(base_text, ext, "--can-ext", &m.base_id, err, sizeof err) != IMEST_OK) {
+      fprintf(stderr, "imest-monitor: bad --can-base-id %s\n", err);
       return TOOL_EXIT_USAGE;
     }
   }

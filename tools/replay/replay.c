@@ -98,7 +98,7 @@ static int can_log_open(can_log_t *c, const replay_opts_t *o)
     return TOOL_EXIT_DATA;
   }
   if (imest_candump_port_open(&c->port, c->f, o->can_iface) != 0) {
-    fprintf(stderr, "%s: --can-iface '%s' is not a valid interface name\n", k_prog, o->can_iface);
+    fprintf(stderr, "%s: --candump-iface '%s' is not a valid interface name\n", k_prog, o->can_iface);
     return TOOL_EXIT_USAGE;
   }
   (void)imest_can_pub_init(&c->pub, &c->port.port, o->can_id); /* checked by replay_parse */
@@ -245,6 +245,16 @@ static void summary(const drive_t *d, const replay_scan_t *s, const imest_config
             imest_reason_name(most), what);
 }
 
+/* --require-valid: TOOL_EXIT_NOT_VALID when no window has the column asked for at 1. */
+static int require_valid(const drive_t *d, tool_require_t req)
+{
+  const long n = req == TOOL_REQUIRE_TR ? d->tr_valid : req == TOOL_REQUIRE_RS ? d->rs_valid : d->valid;
+  if (req == TOOL_REQUIRE_NONE || n > 0) return TOOL_EXIT_OK;
+  fprintf(stderr, "%s: --require-valid: none of the %ld window(s) has %s = 1\n", k_prog, d->windows,
+          tool_require_column(req));
+  return TOOL_EXIT_NOT_VALID;
+}
+
 /* Opens the recording with the columns of the chosen input. A header that has
  * the other input's columns gets the --voltage that reads it. */
 static int open_recording(csv_reader_t *r, const replay_opts_t *o)
@@ -301,7 +311,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "%s: no window could be estimated\n", k_prog);
     rc = TOOL_EXIT_DATA;
   } else {
-    rc = TOOL_EXIT_OK;
+    rc = require_valid(&d, (tool_require_t)o.require);
   }
 done:
   csv_close(&r);

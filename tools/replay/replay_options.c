@@ -75,7 +75,8 @@ static void usage(FILE *o)
              "                      negative: off)\n"
              "  --tr-nominal S      nominal T_R for scaling (default 0.1)\n"
              "  --tr-min S --tr-max S   admissible T_R band (default 0.001 .. 10)\n"
-             "  --max-pe-k2 X       validity threshold on the relative PE index of K2 (0.1)\n"
+             "  --max-pe-k2 X       validity threshold on the relative PE index of K2\n"
+             "                      (default 0.1)\n"
              "  --rs OHM            R_S at ambient temperature (data sheet, commissioning);\n"
              "                      an R_S far from it marks the window constants_mismatch\n"
              "                      (default 0: unknown)\n"
@@ -84,7 +85,7 @@ static void usage(FILE *o)
              "  --tr-tolerance X    T_R is valid only if its error bound is within this,\n"
              "                      relative (default 0.02)\n"
              "  --timing-uncertainty S  uncertainty of the voltage/current alignment after\n"
-             "                      --pwm-timing and --u-delay [s] (default 2e-6)\n"
+             "                      --pwm-timing and --u-delay [s] (default 1e-6)\n"
              "  --speed-limit RAD_S an angle step faster than this is an encoder fault\n"
              "                      (default min(3000, 2 x fs); below 3 x fs, i.e. less than\n"
              "                      pi per sample)\n"
@@ -97,18 +98,26 @@ static void usage(FILE *o)
              "CAN telemetry:\n"
              "  --candump FILE      also write the published CAN frames (candump -L format;\n"
              "                      \"-\" = stdout)\n"
-             "  --can-iface NAME    interface name in that log (default vcan0)\n"
-             "  --can-id ID         base CAN identifier (default 0x6A0; above 0x7FF a 29-bit\n"
-             "                      extended identifier)\n"
+             "  --candump-iface NAME  the interface name written into that log, a label only\n"
+             "                      (default vcan0; a live interface is --can-iface in\n"
+             "                      imest-monitor and imest-demo)\n"
+             "  --can-base-id ID    base CAN identifier (default 0x6A0; above 0x7FF a 29-bit\n"
+             "                      extended identifier; --can-id ID is the same, the older\n"
+             "                      spelling)\n"
              "  --can-ext           the base CAN identifier is 29-bit even if it is small\n"
              "other:\n"
+             "  --require-valid[=WHICH]  exit 3 when windows were estimated but none has\n"
+             "                      WHICH = 1: valid (the default: T_R and R_S), tr (the\n"
+             "                      tr_valid column) or rs (rs_valid); the value only as\n"
+             "                      --require-valid=WHICH\n"
              "  --quiet             no notes or summary on stderr\n"
              "  -h, --help          this text\n"
              "  --version           the version and licence\n"
              "\n"
-             "Exit status: 0 windows estimated (valid or not); 1 the file or its data are\n"
-             "unusable, or an output cannot be written (the message says why and what to do);\n"
-             "2 bad option or argument.\n");
+             "Exit status: 0 windows estimated (valid or not, unless --require-valid); 1 the\n"
+             "file or its data are unusable, or an output cannot be written (the message says\n"
+             "why and what to do); 2 bad option or argument; 3 --require-valid given and no\n"
+             "window valid (the message names the column).\n");
 }
 
 /* Which input an option belongs to. */
@@ -342,9 +351,20 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
       }
     } else if (tool_args_is(&a, "--candump")) {
       if ((o->candump_path = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
-    } else if (tool_args_is(&a, "--can-iface")) {
+    } else if (tool_args_is(&a, "--candump-iface")) {
       if ((o->can_iface = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
-    } else if (tool_args_is(&a, "--can-id")) {
+    } else if (tool_args_is(&a, "--can-iface")) {
+      /* in every other tool --can-iface is a live SocketCAN interface */
+      fprintf(stderr,
+              "%s: --can-iface is now --candump-iface NAME: the interface name written into the "
+              "--candump log (a label; imest-replay sends nothing on a bus)\n",
+              k_prog);
+      return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--require-valid")) {
+      tool_require_t req;
+      if (tool_args_require_valid(&a, &req)) return TOOL_EXIT_USAGE;
+      o->require = (int)req;
+    } else if (tool_args_is(&a, "--can-base-id") || tool_args_is(&a, "--can-id")) {
       if ((can_id = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--can-ext")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
@@ -367,11 +387,11 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
   const int rc = check_input_options(o, pwm_timing_given);
   if (rc >= 0) return rc;
   default_uncertainty(o);
-  /* the same parser as imest-monitor's --base-id (port/canid) */
+  /* the same parser as imest-monitor's --can-base-id (port/canid) */
   o->can_id = IMEST_CAN_DEFAULT_BASE_ID | (can_ext ? IMEST_CAN_ID_EXT : 0u);
   char err[256];
   if (can_id != NULL && imest_can_id_parse(can_id, can_ext, "--can-ext", &o->can_id, err, sizeof err)) {
-    fprintf(stderr, "%s: --can-id %s\n", k_prog, err);
+    fprintf(stderr, "%s: --can-base-id %s\n", k_prog, err);
     return TOOL_EXIT_USAGE;
   }
   return -1;

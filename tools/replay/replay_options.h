@@ -19,13 +19,14 @@ typedef struct {
   replay_voltage_t voltage; /* --voltage */
   const char *path;         /* the recording, "-" = stdin */
   const char *candump_path; /* NULL = no CAN log; "-" = stdout */
-  const char *can_iface;
-  uint32_t can_id;         /* with IMEST_CAN_ID_EXT for a 29-bit identifier */
-  double fs_hz;            /* --fs: 0 = from t */
-  double speed_limit;      /* --speed-limit: 0 = from the sample rate */
-  double i_limit, u_limit; /* -1 = auto */
-  int from_rest;           /* -1 = auto, 0 no, 1 yes */
+  const char *can_iface;    /* --candump-iface: the interface name written into that log */
+  uint32_t can_id;          /* with IMEST_CAN_ID_EXT for a 29-bit identifier */
+  double fs_hz;             /* --fs: 0 = from t */
+  double speed_limit;       /* --speed-limit: 0 = from the sample rate */
+  double i_limit, u_limit;  /* -1 = auto */
+  int from_rest;            /* -1 = auto, 0 no, 1 yes */
   int quiet;
+  int require; /* --require-valid: a tool_require_t */
 } replay_opts_t;
 
 /* Parses argv into *o. Returns -1 to go on, or the exit code to end with

@@ -1,0 +1,76 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Prints what imest_config_default() sets, one "field value" line per field
+ * of imest_config_t (inverter fields as inverter.NAME), then "sizeof imest_t
+ * N" for this host. test_documented_defaults.py compares it with the
+ * defaults the header's comments and imest-replay --help state, and checks
+ * that every field the header declares is listed here. */
+#include <stddef.h>
+#include <stdio.h>
+
+#include "imest/imest.h"
+
+#define F(name)                                                                                              \
+  {                                                                                                          \
+#name, offsetof(imest_config_t, name)                                                                    \
+  }
+
+static const struct {
+  const char *name;
+  size_t offset;
+} k_float[] = {
+    F(ls_h),
+    F(sigma),
+    F(fs_hz),
+    F(window_s),
+    F(filter_hz),
+    F(aa_hz),
+    F(u_delay_s),
+    F(angle_observer_hz),
+    F(dc_block_hz),
+    F(warmup_s),
+    F(pwm_hz),
+    F(inverter.dead_time_s),
+    F(inverter.v_switch_v),
+    F(inverter.r_switch_ohm),
+    F(inverter.v_diode_v),
+    F(inverter.r_diode_ohm),
+    F(inverter.i_band_a),
+    F(inverter.uncertainty),
+    F(tr_nominal_s),
+    F(tr_min_s),
+    F(tr_max_s),
+    F(rs_min_ohm),
+    F(rs_max_ohm),
+    F(max_pe_k2_rel),
+    F(max_ei),
+    F(min_current_a),
+    F(min_slip_ratio),
+    F(rs_tolerance),
+    F(tr_tolerance),
+    F(u_uncertainty_v),
+    F(timing_uncertainty_s),
+    F(rs_nominal_ohm),
+    F(i_limit_a),
+    F(u_limit_v),
+    F(i_absurd_a),
+    F(u_absurd_v),
+    F(speed_limit_rad_s),
+};
+
+int main(void)
+{
+  imest_config_t c;
+  imest_config_default(&c);
+  for (size_t k = 0; k < sizeof k_float / sizeof k_float[0]; ++k) {
+    const float v = *(const float *)(const void *)((const char *)&c + k_float[k].offset);
+    printf("%s %.9g\n", k_float[k].name, (double)v);
+  }
+  printf("pole_pairs %u\n", c.pole_pairs);
+  printf("start_at_rest %d\n", c.start_at_rest);
+  printf("tr_nominal_known %d\n", c.tr_nominal_known);
+  printf("pwm_timing %s\n", c.pwm_timing == IMEST_PWM_NEXT_PERIOD ? "NEXT_PERIOD"
+                            : c.pwm_timing == IMEST_PWM_CENTRED   ? "CENTRED"
+                                                                  : "LAST_PERIOD");
+  printf("sizeof imest_t %zu\n", sizeof(imest_t));
+  return 0;
+}
