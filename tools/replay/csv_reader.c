@@ -133,8 +133,8 @@ typedef struct {
 } unit_t;
 
 /* The units a drive logs, per kind of column; the first is the column's own. */
-static const unit_t k_time[] = {{"s", 1.0}, {"sec", 1.0}, {"ms", 1e-3}, {"us", 1e-6}, {"\xC2\xB5s", 1e-6},
-                                {"\xCE\xBCs", 1e-6}, {NULL, 0}};
+static const unit_t k_time[] = {{"s", 1.0},          {"sec", 1.0},        {"ms", 1e-3}, {"us", 1e-6},
+                                {"\xC2\xB5s", 1e-6}, {"\xCE\xBCs", 1e-6}, {NULL, 0}};
 static const unit_t k_current[] = {{"A", 1.0}, {"mA", 1e-3}, {NULL, 0}};
 static const unit_t k_voltage[] = {{"V", 1.0}, {"mV", 1e-3}, {NULL, 0}};
 static const unit_t k_angle[] = {{"rad", 1.0},
@@ -256,12 +256,11 @@ static int match_field(csv_reader_t *r, header_t *h, char *tok, int idx, int nsr
   char *raw = trim(tok);
   char quoted[48];
   snprintf(quoted, sizeof quoted, "%s", raw);
-  if (strlen(h->list) + strlen(raw) + 3 < sizeof h->list) {
-    strcat(h->list, idx ? ", " : "");
-    strcat(h->list, raw);
-  } else if (strlen(h->list) + 5 < sizeof h->list && strstr(h->list, ", ...") == NULL) {
-    strcat(h->list, ", ...");
-  }
+  const size_t used = strlen(h->list);
+  if (used + strlen(raw) + 3 < sizeof h->list)
+    snprintf(h->list + used, sizeof h->list - used, "%s%s", idx ? ", " : "", raw);
+  else if (used + 6 < sizeof h->list && strstr(h->list, ", ...") == NULL)
+    snprintf(h->list + used, sizeof h->list - used, ", ...");
   for (int k = 0; k < nsrc; ++k) {
     if (strcmp(raw, src_name(r, k)) == 0) {
       if (h->fields[k][0] >= 0) {
@@ -307,16 +306,17 @@ static int apply_unit(csv_reader_t *r, const header_t *h, int k)
     if (k == 0) snprintf(r->t_unit, sizeof r->t_unit, "%s", u[j].unit);
     if (u[j].scale != 1.0) {
       char text[160];
-      snprintf(text, sizeof text, "%s in %s (from its header '%s'): converted to %s", src_name(r, k), u[j].unit,
-               h->text[k], u[0].unit);
+      snprintf(text, sizeof text, "%s in %s (from its header '%s'): converted to %s", src_name(r, k),
+               u[j].unit, h->text[k], u[0].unit);
       note(r, text);
     }
     return 0;
   }
   char all[64];
   unit_list(u, all, sizeof all);
-  snprintf(r->err, sizeof r->err, "%s:%ld: column '%s' (read as %s): unit '%s' is not known; expected one of %s",
-           r->name, r->header_line, h->text[k], src_name(r, k), h->unit[k], all);
+  snprintf(r->err, sizeof r->err,
+           "%s:%ld: column '%s' (read as %s): unit '%s' is not known; expected one of %s", r->name,
+           r->header_line, h->text[k], src_name(r, k), h->unit[k], all);
   return -1;
 }
 
@@ -329,7 +329,8 @@ static void missing(csv_reader_t *r, const header_t *h, int k, const char *hint)
     strncat(all, r->names[j], sizeof all - strlen(all) - 1);
   }
   char other[96] = "";
-  if (*csv_aliases(r->names[k])) snprintf(other, sizeof other, "; %s may be named %s", r->names[k], csv_aliases(r->names[k]));
+  if (*csv_aliases(r->names[k]))
+    snprintf(other, sizeof other, "; %s may be named %s", r->names[k], csv_aliases(r->names[k]));
   snprintf(r->err, sizeof r->err,
            "%s:%ld: missing column '%s' (the header needs %s in any order%s%s; names are "
            "case-insensitive, a unit may follow in [] or ()): the header (line %ld, separator %s) has: %s",
@@ -349,7 +350,8 @@ static int resolve(csv_reader_t *r, header_t *h)
     if (r->col[k] < 0) continue;
     if (h->twice[k] >= 0) {
       snprintf(r->err, sizeof r->err, "%s:%ld: columns '%s' (%d) and '%s' (%d) both read as %s: rename one",
-               r->name, r->header_line, h->text[k], r->col[k] + 1, h->text2[k], h->twice[k] + 1, src_name(r, k));
+               r->name, r->header_line, h->text[k], r->col[k] + 1, h->text2[k], h->twice[k] + 1,
+               src_name(r, k));
       return -1;
     }
     if (apply_unit(r, h, k)) return -1;
@@ -367,7 +369,8 @@ static int resolve(csv_reader_t *r, header_t *h)
     r->derive_i = ki[which];
     const int a = which == 0 ? 1 : 0, b = which == 2 ? 1 : 2;
     char text[160];
-    snprintf(text, sizeof text, "%s not in the header: %s = -%s - %s (the currents of a three-wire motor sum to zero)",
+    snprintf(text, sizeof text,
+             "%s not in the header: %s = -%s - %s (the currents of a three-wire motor sum to zero)",
              r->names[ki[which]], r->names[ki[which]], r->names[ki[a]], r->names[ki[b]]);
     note(r, text);
   }
@@ -534,7 +537,7 @@ int csv_next(csv_reader_t *r, double *v)
     len = read_line(r);
     if (len < 0) return 0;
   } while (skip_line(r->buf)); /* blank lines and comments are ignored */
-  double src[CSV_NSRC];
+  double src[CSV_NSRC] = {0};
   int idx = 0, got = 0, cut = 0; /* cut: the line looks cut off mid-write */
   char *tok = r->buf;
   for (;; ++idx) {
@@ -551,8 +554,8 @@ int csv_next(csv_reader_t *r, double *v)
     tok = sep + 1;
   }
   if (idx + 1 != r->ncols || got != r->nsrc) {
-    snprintf(r->err, sizeof r->err, "%s:%ld: %d fields, the header (line %ld) has %d", r->name, r->line, idx + 1,
-             r->header_line, r->ncols);
+    snprintf(r->err, sizeof r->err, "%s:%ld: %d fields, the header (line %ld) has %d", r->name, r->line,
+             idx + 1, r->header_line, r->ncols);
     cut = idx + 1 < r->ncols;
     goto bad;
   }

@@ -194,9 +194,9 @@ typedef struct {
   imest_t *est;
   imest_config_t cfg; /* for a restart: as configured, but warming up (the motor runs) */
   row_ctx_t *row;
-  long win_n;         /* samples per window */
-  long k0;            /* the segment's first sample */
-  double t0_s;        /* its time [s] */
+  long win_n;                      /* samples per window */
+  long k0;                         /* the segment's first sample */
+  double t0_s;                     /* its time [s] */
   long restarts, flushed, dropped; /* at gaps: partial windows estimated, dropped */
 } segment_t;
 
@@ -255,7 +255,8 @@ static int run(csv_reader_t *r, const replay_opts_t *o, const replay_scan_t *s, 
 /* A last partial window of at least half the length is estimated too, and a
  * record shorter than one window (without gaps) is estimated as one shorter
  * window. */
-static long run_last_window(drive_t *d, const replay_scan_t *s, const segment_t *g, can_log_t *can, int *flushed)
+static long run_last_window(drive_t *d, const replay_scan_t *s, const segment_t *g, can_log_t *can,
+                            int *flushed)
 {
   const long n = s->n - g->k0, rest = n % g->win_n;
   *flushed = rest > 0 && (2 * rest >= g->win_n || (n < g->win_n && g->restarts == 0));
@@ -285,8 +286,8 @@ static void summary(const drive_t *d, const replay_scan_t *s, const imest_config
     fprintf(stderr, "; last window has %ld samples", rest);
   fprintf(stderr, "%s", cfg->start_at_rest ? "; started at rest" : "; warm-up at start");
   if (g->restarts)
-    fprintf(stderr, "; restarted at %ld gap%s (%ld partial window%s before them estimated, %ld dropped)", g->restarts,
-            g->restarts == 1 ? "" : "s", g->flushed, g->flushed == 1 ? "" : "s", g->dropped);
+    fprintf(stderr, "; restarted at %ld gap%s (%ld partial window%s before them estimated, %ld dropped)",
+            g->restarts, g->restarts == 1 ? "" : "s", g->flushed, g->flushed == 1 ? "" : "s", g->dropped);
   fprintf(stderr, "\n");
   /* nothing valid: say what the most common reason usually means */
   const char *what = d->valid == 0 && most ? replay_remedy(most) : NULL;

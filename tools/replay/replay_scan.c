@@ -79,8 +79,8 @@ typedef struct {
   long line_min, line_max;
   double lo, hi; /* steps widened / narrowed by their rounding */
   long line_lo, line_hi;
-  double t_hi[2]; /* t before and after the step at line_hi */
-  double step;    /* the nominal step when gaps are left out (0: the record's mean) */
+  double t_hi[2];            /* t before and after the step at line_hi */
+  double step;               /* the nominal step when gaps are left out (0: the record's mean) */
   long repeats, line_repeat; /* steps of exactly 0 */
   double t_repeat;
   double q_repeat, q_worst;   /* rounding of t at the first repeat, at the widest step */
@@ -252,9 +252,9 @@ static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s
             k_prog, name, line, dt, step, 1.0 / step, missing ? ": samples are missing there" : "");
     if (missing)
       fprintf(stderr,
-              " t = %.9g after %.9g: about %ld samples missing; --gaps restart restarts the estimator "
-              "at each such gap instead of refusing the file.",
-              y->t_hi[1], y->t_hi[0], lround(dt / step) - 1);
+              " t = %.9g after %.9g: about %ld sample%s missing; --gaps restart restarts the "
+              "estimator at each such gap instead of refusing the file.",
+              y->t_hi[1], y->t_hi[0], lround(dt / step) - 1, lround(dt / step) - 1 == 1 ? "" : "s");
     fprintf(stderr, "\n");
     return TOOL_EXIT_DATA;
   }
@@ -273,8 +273,8 @@ static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s
 static void fs_against_seconds(const char *what, double step, double fs, int quiet)
 {
   if (quiet || fabs(step * fs - 1.0) <= 0.01) return;
-  fprintf(stderr, "%s: note: t (%s) steps by %.6g s, %.6g Hz, where --fs says %.6g Hz (a step of %.6g s)", k_prog,
-          what, step, 1.0 / step, fs, 1.0 / fs);
+  fprintf(stderr, "%s: note: t (%s) steps by %.6g s, %.6g Hz, where --fs says %.6g Hz (a step of %.6g s)",
+          k_prog, what, step, 1.0 / step, fs, 1.0 / fs);
   const double p10 = log10(step * fs);
   if (fabs(p10 - round(p10)) < log10(1.01) && round(p10) != 0.0)
     fprintf(stderr, ": the step is 1/fs x %.0e, is t's unit right?", pow(10.0, round(p10)));
@@ -295,7 +295,8 @@ static int time_base_given(const csv_reader_t *r, const tally_t *y, replay_scan_
       fprintf(stderr,
               "%s: note: %s:%ld: t decreases; with --fs it is not used, output times "
               "count from the first row%s\n",
-              k_prog, name, y->line_min, s->n_gaps ? " (and gaps cannot be found: --gaps restart does nothing)" : "");
+              k_prog, name, y->line_min,
+              s->n_gaps ? " (and gaps cannot be found: --gaps restart does nothing)" : "");
     s->t_unit_s = 0.0;
     s->n_gaps = 0;
     s->gap_step = 0.0;
@@ -320,11 +321,13 @@ static int time_base_given(const csv_reader_t *r, const tally_t *y, replay_scan_
       unit = 1.0;
     } else if (k < sizeof k_units / sizeof k_units[0]) {
       if (!quiet)
-        fprintf(stderr, "%s: note: t steps by %.6g: in %s at --fs %.6g Hz\n", k_prog, step, k_unit_names[k], fs);
+        fprintf(stderr, "%s: note: t steps by %.6g: in %s at --fs %.6g Hz\n", k_prog, step, k_unit_names[k],
+                fs);
       unit = k_units[k];
     } else if (!quiet && step > 0) {
       if (fabs(step - 1.0) < 0.01)
-        fprintf(stderr, "%s: note: t steps by %.6g: a sample index; the rate is --fs %.6g Hz\n", k_prog, step, fs);
+        fprintf(stderr, "%s: note: t steps by %.6g: a sample index; the rate is --fs %.6g Hz\n", k_prog, step,
+                fs);
       else
         fprintf(stderr,
                 "%s: note: t steps by %.6g: %.6g Hz if t is in seconds, %.6g Hz if in ms, where "
@@ -338,8 +341,9 @@ static int time_base_given(const csv_reader_t *r, const tally_t *y, replay_scan_
             "%s: note: t's steps vary from %.6g to %.6g (mean %.6g, line %ld); with --fs "
             "they are not checked: the rows are taken as samples at %.6g Hz%s\n",
             k_prog, y->dt_min, y->dt_max, step, y->hi > 1.05 * step ? y->line_hi : y->line_lo, fs,
-            y->hi > 1.5 * step && !s->n_gaps ? " (samples missing: --gaps restart restarts the estimator at gaps)"
-                                             : "");
+            y->hi > 1.5 * step && !s->n_gaps
+                ? " (samples missing: --gaps restart restarts the estimator at gaps)"
+                : "");
   return -1;
 }
 
@@ -506,8 +510,8 @@ static int find_gaps(csv_reader_t *r, const replay_opts_t *o, tally_t *y, replay
 /* Where the gaps are, and what --gaps restart does at them. */
 static void say_gaps(const csv_reader_t *r, const replay_scan_t *s, double step)
 {
-  fprintf(stderr, "%s: note: %s: %ld gap%s in t (--gaps restart), about %ld samples missing:", k_prog, r->name,
-          s->n_gaps, s->n_gaps == 1 ? "" : "s", s->gap_missing);
+  fprintf(stderr, "%s: note: %s: %ld gap%s in t (--gaps restart), about %ld sample%s missing:", k_prog,
+          r->name, s->n_gaps, s->n_gaps == 1 ? "" : "s", s->gap_missing, s->gap_missing == 1 ? "" : "s");
   for (long g = 0; g < s->n_gaps && g < 4; ++g)
     fprintf(stderr, "%s line %ld (t = %.9g after %.9g, a step of %.6g where %.6g is expected)", g ? ";" : "",
             s->gap_line[g], s->gap_t[g][1], s->gap_t[g][0], s->gap_t[g][1] - s->gap_t[g][0], step);
@@ -557,7 +561,8 @@ int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s)
   }
   s->t_last = y.tprev;
   if (o->gaps_restart && (rc = find_gaps(r, o, &y, s)) >= 0) return rc;
-  rc = o->fs_hz > 0 ? time_base_given(r, &y, s, o->fs_hz, o->quiet) : time_base_from_t(r->name, &y, s, o->quiet);
+  rc = o->fs_hz > 0 ? time_base_given(r, &y, s, o->fs_hz, o->quiet)
+                    : time_base_from_t(r->name, &y, s, o->quiet);
   if (rc >= 0) return rc;
   if (s->n_gaps && !o->quiet) say_gaps(r, s, mean_step(&y, s));
   if (r->decimal_comma_line && !o->quiet)

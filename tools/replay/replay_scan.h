@@ -40,10 +40,10 @@ typedef struct {
   double i_first, i_max;       /* for the at-rest test */
   double th_step1;             /* |first angle step| [rad] */
   /* --gaps restart: steps of t over 1.5 x gap_step (t's unit) are gaps */
-  double gap_step;    /* the median step of t (0: no gaps looked for) */
-  long n_gaps;        /* how many */
-  long gap_missing;   /* samples missing in them, about */
-  long gap_line[4];   /* the first ones: line, t before and after */
+  double gap_step;  /* the median step of t (0: no gaps looked for) */
+  long n_gaps;      /* how many */
+  long gap_missing; /* samples missing in them, about */
+  long gap_line[4]; /* the first ones: line, t before and after */
   double gap_t[4][2];
 } replay_scan_t;
 
