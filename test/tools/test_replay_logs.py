@@ -206,6 +206,10 @@ def main():
         os.remove(csv) if os.path.exists(csv) else None
         rc, out, err = run([replay] + MOTOR + ["--output=" + csv, "--quiet", canon])
         check(rc == 0 and out == "" and slurp(csv) == ref, "--output=FILE", err)
+        rc, out, err = run([replay] + MOTOR + ["-o", os.path.join(d, "no", "such.csv"), canon])
+        check(rc == 1 and "-o " in err and "no/such.csv" in err, "-o into a missing folder: exit 1, named", err)
+        rc, out, err = run([replay] + MOTOR + ["--gaps", "bridge", canon])
+        check(rc == 2 and "--gaps takes refuse or restart, not 'bridge'" in err, "--gaps bridge: exit 2", err)
         with open(canon) as f:
             rc, out, err = run([replay] + MOTOR + ["-o", "-", "-"], stdin=f)
         check(rc == 0 and out == ref, "-o - and stdin", err)
