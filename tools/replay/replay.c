@@ -8,10 +8,12 @@
  * parse (replay_options.c) -> scan: time base, clipping, conventions
  * (replay_scan.c) -> configure, with advice on what the estimator refuses
  * (replay_advice.c) -> run: the drive loop (tools/common/drive_loop.c). */
+#define _POSIX_C_SOURCE 200809L /* dup, fdopen */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "csv_reader.h"
 #include "drive_loop.h"
@@ -80,19 +82,23 @@ static int configure(const replay_opts_t *o, const replay_scan_t *s, imest_confi
 /* CAN telemetry: the frames each window publishes, as a candump -L log       */
 
 typedef struct {
-  FILE *f; /* NULL: no log */
+  FILE *f;   /* NULL: no log */
+  int owned; /* f is closed at the end (not the process's stdout) */
 #ifdef IMEST_HAVE_CANDUMP
   imest_candump_port_t port;
   imest_can_pub_t pub; /* publishes what the background returns, as firmware would */
 #endif
 } can_log_t;
 
-static int can_log_open(can_log_t *c, const replay_opts_t *o)
+/* to_stdout: the stream "-" writes to (the process's stdout, kept aside when
+ * -o FILE took stdout for the windows' CSV). */
+static int can_log_open(can_log_t *c, const replay_opts_t *o, FILE *to_stdout)
 {
   memset(c, 0, sizeof *c);
   if (o->candump_path == NULL) return -1;
 #ifdef IMEST_HAVE_CANDUMP
-  c->f = strcmp(o->candump_path, "-") ? fopen(o->candump_path, "w") : stdout;
+  c->owned = strcmp(o->candump_path, "-") != 0 || to_stdout != stdout;
+  c->f = strcmp(o->candump_path, "-") ? fopen(o->candump_path, "w") : to_stdout;
   if (c->f == NULL) {
     fprintf(stderr, "%s: %s: %s\n", k_prog, o->candump_path, strerror(errno));
     return TOOL_EXIT_DATA;
@@ -104,6 +110,7 @@ static int can_log_open(can_log_t *c, const replay_opts_t *o)
   (void)imest_can_pub_init(&c->pub, &c->port.port, o->can_id); /* checked by replay_parse */
   return -1;
 #else
+  (void)to_stdout;
   fprintf(stderr, "%s: built without the candump port: --candump is not available\n", k_prog);
   return TOOL_EXIT_USAGE;
 #endif
@@ -132,7 +139,8 @@ static void can_log_time(can_log_t *c, double t_s)
 
 static int can_log_close(can_log_t *c)
 {
-  if (c->f == NULL || c->f == stdout) return 0;
+  if (c->f == NULL) return 0;
+  if (!c->owned) return fflush(c->f) == 0 ? 0 : -1;
   return fclose(c->f) == 0 ? 0 : -1;
 }
 
@@ -180,20 +188,58 @@ static void print_row(void *ctx, const imest_result_t *r)
   printf("\n");
 }
 
-static int run(csv_reader_t *r, const replay_opts_t *o, const replay_scan_t *s, drive_t *d, can_log_t *can)
+/* The estimator along the record, in segments: --gaps restart starts a new
+ * one at each gap in t. */
+typedef struct {
+  imest_t *est;
+  imest_config_t cfg; /* for a restart: as configured, but warming up (the motor runs) */
+  row_ctx_t *row;
+  long win_n;                      /* samples per window */
+  long k0;                         /* the segment's first sample */
+  double t0_s;                     /* its time [s] */
+  long restarts, flushed, dropped; /* at gaps: partial windows estimated, dropped */
+} segment_t;
+
+/* At a gap: the partial window before it is estimated if it has at least half
+ * a window's samples (as at the record's end), else dropped; then the
+ * instance is initialised again (filters, window, sequence) and output times
+ * count from the sample after the gap. */
+static void restart(drive_t *d, segment_t *g, const replay_scan_t *s, can_log_t *can, long k, double t_s)
+{
+  const long rest = (k - g->k0) % g->win_n;
+  if (rest > 0 && 2 * rest >= g->win_n) {
+    can_log_time(can, g->t0_s + (double)(k - g->k0 - 1) / s->fs);
+    drive_flush(d);
+    g->flushed++;
+  } else if (rest > 0) {
+    g->dropped++;
+  }
+  (void)imest_init(g->est, &g->cfg); /* the config was checked */
+  g->k0 = k;
+  g->t0_s = t_s;
+  g->row->t0_s = t_s;
+  g->restarts++;
+}
+
+static int run(csv_reader_t *r, const replay_opts_t *o, const replay_scan_t *s, drive_t *d, can_log_t *can,
+               segment_t *g)
 {
   if (csv_rewind(r) != 0) {
     fprintf(stderr, "%s: %s: cannot read the file a second time\n", k_prog, r->name);
     return TOOL_EXIT_DATA;
   }
   print_header();
-  double v[CSV_MAX_NEED];
+  double v[CSV_MAX_NEED], tprev = 0, qprev = 0;
   replay_sample_t x;
   long k = 0;
   int rc;
   while ((rc = csv_next(r, v)) == 1) {
-    can_log_time(can, s->t0 * s->t_unit_s + (double)k / s->fs);
     replay_decode(o->voltage, v, &x);
+    if (k > 0 && s->n_gaps > 0 && replay_is_gap(s, x.t - tprev, r->t_round + qprev))
+      restart(d, g, s, can, k, x.t * s->t_unit_s);
+    tprev = x.t;
+    qprev = r->t_round;
+    can_log_time(can, g->t0_s + (double)(k - g->k0) / s->fs);
     const int n = o->voltage == REPLAY_VOLTAGE_DUTY ? drive_sample_duty(d, x.d, x.vdc, x.i, x.theta)
                                                     : drive_sample(d, x.u, x.i, x.theta);
     if (n < 0) break;
@@ -207,21 +253,22 @@ static int run(csv_reader_t *r, const replay_opts_t *o, const replay_scan_t *s, 
 }
 
 /* A last partial window of at least half the length is estimated too, and a
- * record shorter than one window is estimated as one shorter window. */
-static long run_last_window(drive_t *d, const replay_scan_t *s, const imest_config_t *cfg, can_log_t *can,
+ * record shorter than one window (without gaps) is estimated as one shorter
+ * window. */
+static long run_last_window(drive_t *d, const replay_scan_t *s, const segment_t *g, can_log_t *can,
                             int *flushed)
 {
-  const long win_n = lround((double)cfg->window_s * s->fs), rest = s->n % win_n;
-  *flushed = rest > 0 && (2 * rest >= win_n || s->n < win_n);
+  const long n = s->n - g->k0, rest = n % g->win_n;
+  *flushed = rest > 0 && (2 * rest >= g->win_n || (n < g->win_n && g->restarts == 0));
   if (*flushed) {
-    can_log_time(can, s->t0 * s->t_unit_s + (double)(s->n - 1) / s->fs);
+    can_log_time(can, g->t0_s + (double)(n - 1) / s->fs);
     drive_flush(d);
   }
   return rest;
 }
 
-static void summary(const drive_t *d, const replay_scan_t *s, const imest_config_t *cfg, long rest,
-                    int flushed)
+static void summary(const drive_t *d, const replay_scan_t *s, const imest_config_t *cfg, const segment_t *g,
+                    long rest, int flushed)
 {
   fprintf(stderr, "%s: %ld samples at %.6g Hz, %ld windows (%ld valid", k_prog, s->n, s->fs, d->windows,
           d->valid);
@@ -237,7 +284,11 @@ static void summary(const drive_t *d, const replay_scan_t *s, const imest_config
     fprintf(stderr, "; last %ld samples (under half a window) not used", rest);
   else if (rest)
     fprintf(stderr, "; last window has %ld samples", rest);
-  fprintf(stderr, "%s\n", cfg->start_at_rest ? "; started at rest" : "; warm-up at start");
+  fprintf(stderr, "%s", cfg->start_at_rest ? "; started at rest" : "; warm-up at start");
+  if (g->restarts)
+    fprintf(stderr, "; restarted at %ld gap%s (%ld partial window%s before them estimated, %ld dropped)",
+            g->restarts, g->restarts == 1 ? "" : "s", g->flushed, g->flushed == 1 ? "" : "s", g->dropped);
+  fprintf(stderr, "\n");
   /* nothing valid: say what the most common reason usually means */
   const char *what = d->valid == 0 && most ? replay_remedy(most) : NULL;
   if (what)
@@ -259,7 +310,15 @@ static int require_valid(const drive_t *d, tool_require_t req)
  * the other input's columns gets the --voltage that reads it. */
 static int open_recording(csv_reader_t *r, const replay_opts_t *o)
 {
-  if (csv_open_layout(r, o->path, replay_layout(o->voltage)) == 0) return 0;
+  if (csv_open_layout(r, o->path, replay_layout(o->voltage)) == 0) {
+    /* what the header made the reader do: said once */
+    for (const char *p = r->notes; *p && !o->quiet;) {
+      const char *e = strchr(p, '\n');
+      fprintf(stderr, "%s: note: %.*s\n", k_prog, (int)(e - p), p);
+      p = e + 1;
+    }
+    return 0;
+  }
   fprintf(stderr, "%s: %s", k_prog, r->err);
   const replay_voltage_t other =
       o->voltage == REPLAY_VOLTAGE_DUTY ? REPLAY_VOLTAGE_PHASE : REPLAY_VOLTAGE_DUTY;
@@ -270,6 +329,27 @@ static int open_recording(csv_reader_t *r, const replay_opts_t *o)
     fprintf(stderr, "; it has the columns of --voltage %s", other == REPLAY_VOLTAGE_DUTY ? "duty" : "phase");
   csv_close(&alt);
   fprintf(stderr, "\n");
+  return -1;
+}
+
+/* -o FILE: the windows' CSV into FILE (stdout is reopened on it, so the rows
+ * are written as without -o); *to_stdout: where "--candump -" then goes. */
+static int open_output(const replay_opts_t *o, FILE **to_stdout)
+{
+  *to_stdout = stdout;
+  if (o->output_path == NULL || strcmp(o->output_path, "-") == 0) return -1;
+  if (o->candump_path != NULL && strcmp(o->candump_path, "-") == 0) {
+    const int fd = dup(STDOUT_FILENO);
+    *to_stdout = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (*to_stdout == NULL) {
+      fprintf(stderr, "%s: stdout for --candump -: %s\n", k_prog, strerror(errno));
+      return TOOL_EXIT_DATA;
+    }
+  }
+  if (freopen(o->output_path, "w", stdout) == NULL) {
+    fprintf(stderr, "%s: -o %s: cannot write: %s\n", k_prog, o->output_path, strerror(errno));
+    return TOOL_EXIT_DATA;
+  }
   return -1;
 }
 
@@ -292,18 +372,21 @@ int main(int argc, char **argv)
   row_ctx_t row = {0, &can};
   if ((rc = replay_scan(&r, &o, &s)) >= 0 || (rc = configure(&o, &s, &cfg)) >= 0) goto done;
   imest_init(&est, &cfg);
-  if ((rc = can_log_open(&can, &o)) >= 0) goto done;
+  FILE *to_stdout = stdout;
+  if ((rc = open_output(&o, &to_stdout)) >= 0 || (rc = can_log_open(&can, &o, to_stdout)) >= 0) goto done;
   row.t0_s = s.t0 * s.t_unit_s;
   drive_init(&d, &est, print_row, &row);
-  if ((rc = run(&r, &o, &s, &d, &can)) >= 0) goto done;
+  segment_t seg = {&est, cfg, &row, lround((double)cfg.window_s * s.fs), 0, row.t0_s, 0, 0, 0};
+  seg.cfg.start_at_rest = 0;
+  if ((rc = run(&r, &o, &s, &d, &can, &seg)) >= 0) goto done;
   int flushed;
-  const long rest = run_last_window(&d, &s, &cfg, &can, &flushed);
+  const long rest = run_last_window(&d, &s, &seg, &can, &flushed);
   if (can_log_close(&can) != 0 || fflush(stdout) != 0) {
     fprintf(stderr, "%s: write error\n", k_prog);
     rc = TOOL_EXIT_DATA;
     goto done;
   }
-  if (!o.quiet) summary(&d, &s, &cfg, rest, flushed);
+  if (!o.quiet) summary(&d, &s, &cfg, &seg, rest, flushed);
   if (d.error) {
     fprintf(stderr, "%s: imest_background failed: %s\n", k_prog, imest_err_name(d.error));
     rc = TOOL_EXIT_DATA;

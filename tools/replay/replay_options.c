@@ -23,7 +23,13 @@ static void usage(FILE *o)
              "order; other columns ignored): t in s, phase-to-neutral V, phase currents in A\n"
              "(positive into the motor), mechanical angle in rad (wrapped or unwrapped,\n"
              "increasing with the a-b-c field). With --voltage duty it needs\n"
-             "t,d_a,d_b,d_c,v_dc,i_a,i_b,i_c,theta instead. Guide: docs/feeding-logs.md.\n"
+             "t,d_a,d_b,d_c,v_dc,i_a,i_b,i_c,theta instead. Logs are read as drives write\n"
+             "them: names case-insensitive, a few aliases (time, v_a, angle, u_dc, ...), a\n"
+             "unit after the name in [] or () converted (ms, us, mA, mV, deg, rev, %%);\n"
+             "separator ',', ';' or tab (then a decimal comma is read); '#' comment lines;\n"
+             "two of the three currents suffice (the third is minus their sum), and so do\n"
+             "two line-to-line voltages u_ab,u_bc,u_ca instead of u_a,u_b,u_c (converted\n"
+             "without a zero sequence). Guide: docs/feeding-logs.md.\n"
              "Options take a value as '--opt VALUE' or '--opt=VALUE'.\n"
              "\n"
              "motor (required):\n"
@@ -34,7 +40,13 @@ static void usage(FILE *o)
              "  --fs HZ             sample rate; t then only orders the rows and may be in any\n"
              "                      unit (ms, a sample index) or too coarse (default: from t,\n"
              "                      which must then be in seconds; rounding of t to its printed\n"
-             "                      decimals is tolerated)\n"
+             "                      decimals is tolerated). With --fs, a t in seconds (or with\n"
+             "                      a unit in its header) that disagrees is named\n"
+             "  --gaps refuse|restart  missing samples (a step of t of 1.5 sample periods or\n"
+             "                      more): refuse the file (default), or restart the estimator\n"
+             "                      at each gap (the window before it is estimated if it has\n"
+             "                      half a window's samples, else dropped; the filters warm up\n"
+             "                      again)\n"
              "voltage:\n"
              "  --voltage phase|duty  phase: measured phase-to-neutral voltages u_a,u_b,u_c\n"
              "                      (default); duty: the upper switches' duty cycles d_a,d_b,d_c\n"
@@ -95,9 +107,11 @@ static void usage(FILE *o)
              "                      with --voltage duty: a duty-cycle voltage has no ADC)\n"
              "  --from-rest auto|yes|no  the record starts at rest (no warm-up needed);\n"
              "                      auto = current ~0 and rotor still at the first samples\n"
+             "output:\n"
+             "  -o, --output FILE   the windows' CSV into FILE (default: stdout; \"-\" = stdout)\n"
              "CAN telemetry:\n"
              "  --candump FILE      also write the published CAN frames (candump -L format;\n"
-             "                      \"-\" = stdout)\n"
+             "                      \"-\" = stdout, with the windows' CSV in -o FILE)\n"
              "  --candump-iface NAME  the interface name written into that log, a label only\n"
              "                      (default vcan0; a live interface is --can-iface in\n"
              "                      imest-monitor and imest-demo)\n"
@@ -349,6 +363,17 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
         fprintf(stderr, "%s: --from-rest takes auto, yes or no, not '%s'\n", k_prog, v);
         return TOOL_EXIT_USAGE;
       }
+    } else if (tool_args_is(&a, "--gaps")) {
+      const char *v = tool_args_value(&a);
+      if (v == NULL) return TOOL_EXIT_USAGE;
+      if (!strcmp(v, "refuse") || !strcmp(v, "restart")) {
+        o->gaps_restart = !strcmp(v, "restart");
+      } else {
+        fprintf(stderr, "%s: --gaps takes refuse or restart, not '%s'\n", k_prog, v);
+        return TOOL_EXIT_USAGE;
+      }
+    } else if (tool_args_is(&a, "-o") || tool_args_is(&a, "--output")) {
+      if ((o->output_path = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--candump")) {
       if ((o->candump_path = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--candump-iface")) {
@@ -382,6 +407,14 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
   }
   if (o->path == NULL) {
     fprintf(stderr, "%s: no input file (\"-\" reads stdin; see --help)\n", k_prog);
+    return TOOL_EXIT_USAGE;
+  }
+  const int to_stdout = o->output_path == NULL || strcmp(o->output_path, "-") == 0;
+  if (o->candump_path != NULL && strcmp(o->candump_path, "-") == 0 && to_stdout) {
+    fprintf(stderr,
+            "%s: --candump - writes the CAN frames to stdout, where the windows' CSV goes: "
+            "give the CSV a file with -o FILE (or the frames one with --candump FILE)\n",
+            k_prog);
     return TOOL_EXIT_USAGE;
   }
   const int rc = check_input_options(o, pwm_timing_given);

@@ -18,6 +18,7 @@ typedef struct {
   unsigned long given;      /* bit k: option k of the numeric table was given */
   replay_voltage_t voltage; /* --voltage */
   const char *path;         /* the recording, "-" = stdin */
+  const char *output_path;  /* -o/--output: the windows' CSV; NULL or "-" = stdout */
   const char *candump_path; /* NULL = no CAN log; "-" = stdout */
   const char *can_iface;    /* --candump-iface: the interface name written into that log */
   uint32_t can_id;          /* with IMEST_CAN_ID_EXT for a 29-bit identifier */
@@ -25,6 +26,7 @@ typedef struct {
   double speed_limit;       /* --speed-limit: 0 = from the sample rate */
   double i_limit, u_limit;  /* -1 = auto */
   int from_rest;            /* -1 = auto, 0 no, 1 yes */
+  int gaps_restart;         /* --gaps restart: missing samples restart the estimator (0: refused) */
   int quiet;
   int require; /* --require-valid: a tool_require_t */
 } replay_opts_t;

@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "tool_args.h"
@@ -78,6 +79,8 @@ typedef struct {
   long line_min, line_max;
   double lo, hi; /* steps widened / narrowed by their rounding */
   long line_lo, line_hi;
+  double t_hi[2];            /* t before and after the step at line_hi */
+  double step;               /* the nominal step when gaps are left out (0: the record's mean) */
   long repeats, line_repeat; /* steps of exactly 0 */
   double t_repeat;
   double q_repeat, q_worst;   /* rounding of t at the first repeat, at the widest step */
@@ -139,6 +142,8 @@ static void tally_row(tally_t *y, replay_scan_t *s, const csv_reader_t *r, const
     if (dt - q > y->hi) {
       y->hi = dt - q;
       y->line_hi = r->line;
+      y->t_hi[0] = y->tprev;
+      y->t_hi[1] = x->t;
     }
     if (dt == y->dt_max) y->q_worst = r->t_round;
     if (dt == 0.0 && y->repeats++ == 0) {
@@ -202,10 +207,16 @@ static int bad_unit(const char *name, const tally_t *y, double step)
   return TOOL_EXIT_DATA;
 }
 
+/* The step of t: the record's mean, or without its gaps (--gaps restart). */
+static double mean_step(const tally_t *y, const replay_scan_t *s)
+{
+  return y->step > 0 ? y->step : (s->t_last - s->t0) / (double)(s->n - 1);
+}
+
 /* Without --fs: t in seconds, increasing, steps fixed but for its rounding. */
 static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s, int quiet)
 {
-  const double step = (s->t_last - s->t0) / (double)(s->n - 1);
+  const double step = mean_step(y, s);
   if (y->repeats) {
     if (2.0 * y->q_repeat >= 0.5 * step)
       fprintf(stderr,
@@ -233,12 +244,18 @@ static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s
     const int gap = y->hi - 1.05 * step > 0.95 * step - y->lo;
     const long line = gap ? y->line_hi : y->line_lo;
     const double dt = gap ? y->dt_max : y->dt_min;
+    const int missing = gap && dt > 1.5 * step;
     fprintf(stderr,
             "%s: %s:%ld: irregular sampling: a step of %.6g s where the record's mean step is "
             "%.6g s (%.6g Hz)%s. The estimator needs a fixed sample rate. If the drive did sample "
-            "at a fixed rate and only t is inaccurate, give --fs HZ.\n",
-            k_prog, name, line, dt, step, 1.0 / step,
-            gap && dt > 1.5 * step ? ": samples are missing there" : "");
+            "at a fixed rate and only t is inaccurate, give --fs HZ.",
+            k_prog, name, line, dt, step, 1.0 / step, missing ? ": samples are missing there" : "");
+    if (missing)
+      fprintf(stderr,
+              " t = %.9g after %.9g: about %ld sample%s missing; --gaps restart restarts the "
+              "estimator at each such gap instead of refusing the file.",
+              y->t_hi[1], y->t_hi[0], lround(dt / step) - 1, lround(dt / step) - 1 == 1 ? "" : "s");
+    fprintf(stderr, "\n");
     return TOOL_EXIT_DATA;
   }
   s->fs = s->fs_t = 1.0 / step;
@@ -252,37 +269,81 @@ static int time_base_from_t(const char *name, const tally_t *y, replay_scan_t *s
   return -1;
 }
 
-/* With --fs: t only orders the rows; its unit follows from its mean step. */
-static int time_base_given(const char *name, const tally_t *y, replay_scan_t *s, double fs, int quiet)
+/* --fs against a t in seconds: a step that disagrees by more than 1 % is named. */
+static void fs_against_seconds(const char *what, double step, double fs, int quiet)
 {
-  const double step = (s->t_last - s->t0) / (double)(s->n - 1);
+  if (quiet || fabs(step * fs - 1.0) <= 0.01) return;
+  fprintf(stderr, "%s: note: t (%s) steps by %.6g s, %.6g Hz, where --fs says %.6g Hz (a step of %.6g s)",
+          k_prog, what, step, 1.0 / step, fs, 1.0 / fs);
+  const double p10 = log10(step * fs);
+  if (fabs(p10 - round(p10)) < log10(1.01) && round(p10) != 0.0)
+    fprintf(stderr, ": the step is 1/fs x %.0e, is t's unit right?", pow(10.0, round(p10)));
+  fprintf(stderr, "; using --fs\n");
+}
+
+/* With --fs: t only orders the rows; its unit follows from its mean step, or
+ * from its header. What that unit looks like is said, and a t in seconds that
+ * disagrees with --fs is named. */
+static int time_base_given(const csv_reader_t *r, const tally_t *y, replay_scan_t *s, double fs, int quiet)
+{
+  const double step = mean_step(y, s);
+  const char *name = r->name;
   s->fs = fs;
   if (y->dt_min < 0) {
     /* a timer that wrapped, or no time at all: the output counts from the first row */
     if (!quiet)
       fprintf(stderr,
               "%s: note: %s:%ld: t decreases; with --fs it is not used, output times "
-              "count from the first row\n",
-              k_prog, name, y->line_min);
+              "count from the first row%s\n",
+              k_prog, name, y->line_min,
+              s->n_gaps ? " (and gaps cannot be found: --gaps restart does nothing)" : "");
     s->t_unit_s = 0.0;
+    s->n_gaps = 0;
+    s->gap_step = 0.0;
     return -1;
   }
   s->fs_t = step > 0 ? 1.0 / step : 0.0;
-  double unit = step > 0 ? 1.0 / (fs * step) : 0.0;
-  static const double k_units[] = {1.0, 1e-3, 1e-6};
-  for (size_t k = 0; k < sizeof k_units / sizeof k_units[0]; ++k)
-    if (fabs(unit / k_units[k] - 1.0) < 0.05) {
-      if (k == 0 && fabs(unit - 1.0) > 0.01 && !quiet)
-        fprintf(stderr, "%s: note: t says %.6g Hz, --fs says %.6g Hz: using --fs\n", k_prog, s->fs_t, fs);
+  if (r->t_unit[0] != '\0' && step > 0) {
+    /* the header says what t is in (converted to s) */
+    char what[48];
+    snprintf(what, sizeof what, "in %s by its header", r->t_unit);
+    fs_against_seconds(what, step, fs, quiet);
+    s->t_unit_s = 1.0;
+  } else {
+    double unit = step > 0 ? 1.0 / (fs * step) : 0.0;
+    static const double k_units[] = {1.0, 1e-3, 1e-6};
+    static const char *const k_unit_names[] = {"s", "ms", "us"};
+    size_t k = 0;
+    for (; k < sizeof k_units / sizeof k_units[0]; ++k)
+      if (fabs(unit / k_units[k] - 1.0) < 0.05) break;
+    if (k == 0) {
+      fs_against_seconds("in s", step, fs, quiet);
+      unit = 1.0;
+    } else if (k < sizeof k_units / sizeof k_units[0]) {
+      if (!quiet)
+        fprintf(stderr, "%s: note: t steps by %.6g: in %s at --fs %.6g Hz\n", k_prog, step, k_unit_names[k],
+                fs);
       unit = k_units[k];
-      break;
+    } else if (!quiet && step > 0) {
+      if (fabs(step - 1.0) < 0.01)
+        fprintf(stderr, "%s: note: t steps by %.6g: a sample index; the rate is --fs %.6g Hz\n", k_prog, step,
+                fs);
+      else
+        fprintf(stderr,
+                "%s: note: t steps by %.6g: %.6g Hz if t is in seconds, %.6g Hz if in ms, where "
+                "--fs says %.6g Hz: t is read in units of %.6g s; using --fs\n",
+                k_prog, step, 1.0 / step, 1e3 / step, fs, unit);
     }
-  s->t_unit_s = unit;
+    s->t_unit_s = unit;
+  }
   if (step > 0 && (y->hi > 1.05 * step || y->lo < 0.95 * step) && !quiet)
     fprintf(stderr,
             "%s: note: t's steps vary from %.6g to %.6g (mean %.6g, line %ld); with --fs "
-            "they are not checked: the rows are taken as samples at %.6g Hz\n",
-            k_prog, y->dt_min, y->dt_max, step, y->hi > 1.05 * step ? y->line_hi : y->line_lo, fs);
+            "they are not checked: the rows are taken as samples at %.6g Hz%s\n",
+            k_prog, y->dt_min, y->dt_max, step, y->hi > 1.05 * step ? y->line_hi : y->line_lo, fs,
+            y->hi > 1.5 * step && !s->n_gaps
+                ? " (samples missing: --gaps restart restarts the estimator at gaps)"
+                : "");
   return -1;
 }
 
@@ -350,6 +411,116 @@ static int check_conventions(const tally_t *y, const char *name, int quiet)
   return -1;
 }
 
+int replay_is_gap(const replay_scan_t *s, double dt, double q)
+{
+  return s->gap_step > 0 && dt - q > 1.5 * s->gap_step;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+  const double x = *(const double *)a, z = *(const double *)b;
+  return (x > z) - (x < z);
+}
+
+/* --gaps restart: a second pass over t. Steps of more than 1.5 x the median
+ * are gaps; without them the steps are tallied again and the nominal step is
+ * the mean of the others. Returns -1 to go on, or an exit code. */
+static int find_gaps(csv_reader_t *r, const replay_opts_t *o, tally_t *y, replay_scan_t *s)
+{
+  double *dt = malloc(sizeof *dt * (size_t)(s->n - 1)), *q = malloc(sizeof *q * (size_t)(s->n - 1));
+  if (dt == NULL || q == NULL || csv_rewind(r) != 0) {
+    free(dt);
+    free(q);
+    fprintf(stderr, "%s: %s: cannot read the file a second time\n", k_prog, r->name);
+    return TOOL_EXIT_DATA;
+  }
+  double v[CSV_MAX_NEED], tprev = 0, qprev = 0;
+  replay_sample_t x;
+  long k = 0;
+  while (csv_next(r, v) == 1 && k < s->n) {
+    replay_decode(o->voltage, v, &x);
+    if (k > 0) {
+      dt[k - 1] = x.t - tprev;
+      q[k - 1] = r->t_round + qprev;
+    }
+    tprev = x.t;
+    qprev = r->t_round;
+    k++;
+  }
+  const long m = k - 1;
+  double *sorted = malloc(sizeof *sorted * (size_t)(m > 0 ? m : 1));
+  if (sorted == NULL || m < 1) {
+    free(dt);
+    free(q);
+    free(sorted);
+    return -1;
+  }
+  memcpy(sorted, dt, sizeof *dt * (size_t)m);
+  qsort(sorted, (size_t)m, sizeof *sorted, cmp_double);
+  s->gap_step = sorted[m / 2];
+  free(sorted);
+  double span_gaps = 0;
+  for (long j = 0; j < m; ++j) {
+    if (!replay_is_gap(s, dt[j], q[j])) continue;
+    span_gaps += dt[j];
+    s->gap_missing += lround(dt[j] / s->gap_step) - 1;
+    s->n_gaps++;
+  }
+  if (s->n_gaps == 0 || s->gap_step <= 0) {
+    s->gap_step = 0;
+    free(dt);
+    free(q);
+    return -1;
+  }
+  /* the steps again, without the gaps */
+  y->step = (s->t_last - s->t0 - span_gaps) / (double)(m - s->n_gaps);
+  y->dt_min = y->lo = (double)INFINITY;
+  y->dt_max = y->hi = -(double)INFINITY;
+  free(dt);
+  free(q);
+  /* a third pass: the gaps' lines, the other steps' extremes */
+  if (csv_rewind(r) != 0) return TOOL_EXIT_DATA;
+  long g = 0;
+  k = 0;
+  while (csv_next(r, v) == 1 && k < s->n) {
+    replay_decode(o->voltage, v, &x);
+    if (k > 0) {
+      const double d = x.t - tprev, qq = r->t_round + qprev;
+      if (replay_is_gap(s, d, qq)) {
+        if (g < 4) {
+          s->gap_line[g] = r->line;
+          s->gap_t[g][0] = tprev;
+          s->gap_t[g][1] = x.t;
+        }
+        g++;
+      } else {
+        if (d < y->dt_min) y->dt_min = d, y->line_min = r->line;
+        if (d > y->dt_max) y->dt_max = d, y->line_max = r->line, y->q_worst = r->t_round;
+        if (d + qq < y->lo) y->lo = d + qq, y->line_lo = r->line;
+        if (d - qq > y->hi) y->hi = d - qq, y->line_hi = r->line, y->t_hi[0] = tprev, y->t_hi[1] = x.t;
+      }
+    }
+    tprev = x.t;
+    qprev = r->t_round;
+    k++;
+  }
+  return -1;
+}
+
+/* Where the gaps are, and what --gaps restart does at them. */
+static void say_gaps(const csv_reader_t *r, const replay_scan_t *s, double step)
+{
+  fprintf(stderr, "%s: note: %s: %ld gap%s in t (--gaps restart), about %ld sample%s missing:", k_prog,
+          r->name, s->n_gaps, s->n_gaps == 1 ? "" : "s", s->gap_missing, s->gap_missing == 1 ? "" : "s");
+  for (long g = 0; g < s->n_gaps && g < 4; ++g)
+    fprintf(stderr, "%s line %ld (t = %.9g after %.9g, a step of %.6g where %.6g is expected)", g ? ";" : "",
+            s->gap_line[g], s->gap_t[g][1], s->gap_t[g][0], s->gap_t[g][1] - s->gap_t[g][0], step);
+  fprintf(stderr,
+          "%s. The estimator restarts at each: the window before the gap is estimated if it has at least "
+          "half a window's samples, else dropped; the filters warm up again\n",
+          s->n_gaps > 4 ? "; ..." : "");
+}
+
 int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s)
 {
   memset(s, 0, sizeof *s);
@@ -389,9 +560,14 @@ int replay_scan(csv_reader_t *r, const replay_opts_t *o, replay_scan_t *s)
     return TOOL_EXIT_DATA;
   }
   s->t_last = y.tprev;
-  rc = o->fs_hz > 0 ? time_base_given(r->name, &y, s, o->fs_hz, o->quiet)
+  if (o->gaps_restart && (rc = find_gaps(r, o, &y, s)) >= 0) return rc;
+  rc = o->fs_hz > 0 ? time_base_given(r, &y, s, o->fs_hz, o->quiet)
                     : time_base_from_t(r->name, &y, s, o->quiet);
   if (rc >= 0) return rc;
+  if (s->n_gaps && !o->quiet) say_gaps(r, s, mean_step(&y, s));
+  if (r->decimal_comma_line && !o->quiet)
+    fprintf(stderr, "%s: note: %s: numbers with a decimal comma (first on line %ld) read as decimal points\n",
+            k_prog, r->name, r->decimal_comma_line);
   if (o->voltage == REPLAY_VOLTAGE_DUTY && (rc = check_duty(&y, r->name)) >= 0) return rc;
   return check_conventions(&y, r->name, o->quiet);
 }

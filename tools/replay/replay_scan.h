@@ -39,7 +39,17 @@ typedef struct {
   clip_t clip_i[3], clip_u[3]; /* clip_u: measured phase voltages only */
   double i_first, i_max;       /* for the at-rest test */
   double th_step1;             /* |first angle step| [rad] */
+  /* --gaps restart: steps of t over 1.5 x gap_step (t's unit) are gaps */
+  double gap_step;  /* the median step of t (0: no gaps looked for) */
+  long n_gaps;      /* how many */
+  long gap_missing; /* samples missing in them, about */
+  long gap_line[4]; /* the first ones: line, t before and after */
+  double gap_t[4][2];
 } replay_scan_t;
+
+/* Whether a step of t (dt, with q the rounding of its two ends) is a gap
+ * that --gaps restart restarts the estimator at. */
+int replay_is_gap(const replay_scan_t *s, double dt, double q);
 
 /* Reads the whole file once. Returns -1 to go on, or the exit code after a
  * message on stderr (TOOL_EXIT_DATA: the file cannot be used, with what to do). */
