@@ -1,4 +1,4 @@
-// SPDX-License-Identifier: Apache-2.0
+/* SPDX-License-Identifier: Apache-2.0 */
 // Equivalent circuit -> the estimator's constants (include/imest/imest_circuit.h), against values
 // worked out by hand.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// SPDX-License-Identifier: Apache-2.0
+/* SPDX-License-Identifier: Apache-2.0 */
 // The T_R tracker (include/imest/imest_tracker.h): every rule of imest_tracker_update() on
 // hand-made result sequences.
 #include <gtest/gtest.h>

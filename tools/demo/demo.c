@@ -374,10 +374,10 @@ typedef struct {
   tee_port_t *tee;
   FILE *log, *csv, *csv_true;
   truth_t *truth;
-  uint32_t wn; /* samples per window */
-  size_t nwin; /* truth slots */
-  size_t win;  /* windows whose truth is complete */
-  int have_id; /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
+  uint32_t wn;         /* samples per window */
+  size_t nwin;         /* truth slots */
+  size_t win;          /* windows whose truth is complete */
+  int have_id;         /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
   imest_tracker_t trk; /* every run: what the tracker makes of its results (applied if adaptive) */
 } run_t;
 
