@@ -39,7 +39,7 @@
  * load shortly after a cold start: 100 K over a 20-min time constant) moves T_R by
  * 0.0039 x 5 K/min = 3.3e-4 /s, so by the estimator's typical bound (tr_tolerance, 2 %) in 60 s.
  * A T_R older than that is no longer known to within its bound: the tracker then says so
- * (IMEST_TRACKER_STALE) and moves towards the nominal T_R at the rate limit.
+ * (IMEST_TRACKER_STALE) and moves towards the nominal T_R at the rate limit (fallback_rel_per_s).
  *
  * The first estimate after init (and after staleness) may move faster than the rate limit: once
  * `confirm_windows` consecutive valid windows agree (below), the tracked T_R is set to the
@@ -103,6 +103,13 @@ typedef struct {
   /** after this long without an accepted window [s], fall back to the nominal (default 60 s:
    *  above). > 0 and finite */
   float stale_after_s;
+  /** largest relative change per second while falling back to the nominal (default: the rate
+   *  limit, 1e-3 /s; 0: hold the last accepted T_R, the state still says STALE). A motor cools
+   *  towards ambient no faster than its rotor's thermal time constant allows: with windows that
+   *  are not valid under load for minutes, a value near alpha x (rated rise) / (thermal time
+   *  constant), e.g. 0.0039 x 80 K / 1200 s = 2.6e-4 /s, keeps a warm motor's T_R closer
+   *  (docs/integrating.md, "Feeding T_R to the controller"). In [0, 1] */
+  float fallback_rel_per_s;
   /** least relative tolerance of the agreement test (below), whatever the windows' bounds say
    *  (default 0.005). In [0, 1) */
   float gate_min_rel;
@@ -180,7 +187,7 @@ int imest_tracker_init(imest_tracker_t *t, const imest_tracker_config_t *cfg);
  * state = TRACKING if this result was accepted; else NOMINAL if none was ever accepted; else STALE
  * if age_s > stale_after_s; else HOLDING. The goal is the last accepted T_R in TRACKING and
  * HOLDING, the nominal in NOMINAL and STALE. tr_s moves towards the goal by at most
- * rate_rel_per_s * dt * tr_s (and stops on it); except that an acceptance while acquiring, with
+ * rate_rel_per_s * dt * tr_s (in STALE fallback_rel_per_s * dt * tr_s), and stops on it; except that an acceptance while acquiring, with
  * acquire_jump, sets tr_s to the accepted value at once.
  * tr_bound_rel = nominal_bound_rel in NOMINAL; otherwise, with a the last accepted T_R and ba its
  * bound, (|tr_s - a| + (ba + rate_rel_per_s * age_s) * a) / tr_s: a bound on |T_R - tr_s| / tr_s as

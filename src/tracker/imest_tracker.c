@@ -43,6 +43,7 @@ void imest_tracker_config_default(imest_tracker_config_t *cfg, float tr_nominal_
   cfg->nominal_bound_rel = 0.35f;
   cfg->rate_rel_per_s = 1.0e-3f;
   cfg->stale_after_s = 60.0f;
+  cfg->fallback_rel_per_s = 1.0e-3f;
   cfg->gate_min_rel = 0.005f;
   cfg->confirm_windows = 2u;
   cfg->acquire_jump = 1;
@@ -70,6 +71,8 @@ int imest_tracker_config_check(const imest_tracker_config_t *cfg, const char **f
     bad = "rate_rel_per_s";
   else if (!in_range(cfg->stale_after_s, 0.0f, 1, 3.0e38f))
     bad = "stale_after_s";
+  else if (!in_range(cfg->fallback_rel_per_s, 0.0f, 0, 1.0f))
+    bad = "fallback_rel_per_s";
   else if (!in_range(cfg->gate_min_rel, 0.0f, 0, 1.0f) || cfg->gate_min_rel >= 1.0f)
     bad = "gate_min_rel";
   else if (cfg->confirm_windows < 1u || cfg->confirm_windows > 16u)
@@ -178,7 +181,8 @@ int imest_tracker_update(imest_tracker_t *t, const imest_result_t *r)
 
   const int to_nominal = t->state == IMEST_TRACKER_NOMINAL || t->state == IMEST_TRACKER_STALE;
   const float goal = to_nominal ? c->tr_nominal_s : t->target_s;
-  t->tr_s = jump ? v : slew(t->tr_s, goal, c->rate_rel_per_s * dt);
+  const float rate = t->state == IMEST_TRACKER_STALE ? c->fallback_rel_per_s : c->rate_rel_per_s;
+  t->tr_s = jump ? v : slew(t->tr_s, goal, rate * dt);
   t->tr_bound_rel = bound_of(t);
   return accepted;
 }

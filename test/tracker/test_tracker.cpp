@@ -56,6 +56,7 @@ TEST_F(Tracker, DefaultsAndInit)
   EXPECT_FLOAT_EQ(cfg.tr_nominal_s, kNominal);
   EXPECT_FLOAT_EQ(cfg.rate_rel_per_s, 1e-3f);
   EXPECT_FLOAT_EQ(cfg.stale_after_s, 60.0f);
+  EXPECT_FLOAT_EQ(cfg.fallback_rel_per_s, 1e-3f);
   EXPECT_FLOAT_EQ(cfg.nominal_bound_rel, 0.35f);
   EXPECT_FLOAT_EQ(cfg.gate_min_rel, 0.005f);
   EXPECT_EQ(cfg.confirm_windows, 2u);
@@ -100,6 +101,9 @@ TEST_F(Tracker, BadConfigsRejected)
       {"stale_after_s",
        [](imest_tracker_config_t *c, float v) { c->stale_after_s = v; },
        {0.0f, -1.0f, nan, inf}},
+      {"fallback_rel_per_s",
+       [](imest_tracker_config_t *c, float v) { c->fallback_rel_per_s = v; },
+       {-1e-4f, 1.5f, nan, inf}},
       {"gate_min_rel",
        [](imest_tracker_config_t *c, float v) { c->gate_min_rel = v; },
        {-0.001f, 1.0f, nan, inf}},
@@ -335,6 +339,24 @@ TEST_F(Tracker, StaleFallsBackToNominal)
   feed(0, 0.0, 100.0);
   EXPECT_FLOAT_EQ(t.tr_s, kNominal);
   EXPECT_EQ(t.state, IMEST_TRACKER_STALE);
+}
+
+TEST_F(Tracker, StaleFallbackRateIsItsOwn)
+{
+  cfg.fallback_rel_per_s = 2.5e-4f; // a rotor's cooling rate
+  ASSERT_EQ(imest_tracker_init(&t, &cfg), IMEST_OK);
+  acquire(0.09);
+  feed(0, 0.0, 61.0); // stale: 61 s at a quarter of the rate limit
+  EXPECT_EQ(t.state, IMEST_TRACKER_STALE);
+  EXPECT_NEAR(t.tr_s, 0.09 * (1.0 + 61 * 2.5e-4), 1e-7);
+  cfg.fallback_rel_per_s = 0.0f; // hold, but say it is stale
+  ASSERT_EQ(imest_tracker_init(&t, &cfg), IMEST_OK);
+  now = 0.0;
+  acquire(0.09);
+  feed(0, 0.0, 500.0);
+  EXPECT_EQ(t.state, IMEST_TRACKER_STALE);
+  EXPECT_FLOAT_EQ(t.tr_s, 0.09f);
+  EXPECT_NEAR(t.tr_bound_rel, 0.0005 + kRate * 500, 1e-6); // the drift allowed since
 }
 
 TEST_F(Tracker, StaleReacquiresWithConfirmationAndJumps)
