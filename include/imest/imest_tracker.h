@@ -82,7 +82,7 @@ typedef enum {
    *  T_R (if it has not reached it yet), then holds it */
   IMEST_TRACKER_HOLDING = 2,
   /** the last accepted window is older than stale_after_s: tr_s moves towards the nominal T_R at
-   *  the rate limit, and stays there */
+   *  fallback_rel_per_s (default: the rate limit), and stays there */
   IMEST_TRACKER_STALE = 3
 } imest_tracker_state_t;
 
