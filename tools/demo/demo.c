@@ -28,7 +28,10 @@
  *   ifoc_fixed     the same heat run under IFOC speed control, the
  *                  controller's T_R fixed at the cold value.
  *   ifoc_adaptive  the same, the controller's T_R set from the estimator's
- *                  latest valid window (imsim_set_ifoc_tr).
+ *                  results through the T_R tracker (imest_tracker.h: hold,
+ *                  rate limit, outlier confirmation, stale fallback;
+ *                  imsim_set_ifoc_tr); --adaptive-tr raw: every valid window
+ *                  as it is, for comparison.
  *   ifoc11_fixed, ifoc11_adaptive
  *                  the same pair on an 11 kW motor (imsim preset 11kw: 8 kHz
  *                  drive, firmware timing) at half load, heating 6x faster
@@ -57,6 +60,7 @@
 #include "drive_loop.h"
 #include "imest/imest.h"
 #include "imest/imest_can.h"
+#include "imest/imest_tracker.h"
 #include "imest_candump.h"
 #include "imsim/imsim.h"
 #include "tool_args.h"
@@ -80,6 +84,7 @@ typedef struct {
   int quiet;
   unsigned int only; /* bit mask of experiments to run */
   int no_commission; /* the estimators get the true constants, nothing is commissioned */
+  int adaptive_raw;  /* the adaptive runs take every valid window as it is, not the tracker's T_R */
 } options_t;
 
 /* The constants the experiments' estimators get: commissioning's, or the truth. */
@@ -369,10 +374,11 @@ typedef struct {
   tee_port_t *tee;
   FILE *log, *csv, *csv_true;
   truth_t *truth;
-  uint32_t wn; /* samples per window */
-  size_t nwin; /* truth slots */
-  size_t win;  /* windows whose truth is complete */
-  int have_id; /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
+  uint32_t wn;         /* samples per window */
+  size_t nwin;         /* truth slots */
+  size_t win;          /* windows whose truth is complete */
+  int have_id;         /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
+  imest_tracker_t trk; /* every run: what the tracker makes of its results (applied if adaptive) */
 } run_t;
 
 static void run_release(run_t *x)
@@ -466,13 +472,22 @@ static int job_open(job_t *j, run_t *x)
     return -1;
   }
 
+  /* the tracker's nominal is the controller's own cold T_R (imsim: ifoc_tr_s 0 = the motor's) */
+  imest_tracker_config_t tc;
+  imest_tracker_config_default(&tc, (float)(x->c.ifoc_tr_s > 0.0 ? x->c.ifoc_tr_s : x->c.tr_s));
+  if (imest_tracker_init(&x->trk, &tc) != IMEST_OK) {
+    snprintf(j->err, sizeof j->err, "%s: imest_tracker_init failed", x->name);
+    return -1;
+  }
+
   snprintf(fname, sizeof fname, "%s_direct.csv", x->name);
   if ((x->csv = open_out(j, x->dir, fname)) == NULL) return -1;
   fprintf(x->csv, "experiment,seq,t_end_s,T_R_s,R_S_ohm,valid,status,T_R_true_s,R_S_true_ohm,E_I,"
                   "pe_k1_rel,pe_k2_rel,slip_ratio,i_rms_a,n_roots,n_admissible,used_samples,flags,"
                   "speed_rad_s,torque_nm,load_nm,torque_ref_nm,torque_err_rms_nm,psi_r_wb,psi_ref_wb,"
                   "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s,"
-                  "tr_valid,tr_reason,rs_valid,rs_reason\n");
+                  "tr_valid,tr_reason,rs_valid,rs_reason,tr_bound_rel,trk_T_R_s,trk_state,trk_age_s,"
+                  "trk_bound_rel\n");
 
   j->fs_hz = x->c.fs_hz;
   j->total = (unsigned long long)llround(j->duration_s * x->c.fs_hz);
@@ -503,16 +518,25 @@ static void on_window(void *ctx, const imest_result_t *r)
   static const truth_t nan_t = {D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN,
                                 D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN};
   const truth_t *t = (r->seq < x->nwin && r->seq < x->win) ? &x->truth[r->seq] : &nan_t;
+  (void)imest_tracker_update(&x->trk, r); /* t_end_s only grows: it cannot refuse */
   fprintf(x->csv,
           "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
-          "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s\n",
+          "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s,%.4g,%.9g,%s,%.6g,%.4g\n",
           x->name, r->seq, r->t_end_s, r->tr_s, r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr,
           t->rs, r->e_i, r->pe_k1_rel, r->pe_k2_rel, r->slip_ratio, r->i_rms_a, r->n_roots, r->n_admissible,
           r->used_samples, r->flags, t->speed, t->te, t->load, t->te_ref, t->te_err_rms, t->psi, t->psi_ref,
           t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr, r->tr_valid, imest_reason_name(r->tr_reason),
-          r->rs_valid, imest_reason_name(r->rs_reason));
-  /* the controller takes T_R whenever T_R itself is trusted */
-  if (r->tr_valid && IS_ADAPTIVE(j->id)) imsim_set_ifoc_tr(x->sim, r->tr_s);
+          r->rs_valid, imest_reason_name(r->rs_reason), r->tr_bound_rel, (double)x->trk.tr_s,
+          imest_tracker_state_name(x->trk.state), (double)x->trk.age_s, (double)x->trk.tr_bound_rel);
+  /* the controller takes the tracker's T_R (or, with --adaptive-tr raw, every window whose T_R is
+     trusted, as it is) */
+  if (IS_ADAPTIVE(j->id)) {
+    if (j->opt->adaptive_raw) {
+      if (r->tr_valid) imsim_set_ifoc_tr(x->sim, r->tr_s);
+    } else {
+      imsim_set_ifoc_tr(x->sim, (double)x->trk.tr_s);
+    }
+  }
   if (r->valid) {
     if (j->id == EXP1 && x->have_id < 2) {
       x->have_id = 2; /* the first valid window */
@@ -684,7 +708,8 @@ static int commission(const options_t *o, const char *raw, demo_constants_t *k)
 static void usage(FILE *f)
 {
   fprintf(f, "usage: imest-demo [--out DIR] [--duration S] [--exp1-duration S] [--only LIST]\n"
-             "                  [--can-iface NAME] [--seed N] [--no-commission] [--quiet]\n"
+             "                  [--can-iface NAME] [--seed N] [--no-commission]\n"
+             "                  [--adaptive-tr tracker|raw] [--quiet]\n"
              "\n"
              "Commissions the simulated motor with the library's routine first, then runs the\n"
              "paper's experiments with the identified constants and imest in the loop (ISR\n"
@@ -705,6 +730,8 @@ static void usage(FILE *f)
              "  --can-iface NAME    also send exp2's frames on this SocketCAN interface\n"
              "  --seed N            sensor noise seed (default 1)\n"
              "  --no-commission     the estimators get the true constants (no commissioning)\n"
+             "  --adaptive-tr MODE  what the adaptive runs' controller takes: tracker (default:\n"
+             "                      the T_R tracker, imest_tracker.h) or raw (every valid window)\n"
              "  --quiet             no progress on stderr (default: progress if it is a terminal)\n"
              "  -h, --help          this text\n"
              "  --version           the version and licence\n"
@@ -798,6 +825,14 @@ static int parse_options(int argc, char **argv, options_t *o)
     } else if (tool_args_is(&a, "--quiet")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       o->quiet = 1;
+    } else if (tool_args_is(&a, "--adaptive-tr")) {
+      const char *v = tool_args_value(&a);
+      if (v == NULL) return TOOL_EXIT_USAGE;
+      if (strcmp(v, "tracker") != 0 && strcmp(v, "raw") != 0) {
+        fprintf(stderr, "imest-demo: --adaptive-tr: '%s' is not tracker or raw\n", v);
+        return TOOL_EXIT_USAGE;
+      }
+      o->adaptive_raw = strcmp(v, "raw") == 0;
     } else if (tool_args_is(&a, "--no-commission")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       o->no_commission = 1;

@@ -155,6 +155,11 @@ def build_windows(raw, exp):
                     "temp_rotor_c", "torque_ref_nm", "torque_err_rms_nm", "psi_r_wb",
                     "psi_ref_wb", "ifoc_T_R_s"):
             row[key] = d[key]
+        # the T_R tracker's output after this window (imest_tracker.h; the adaptive runs' controller
+        # uses it from the next window on), when the demo wrote it
+        for key in ("tr_bound_rel", "trk_T_R_s", "trk_state", "trk_age_s", "trk_bound_rel"):
+            if key in d:
+                row[key] = d[key]
         rows.append(row)
     return rows, mismatches, missing, len(mon)
 

@@ -59,6 +59,17 @@ for name in ("exp1_windows.csv", "windows.csv"):
             for key, fmt in (("R_S_ohm", "%.5g"), ("R_S_ohm", "%.4f"), ("T_R_s", "%.5g"), ("T_R_s", "%.5f")):
                 txt = fmt % float(r[key])
                 assert txt not in md, f"summary prints {name} window {r['seq']}'s {key} {txt}"
+# the adaptive runs' controller uses the T_R tracker's output (imest_tracker.h) from the next window on
+# (ifoc_T_R_s is the window's mean, written with 6 digits)
+for name in ("ifoc_adaptive_windows.csv", "ifoc11_adaptive_windows.csv"):
+    rows = list(csv.DictReader(open(f"{out}/{name}")))
+    for k in ("trk_T_R_s", "trk_state", "trk_age_s", "trk_bound_rel", "tr_bound_rel"):
+        assert k in rows[0], f"{name}: no column {k}"
+    assert {r["trk_state"] for r in rows} <= {"nominal", "tracking", "holding", "stale"}, name
+    assert rows[-1]["trk_state"] == "tracking", f"{name}: the tracker is not tracking at the end"
+    for a, b in zip(rows, rows[1:]):
+        used, trk = float(b["ifoc_T_R_s"]), float(a["trk_T_R_s"])
+        assert abs(used / trk - 1) < 1e-5, f"{name} window {b['seq']}: controller T_R {used}, tracker {trk}"
 for sec in ("## R_S and the encoder", "Why the fixed-T_R torque error changes sign"):
     assert sec in md, f"summary: no '{sec}'"
 print("demo smoke test: ok")
