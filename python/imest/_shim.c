@@ -28,47 +28,47 @@ enum { KIND_FLOAT = 0, KIND_INT = 1, KIND_UINT = 2, KIND_PWM_TIMING = 3, KIND_RE
 
 /* Every field of imest_config_t, by its C name (a nested field as
  * "inverter.dead_time_s", the name imest_config_check() reports). */
-#define IMEST_PY_CONFIG_FIELDS(X)                                                                             \
-  X(pole_pairs, KIND_UINT)                                                                                 \
-  X(ls_h, KIND_FLOAT)                                                                                      \
-  X(sigma, KIND_FLOAT)                                                                                     \
-  X(fs_hz, KIND_FLOAT)                                                                                     \
-  X(window_s, KIND_FLOAT)                                                                                  \
-  X(filter_hz, KIND_FLOAT)                                                                                 \
-  X(aa_hz, KIND_FLOAT)                                                                                     \
-  X(u_delay_s, KIND_FLOAT)                                                                                 \
-  X(angle_observer_hz, KIND_FLOAT)                                                                         \
-  X(dc_block_hz, KIND_FLOAT)                                                                               \
-  X(warmup_s, KIND_FLOAT)                                                                                  \
-  X(start_at_rest, KIND_INT)                                                                               \
-  X(pwm_hz, KIND_FLOAT)                                                                                    \
-  X(pwm_timing, KIND_PWM_TIMING)                                                                           \
-  X(inverter.dead_time_s, KIND_FLOAT)                                                                      \
-  X(inverter.v_switch_v, KIND_FLOAT)                                                                       \
-  X(inverter.r_switch_ohm, KIND_FLOAT)                                                                     \
-  X(inverter.v_diode_v, KIND_FLOAT)                                                                        \
-  X(inverter.r_diode_ohm, KIND_FLOAT)                                                                      \
-  X(inverter.i_band_a, KIND_FLOAT)                                                                         \
-  X(inverter.uncertainty, KIND_FLOAT)                                                                      \
-  X(tr_nominal_s, KIND_FLOAT)                                                                              \
-  X(tr_nominal_known, KIND_INT)                                                                            \
-  X(tr_min_s, KIND_FLOAT)                                                                                  \
-  X(tr_max_s, KIND_FLOAT)                                                                                  \
-  X(rs_min_ohm, KIND_FLOAT)                                                                                \
-  X(rs_max_ohm, KIND_FLOAT)                                                                                \
-  X(max_pe_k2_rel, KIND_FLOAT)                                                                             \
-  X(max_ei, KIND_FLOAT)                                                                                    \
-  X(min_current_a, KIND_FLOAT)                                                                             \
-  X(min_slip_ratio, KIND_FLOAT)                                                                            \
-  X(rs_tolerance, KIND_FLOAT)                                                                              \
-  X(tr_tolerance, KIND_FLOAT)                                                                              \
-  X(u_uncertainty_v, KIND_FLOAT)                                                                           \
-  X(timing_uncertainty_s, KIND_FLOAT)                                                                      \
-  X(rs_nominal_ohm, KIND_FLOAT)                                                                            \
-  X(i_limit_a, KIND_FLOAT)                                                                                 \
-  X(u_limit_v, KIND_FLOAT)                                                                                 \
-  X(i_absurd_a, KIND_FLOAT)                                                                                \
-  X(u_absurd_v, KIND_FLOAT)                                                                                \
+#define IMEST_PY_CONFIG_FIELDS(X)                                                                            \
+  X(pole_pairs, KIND_UINT)                                                                                   \
+  X(ls_h, KIND_FLOAT)                                                                                        \
+  X(sigma, KIND_FLOAT)                                                                                       \
+  X(fs_hz, KIND_FLOAT)                                                                                       \
+  X(window_s, KIND_FLOAT)                                                                                    \
+  X(filter_hz, KIND_FLOAT)                                                                                   \
+  X(aa_hz, KIND_FLOAT)                                                                                       \
+  X(u_delay_s, KIND_FLOAT)                                                                                   \
+  X(angle_observer_hz, KIND_FLOAT)                                                                           \
+  X(dc_block_hz, KIND_FLOAT)                                                                                 \
+  X(warmup_s, KIND_FLOAT)                                                                                    \
+  X(start_at_rest, KIND_INT)                                                                                 \
+  X(pwm_hz, KIND_FLOAT)                                                                                      \
+  X(pwm_timing, KIND_PWM_TIMING)                                                                             \
+  X(inverter.dead_time_s, KIND_FLOAT)                                                                        \
+  X(inverter.v_switch_v, KIND_FLOAT)                                                                         \
+  X(inverter.r_switch_ohm, KIND_FLOAT)                                                                       \
+  X(inverter.v_diode_v, KIND_FLOAT)                                                                          \
+  X(inverter.r_diode_ohm, KIND_FLOAT)                                                                        \
+  X(inverter.i_band_a, KIND_FLOAT)                                                                           \
+  X(inverter.uncertainty, KIND_FLOAT)                                                                        \
+  X(tr_nominal_s, KIND_FLOAT)                                                                                \
+  X(tr_nominal_known, KIND_INT)                                                                              \
+  X(tr_min_s, KIND_FLOAT)                                                                                    \
+  X(tr_max_s, KIND_FLOAT)                                                                                    \
+  X(rs_min_ohm, KIND_FLOAT)                                                                                  \
+  X(rs_max_ohm, KIND_FLOAT)                                                                                  \
+  X(max_pe_k2_rel, KIND_FLOAT)                                                                               \
+  X(max_ei, KIND_FLOAT)                                                                                      \
+  X(min_current_a, KIND_FLOAT)                                                                               \
+  X(min_slip_ratio, KIND_FLOAT)                                                                              \
+  X(rs_tolerance, KIND_FLOAT)                                                                                \
+  X(tr_tolerance, KIND_FLOAT)                                                                                \
+  X(u_uncertainty_v, KIND_FLOAT)                                                                             \
+  X(timing_uncertainty_s, KIND_FLOAT)                                                                        \
+  X(rs_nominal_ohm, KIND_FLOAT)                                                                              \
+  X(i_limit_a, KIND_FLOAT)                                                                                   \
+  X(u_limit_v, KIND_FLOAT)                                                                                   \
+  X(i_absurd_a, KIND_FLOAT)                                                                                  \
+  X(u_absurd_v, KIND_FLOAT)                                                                                  \
   X(speed_limit_rad_s, KIND_FLOAT)
 
 typedef struct {
@@ -89,44 +89,44 @@ _Static_assert(sizeof(imest_config_t) == sizeof k_fields / sizeof k_fields[0] * 
 /* The result columns: imest-replay's CSV columns in its order (tools/replay/
  * replay.c), t_end_s counted from the record's first t; then more of
  * imest_result_t. `r` is the result, `t0_s` the record's first t [s]. */
-#define IMEST_PY_COLUMNS(X)                                                                                   \
-  X(t_end_s, KIND_FLOAT, t0_s + r->t_end_s)                                                                \
-  X(T_R_s, KIND_FLOAT, r->tr_s)                                                                            \
-  X(R_S_ohm, KIND_FLOAT, r->rs_ohm)                                                                        \
-  X(E_I, KIND_FLOAT, r->e_i)                                                                               \
-  X(valid, KIND_INT, r->valid)                                                                             \
-  X(status, KIND_REASON, r->status)                                                                        \
-  X(seq, KIND_UINT, r->seq)                                                                                \
-  X(K1, KIND_FLOAT, r->k1)                                                                                 \
-  X(K2, KIND_FLOAT, r->k2)                                                                                 \
-  X(pe_k1_rel, KIND_FLOAT, r->pe_k1_rel)                                                                   \
-  X(pe_k2_rel, KIND_FLOAT, r->pe_k2_rel)                                                                   \
-  X(H11, KIND_FLOAT, r->hessian[0][0])                                                                     \
-  X(H12, KIND_FLOAT, r->hessian[0][1])                                                                     \
-  X(H22, KIND_FLOAT, r->hessian[1][1])                                                                     \
-  X(hessian_pd, KIND_INT, (r->flags & IMEST_FLAG_HESSIAN_PD) ? 1 : 0)                                      \
-  X(n_roots, KIND_UINT, r->n_roots)                                                                        \
-  X(n_admissible, KIND_UINT, r->n_admissible)                                                              \
-  X(slip_ratio, KIND_FLOAT, r->slip_ratio)                                                                 \
-  X(i_rms_a, KIND_FLOAT, r->i_rms_a)                                                                       \
-  X(used_samples, KIND_UINT, r->used_samples)                                                              \
-  X(flags, KIND_UINT, r->flags)                                                                            \
-  X(tr_valid, KIND_INT, r->tr_valid)                                                                       \
-  X(rs_valid, KIND_INT, r->rs_valid)                                                                       \
-  X(tr_reason, KIND_REASON, r->tr_reason)                                                                  \
-  X(rs_reason, KIND_REASON, r->rs_reason)                                                                  \
-  X(span_s, KIND_FLOAT, r->span_s)                                                                         \
-  X(windows, KIND_UINT, r->windows)                                                                        \
-  X(tr_bound_rel, KIND_FLOAT, r->tr_bound_rel)                                                             \
-  X(rs_bound_rel, KIND_FLOAT, r->rs_bound_rel)                                                             \
-  X(samples, KIND_UINT, r->samples)                                                                        \
-  X(overruns, KIND_UINT, r->overruns)                                                                      \
-  X(E, KIND_FLOAT, r->e)                                                                                   \
-  X(E_I_noise, KIND_FLOAT, r->e_i_noise)                                                                   \
-  X(noise_i_a, KIND_FLOAT, r->noise_i_a)                                                                   \
-  X(noise_u_v, KIND_FLOAT, r->noise_u_v)                                                                   \
-  X(pe_k1, KIND_FLOAT, r->pe_k1)                                                                           \
-  X(pe_k2, KIND_FLOAT, r->pe_k2)                                                                           \
+#define IMEST_PY_COLUMNS(X)                                                                                  \
+  X(t_end_s, KIND_FLOAT, t0_s + r->t_end_s)                                                                  \
+  X(T_R_s, KIND_FLOAT, r->tr_s)                                                                              \
+  X(R_S_ohm, KIND_FLOAT, r->rs_ohm)                                                                          \
+  X(E_I, KIND_FLOAT, r->e_i)                                                                                 \
+  X(valid, KIND_INT, r->valid)                                                                               \
+  X(status, KIND_REASON, r->status)                                                                          \
+  X(seq, KIND_UINT, r->seq)                                                                                  \
+  X(K1, KIND_FLOAT, r->k1)                                                                                   \
+  X(K2, KIND_FLOAT, r->k2)                                                                                   \
+  X(pe_k1_rel, KIND_FLOAT, r->pe_k1_rel)                                                                     \
+  X(pe_k2_rel, KIND_FLOAT, r->pe_k2_rel)                                                                     \
+  X(H11, KIND_FLOAT, r->hessian[0][0])                                                                       \
+  X(H12, KIND_FLOAT, r->hessian[0][1])                                                                       \
+  X(H22, KIND_FLOAT, r->hessian[1][1])                                                                       \
+  X(hessian_pd, KIND_INT, (r->flags & IMEST_FLAG_HESSIAN_PD) ? 1 : 0)                                        \
+  X(n_roots, KIND_UINT, r->n_roots)                                                                          \
+  X(n_admissible, KIND_UINT, r->n_admissible)                                                                \
+  X(slip_ratio, KIND_FLOAT, r->slip_ratio)                                                                   \
+  X(i_rms_a, KIND_FLOAT, r->i_rms_a)                                                                         \
+  X(used_samples, KIND_UINT, r->used_samples)                                                                \
+  X(flags, KIND_UINT, r->flags)                                                                              \
+  X(tr_valid, KIND_INT, r->tr_valid)                                                                         \
+  X(rs_valid, KIND_INT, r->rs_valid)                                                                         \
+  X(tr_reason, KIND_REASON, r->tr_reason)                                                                    \
+  X(rs_reason, KIND_REASON, r->rs_reason)                                                                    \
+  X(span_s, KIND_FLOAT, r->span_s)                                                                           \
+  X(windows, KIND_UINT, r->windows)                                                                          \
+  X(tr_bound_rel, KIND_FLOAT, r->tr_bound_rel)                                                               \
+  X(rs_bound_rel, KIND_FLOAT, r->rs_bound_rel)                                                               \
+  X(samples, KIND_UINT, r->samples)                                                                          \
+  X(overruns, KIND_UINT, r->overruns)                                                                        \
+  X(E, KIND_FLOAT, r->e)                                                                                     \
+  X(E_I_noise, KIND_FLOAT, r->e_i_noise)                                                                     \
+  X(noise_i_a, KIND_FLOAT, r->noise_i_a)                                                                     \
+  X(noise_u_v, KIND_FLOAT, r->noise_u_v)                                                                     \
+  X(pe_k1, KIND_FLOAT, r->pe_k1)                                                                             \
+  X(pe_k2, KIND_FLOAT, r->pe_k2)                                                                             \
   X(ls_noload_h, KIND_FLOAT, r->ls_noload_h)
 
 typedef struct {
@@ -151,8 +151,9 @@ int imest_py_pwm_timing(const char *name);
 int imest_py_columns(void);
 const char *imest_py_column_name(int k);
 int imest_py_column_kind(int k);
-long imest_py_run(const double *values, int duty, long n, const double *v3, const double *vdc, const double *i3,
-                  const double *theta, double fs_hz, double t0_s, double *out, long max_rows, int *error);
+long imest_py_run(const double *values, int duty, long n, const double *v3, const double *vdc,
+                  const double *i3, const double *theta, double fs_hz, double t0_s, double *out,
+                  long max_rows, int *error);
 
 int imest_py_abi(void)
 {
@@ -231,7 +232,8 @@ static int config_from(const double *values, imest_config_t *cfg, const char **f
       memcpy(p, &x, sizeof x);
       continue;
     }
-    const double lo = kind == KIND_UINT ? 0.0 : (double)INT_MIN, hi = kind == KIND_UINT ? (double)UINT_MAX : INT_MAX;
+    const double lo = kind == KIND_UINT ? 0.0 : (double)INT_MIN,
+                 hi = kind == KIND_UINT ? (double)UINT_MAX : INT_MAX;
     if (!(v >= lo && v <= hi) || v != floor(v)) {
       if (field) *field = k_fields[k].name;
       return IMEST_ERR_ARG;
@@ -317,8 +319,9 @@ static void put_row(void *ctx, const imest_result_t *r)
  * than max_rows: call again with room for them), or a negative imest_err_t
  * (the config: *error is then 0). *error: the first negative return of
  * imest_background() (the rows up to it are written), else 0. */
-long imest_py_run(const double *values, int duty, long n, const double *v3, const double *vdc, const double *i3,
-                  const double *theta, double fs_hz, double t0_s, double *out, long max_rows, int *error)
+long imest_py_run(const double *values, int duty, long n, const double *v3, const double *vdc,
+                  const double *i3, const double *theta, double fs_hz, double t0_s, double *out,
+                  long max_rows, int *error)
 {
   if (error) *error = 0;
   if (values == NULL || v3 == NULL || i3 == NULL || theta == NULL || (duty && vdc == NULL) ||

@@ -8,7 +8,8 @@
 
 #include "imest/imest.h"
 
-_Static_assert(sizeof(imest_config_t) == 41 * sizeof(float), "imest_config_t changed: list the new field below");
+_Static_assert(sizeof(imest_config_t) == 41 * sizeof(float),
+               "imest_config_t changed: list the new field below");
 
 #define F(name) printf(#name " %a\n", (double)cfg.name)
 #define I(name) printf(#name " %d\n", (int)cfg.name)
