@@ -270,6 +270,9 @@ def _adc_limit(channels, sym, unit, field):
 def _time_base(t, fs, n):
     """(fs, t0_s) as imest-replay's scan finds them (replay_scan.c time_base_from_t and
     time_base_given)."""
+    if t is not None and not np.all(np.isfinite(t)):
+        k = int(np.argmax(~np.isfinite(t)))
+        raise ValueError("imest.run: t[%d] = %r: t must be finite" % (k, t[k]))
     if fs is not None:
         fs = float(fs)
         if not (fs > 0.0) or fs > 1e6:
@@ -285,14 +288,14 @@ def _time_base(t, fs, n):
         unit = 1.0 / (fs * step) if step > 0 else 0.0
         for u in (1.0, 1e-3, 1e-6):
             if abs(unit / u - 1.0) < 0.05:
+                if u == 1.0 and abs(unit - 1.0) > 0.01:
+                    warnings.warn("t says %.6g Hz, fs says %.6g Hz: using fs" % (1.0 / step, fs), ImestWarning,
+                                  stacklevel=3)
                 unit = u
                 break
         return fs, float(t[0]) * unit
     if t is None:
         raise ValueError("imest.run: give the sample times t (in s) or the sample rate fs")
-    if not np.all(np.isfinite(t)):
-        k = int(np.argmax(~np.isfinite(t)))
-        raise ValueError("imest.run: t[%d] = %r: t must be finite" % (k, t[k]))
     dt = np.diff(t)
     if np.any(dt < 0):
         k = int(np.argmax(dt < 0)) + 1
