@@ -23,6 +23,7 @@ import sys
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.patches  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -413,20 +414,49 @@ def fig_exp1(out, wave, ident, exp1rows):
         how = (f"{ident['source']}, status {ident['status']}: T_R = {tr_id:.4f} s, "
                f"R_S = {rs_id:.3f} Ω")
     files = []
-    # Fig. 2: voltages
-    fig, axs = plt.subplots(2, 1, figsize=(10, 6.0))
-    for ax, tmax in zip(axs, (1.0, 0.05)):
-        s = t <= tmax
-        ax.plot(t[s], wave["u_alpha_v"][s], lw=0.7 if tmax > 0.5 else 1.2, label=r"$u_{Sa}$")
-        ax.plot(t[s], wave["u_beta_v"][s], lw=0.7 if tmax > 0.5 else 1.2, label=r"$u_{Sb}$")
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel("voltage [V]")
-        ax.grid(alpha=0.3)
+    # Fig. 2: voltages. 60 periods in a second draw a solid band, so the top panel shows what
+    # changes over the second, the amplitude (the voltage vector's length, one period's mean, and
+    # its envelope), with a few periods from mid-run as an inset; the bottom panel the start.
+    fig, axs = plt.subplots(2, 1, figsize=(10, 6.4))
+    ua, ub = wave["u_alpha_v"], wave["u_beta_v"]
+    s = t <= 1.0
+    mag = np.hypot(ua, ub)
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
+    n = max(1, int(round(1.0 / (60.0 * dt))))  # one 60 Hz period of samples
+    mean_mag = np.convolve(mag, np.ones(n) / n, mode="same")
+    ax = axs[0]
+    ax.fill_between(t[s], -mag[s], mag[s], color="tab:blue", alpha=0.12, lw=0,
+                    label=r"envelope $\pm|u_S|$, $|u_S| = \sqrt{u_{Sa}^2 + u_{Sb}^2}$ per sample")
+    ax.plot(t[s], mean_mag[s], color="tab:blue", lw=1.2, label=r"$|u_S|$, mean over one 60 Hz period")
+    ax.axhline(0, color="0.6", lw=0.6)
+    mid = float(np.median(mean_mag[s & (t > 0.1)])) if (s & (t > 0.1)).any() else float(np.max(mag))
+    ax.set_ylim(-1.9 * mid, 1.45 * mid)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("voltage [V]")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
+    ins = ax.inset_axes([0.55, 0.04, 0.43, 0.42])
+    z = (t >= 0.5) & (t <= 0.55)
+    ins.plot(t[z], ua[z], lw=1.0, label=r"$u_{Sa}$")
+    ins.plot(t[z], ub[z], lw=1.0, label=r"$u_{Sb}$")
+    ins.set_title("0.50-0.55 s (3 periods)", fontsize=7, pad=2)
+    ins.tick_params(labelsize=6)
+    ins.grid(alpha=0.3)
+    ins.legend(loc="upper right", fontsize=6, ncol=2)
+    ax.indicate_inset_zoom(ins, edgecolor="0.4")
+    ax2 = axs[1]
+    s = t <= 0.05
+    ax2.plot(t[s], ua[s], lw=1.2, label=r"$u_{Sa}$")
+    ax2.plot(t[s], ub[s], lw=1.2, label=r"$u_{Sb}$")
+    ax2.set_xlabel("time [s]")
+    ax2.set_ylabel("voltage [V]")
+    ax2.grid(alpha=0.3)
+    ax2.legend(loc="upper right", fontsize=8)
     axs[0].set_title("Exp. 1 (cf. paper Fig. 2): sampled two-phase voltages, 60 Hz 230 V applied at rest "
-                     "through the PWM inverter", fontsize=10)
+                     "through the PWM inverter:\nthe amplitude over the run-up (inset: three periods)",
+                     fontsize=10)
     axs[1].set_title("zoom on the first 50 ms (measured = carrier-period mean of the commanded "
                      "volt-seconds, 12-bit ADC)", fontsize=9)
-    axs[0].legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     p = os.path.join(out, "fig02_exp1_voltages.png")
     fig.savefig(p, dpi=110)
@@ -516,9 +546,119 @@ def sym_ylim(ax, ys, min_half):
     ax.set_ylim(min(lo - pad, -min_half), max(hi + pad, min_half))
 
 
+def tr_error_panel(ax, fx, ad, tx):
+    """The T_R panel's lines differ by a fraction of a percent, so the estimate hides under the
+    truth: here the difference itself, estimate / truth - 1 in %. Dots: each valid window's
+    estimate (both runs run the estimator; only the adaptive one feeds it to the controller);
+    line: the adaptive controller's T_R, which holds the last valid estimate. The fixed
+    controller's T_R error (its cold value against the warming rotor) is in the legend only:
+    on this axis it would hide the estimator's."""
+    ax.axhline(0, color="k", lw=0.8)
+    ys = []
+    for a, name, col in ((fx, "T_R fixed run", "tab:red"), (ad, "T_R from the estimator run", "tab:green")):
+        t = tx * a["t_end_s"] / 60.0
+        ok = a["tr_valid"] & (a["t_end_s"] > 5)
+        e = 100.0 * (a["T_R_s"] / a["T_R_true_s"] - 1.0)
+        ax.plot(t[ok], e[ok], ".", ms=2.5, color=col,
+                label=f"estimate, valid window ({int(ok.sum())}), {name.replace('T_R', '$T_R$')}")
+        ys.append(e[ok])
+    sel = ad["t_end_s"] > 5
+    ce = 100.0 * (ad["ifoc_T_R_s"] / ad["T_R_true_s"] - 1.0)
+    ax.plot(tx * ad["t_end_s"][sel] / 60.0, ce[sel], "-", color="darkgreen", lw=1.0,
+            label="controller's $T_R$, run with $T_R$ from the estimator (the last valid estimate: a window behind)")
+    ys.append(ce[sel])
+    fe = 100.0 * (fx["ifoc_T_R_s"] / fx["T_R_true_s"] - 1.0)
+    fe = fe[np.isfinite(fe)]
+    y = np.concatenate(ys)
+    y = y[np.isfinite(y)]
+    lo, hi = (min(float(np.percentile(y, 0.5)), 0.0), max(float(np.percentile(y, 99.5)), 0.0)) if len(y) else (0.0, 0.0)
+    span = max(hi - lo, 0.1)
+    # the lower part of the axis is the legend's, so that it covers no point
+    ax.set_ylim(lo - 0.9 * span, hi + 0.15 * span)
+    if len(fe):
+        ax.plot([], [], "-", color="tab:red", lw=1.0,
+                label=f"controller's $T_R$, fixed run: off the axis, up to {fe.max():+.1f} %")
+    ax.set_ylabel("$T_R$ error [%]\nestimate / truth - 1")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="lower center", ncol=2, fontsize=7, framealpha=0.9)
+
+
+# Colours of the verdict timeline: valid green, each reason its own colour (fixed, so that the
+# same reason looks the same in every run; an unlisted one takes the next of VERDICT_SPARE).
+VERDICT_COLOURS = {
+    "valid": "tab:green", "warmup": "0.75", "zero_slip": "tab:orange", "standstill": "gold",
+    "no_current": "0.45", "poorly_determined": "tab:purple", "high_residual": "tab:red",
+    "no_root": "tab:brown", "not_minimum": "tab:pink", "tr_uncertain": "tab:cyan",
+    "rs_uncertain": "tab:blue", "constants_mismatch": "olive", "wiring_mismatch": "black",
+    "input_fault": "darkred", "adc_saturation": "magenta", "encoder_fault": "navy",
+    "numeric": "0.2", "rs_out_of_range": "saddlebrown", "gain_mismatch": "teal",
+}
+VERDICT_SPARE = ["lightcoral", "khaki", "lightsteelblue", "plum", "darkseagreen"]
+
+
+def verdict_labels(a, key_valid, key_reason):
+    return np.where(a[key_valid], "valid", a[key_reason])
+
+
+def fig_verdicts(path, res):
+    """One panel per run: two rows of bars (T_R, R_S), one bar per window, coloured by its
+    verdict: valid or the reason it is not. Runs of the same verdict are drawn as one bar; a
+    run of not-valid windows too short to see at the run's time scale gets a marker on top."""
+    runs = [e for e in EXPS if e in res]
+    fig, axs = plt.subplots(len(runs), 1, figsize=(10, 1.25 * len(runs) + 1.3), squeeze=False)
+    used = {}
+    spare = iter(VERDICT_SPARE)
+    for ax, exp in zip(axs[:, 0], runs):
+        a = res[exp]["a"]
+        te = a["t_end_s"]
+        minutes = te[-1] > 120
+        scale = 60.0 if minutes else 1.0
+        start = np.concatenate([[0.0], te[:-1]])
+        counts = []
+        for row, (kv, kr, name) in enumerate((("tr_valid", "tr_reason", "T_R"), ("rs_valid", "rs_reason", "R_S"))):
+            lab = verdict_labels(a, kv, kr)
+            y = 1 - row
+            i = 0
+            while i < len(lab):
+                j = i
+                while j + 1 < len(lab) and lab[j + 1] == lab[i]:
+                    j += 1
+                c = VERDICT_COLOURS.get(lab[i])
+                if c is None:
+                    c = VERDICT_COLOURS[lab[i]] = next(spare, "0.6")
+                ax.broken_barh([(start[i] / scale, (te[j] - start[i]) / scale)], (y - 0.4, 0.8),
+                               facecolors=c, lw=0)
+                if lab[i] != "valid" and te[j] - start[i] < 0.006 * te[-1]:
+                    # too narrow to see at this scale: a marker on top of the bar
+                    ax.plot([0.5 * (start[i] + te[j]) / scale], [y + 0.3], "v", color=c, ms=5,
+                            mec="k", mew=0.4, clip_on=False)
+                i = j + 1
+            for v in lab:
+                used[v] = used.get(v, 0) + 1
+            counts.append(f"{name} valid {int(a[kv].sum())}/{len(lab)}")
+        ax.set_yticks([1, 0])
+        ax.set_yticklabels(["$T_R$", "$R_S$"])
+        ax.set_ylim(-0.6, 1.6)
+        ax.set_xlim(0, te[-1] / scale)
+        ax.set_title(f"{exp}: " + ", ".join(counts), fontsize=9, loc="left", pad=3)
+        ax.set_xlabel("time [min]" if minutes else "time [s]", fontsize=8, labelpad=1)
+        ax.tick_params(labelsize=8)
+        ax.grid(axis="x", alpha=0.3)
+    order = ["valid"] + sorted((k for k in used if k != "valid"), key=lambda k: -used[k])
+    handles = [matplotlib.patches.Patch(color=VERDICT_COLOURS[k], label=f"{k} ({used[k]})") for k in order if k in used]
+    fig.legend(handles=handles, loc="lower center", ncol=min(5, len(handles)), fontsize=8, frameon=False,
+               title="verdict of each window (count over all runs and both rows)", title_fontsize=8)
+    fig.suptitle("Verdicts per window: valid, or the reason it is not (README, \"When is a window valid\")",
+                 fontsize=10)
+    fig.tight_layout(rect=(0, 0.04 + 0.025 * ((len(handles) + 4) // 5), 1, 1))
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def fig_closed_loop(path, fx, ad, pair=IFOC_PAIRS[0]):
     rated, tx = pair["rated"], pair["time_x"]
-    fig, axs = plt.subplots(4, 1, figsize=(10, 11.5), sharex=True)
+    fig, axs = plt.subplots(5, 1, figsize=(10, 13.5), sharex=True,
+                            gridspec_kw={"height_ratios": [1, 1, 1, 1, 0.9]})
     # current relative to the tuned drive: the adaptive run's mean after start-up
     i0 = float(np.nanmean(ad["i_phase_rms_a"][ad["t_end_s"] > 5]))
     after = {}
@@ -554,11 +694,12 @@ def fig_closed_loop(path, fx, ad, pair=IFOC_PAIRS[0]):
     axs[1].set_ylabel("rotor-flux error\n$|\\psi_R|/\\psi_{ref} - 1$ [%]")
     axs[2].set_ylabel(f"stator current\nchange [%] of {i0:.3f} A rms")
     axs[3].set_ylabel("$T_R$ [s]")
-    axs[3].set_xlabel("time [min]" if tx == 1.0 else f"heating time [min] (= motor time x {tx:g})")
+    tr_error_panel(axs[4], fx, ad, tx)
+    axs[4].set_xlabel("time [min]" if tx == 1.0 else f"heating time [min] (= motor time x {tx:g})")
     axs[0].set_title(f"Beyond the paper: {pair['title']} under IFOC speed control\n"
                      "(1-s window means from t = 5 s; the speed loop holds $T_e$ at the load, so the reference "
                      "absorbs the detuning)", fontsize=10)
-    for ax in axs:
+    for ax in axs[:4]:
         ax.grid(alpha=0.3)
     for ax in axs[:3]:
         ax.axhline(0, color="0.6", lw=0.6)
@@ -840,6 +981,9 @@ def main(argv):
         if pair["fixed"] in res and pair["adaptive"] in res:
             figs.append(os.path.join(out, pair["fig"]))
             fig_closed_loop(figs[-1], res[pair["fixed"]]["a"], res[pair["adaptive"]]["a"], pair)
+    if res:
+        figs.append(os.path.join(out, "fig13_verdicts.png"))
+        fig_verdicts(figs[-1], res)
 
     # ---------------- summary
     md.append("# imest demo: results\n")

@@ -19,7 +19,7 @@ for f in windows.csv exp1_windows.csv ifoc_fixed_windows.csv ifoc_adaptive_windo
          fig02_exp1_voltages.png fig03_exp1_current.png fig04_exp1_speed.png \
          fig05_tr_1s.png fig06_tr_30s.png fig07_tr_120s.png \
          fig08_rs_1s.png fig09_rs_30s.png fig10_rs_120s.png fig11_ifoc_closed_loop.png \
-         fig12_ifoc_11kw.png ifoc11_fixed_windows.csv ifoc11_adaptive_windows.csv \
+         fig12_ifoc_11kw.png fig13_verdicts.png ifoc11_fixed_windows.csv ifoc11_adaptive_windows.csv \
          raw/exp2.candump.log raw/exp2_monitor.csv; do
   [ -s "$out/$f" ] || fail "missing or empty: $f"
 done
