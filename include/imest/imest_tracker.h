@@ -39,7 +39,20 @@
  * load shortly after a cold start: 100 K over a 20-min time constant) moves T_R by
  * 0.0039 x 5 K/min = 3.3e-4 /s, so by the estimator's typical bound (tr_tolerance, 2 %) in 60 s.
  * A T_R older than that is no longer known to within its bound: the tracker then says so
- * (IMEST_TRACKER_STALE) and moves towards the nominal T_R at the rate limit (fallback_rel_per_s).
+ * (IMEST_TRACKER_STALE) and moves towards the nominal T_R at fallback_rel_per_s.
+ *
+ * The default fall-back rate, from the rotor's cooling. The nominal is the cold T_R, and a T_R
+ * that has gone stale returns to it only as fast as the rotor can cool. A rotor cools towards
+ * ambient with its thermal time constant tau_th: dT/dt = -(T - T_amb) / tau_th, fastest at the
+ * start, when T - T_amb is the whole rise. So the temperature falls no faster than the rated rise
+ * over tau_th, and T_R rises (towards the cold value) no faster than alpha x rise / tau_th =
+ * 0.0039 /K x 80 K / 1200 s = 2.6e-4 /s (a rated rise of 80 K, a 20-min thermal time constant).
+ * The default fallback_rel_per_s, 2.6e-4 /s, never moves the used T_R towards the cold nominal
+ * faster than the rotor could actually cool: under load, where the rotor stays warm, a stale T_R
+ * drifts a quarter as fast as at the rate limit (docs/integrating.md, "Feeding T_R to the
+ * controller": after 5 loaded minutes without a valid window 8 % off, where the rate limit made it
+ * 22 % off and holding 1.4 %). A small motor (tau_th 10 min) can cool twice as fast; the fall-back
+ * then lags its cooling, erring towards holding (the cheaper error under load). 0 holds.
  *
  * The first estimate after init (and after staleness) may move faster than the rate limit: once
  * `confirm_windows` consecutive valid windows agree (below), the tracked T_R is set to the
@@ -82,7 +95,7 @@ typedef enum {
    *  T_R (if it has not reached it yet), then holds it */
   IMEST_TRACKER_HOLDING = 2,
   /** the last accepted window is older than stale_after_s: tr_s moves towards the nominal T_R at
-   *  fallback_rel_per_s (default: the rate limit), and stays there */
+   *  fallback_rel_per_s (default 2.6e-4 /s: the rotor's cooling), and stays there */
   IMEST_TRACKER_STALE = 3
 } imest_tracker_state_t;
 
@@ -103,12 +116,11 @@ typedef struct {
   /** after this long without an accepted window [s], fall back to the nominal (default 60 s:
    *  above). > 0 and finite */
   float stale_after_s;
-  /** largest relative change per second while falling back to the nominal (default: the rate
-   *  limit, 1e-3 /s; 0: hold the last accepted T_R, the state still says STALE). A motor cools
-   *  towards ambient no faster than its rotor's thermal time constant allows: with windows that
-   *  are not valid under load for minutes, a value near alpha x (rated rise) / (thermal time
-   *  constant), e.g. 0.0039 x 80 K / 1200 s = 2.6e-4 /s, keeps a warm motor's T_R closer
-   *  (docs/integrating.md, "Feeding T_R to the controller"). In [0, 1] */
+  /** largest relative change per second while falling back to the nominal (default 2.6e-4 /s:
+   *  above, the fastest a rotor cools, 0.0039 /K x 80 K / 1200 s; 0: hold the last accepted T_R,
+   *  the state still says STALE; rate_rel_per_s: return at the rate limit). For a motor whose
+   *  rise or thermal time constant differs, alpha x (rated rise) / (thermal time constant).
+   *  In [0, 1] */
   float fallback_rel_per_s;
   /** least relative tolerance of the agreement test (below), whatever the windows' bounds say
    *  (default 0.005). In [0, 1) */

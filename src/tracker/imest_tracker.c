@@ -43,7 +43,7 @@ void imest_tracker_config_default(imest_tracker_config_t *cfg, float tr_nominal_
   cfg->nominal_bound_rel = 0.35f;
   cfg->rate_rel_per_s = 1.0e-3f;
   cfg->stale_after_s = 60.0f;
-  cfg->fallback_rel_per_s = 1.0e-3f;
+  cfg->fallback_rel_per_s = 2.6e-4f;
   cfg->gate_min_rel = 0.005f;
   cfg->confirm_windows = 2u;
   cfg->acquire_jump = 1;

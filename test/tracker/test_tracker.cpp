@@ -12,7 +12,8 @@
 namespace {
 
 constexpr float kNominal = 0.12f;
-constexpr double kRate = 1e-3; // the default rate limit [1/s]
+constexpr double kRate = 1e-3;       // the default rate limit [1/s]
+constexpr double kFallback = 2.6e-4; // the default fall-back rate [1/s]: the rotor's cooling
 
 imest_result_t result(double t_end_s, int tr_valid, double tr_s, double bound = 0.0005)
 {
@@ -56,7 +57,7 @@ TEST_F(Tracker, DefaultsAndInit)
   EXPECT_FLOAT_EQ(cfg.tr_nominal_s, kNominal);
   EXPECT_FLOAT_EQ(cfg.rate_rel_per_s, 1e-3f);
   EXPECT_FLOAT_EQ(cfg.stale_after_s, 60.0f);
-  EXPECT_FLOAT_EQ(cfg.fallback_rel_per_s, 1e-3f);
+  EXPECT_FLOAT_EQ(cfg.fallback_rel_per_s, static_cast<float>(kFallback));
   EXPECT_FLOAT_EQ(cfg.nominal_bound_rel, 0.35f);
   EXPECT_FLOAT_EQ(cfg.gate_min_rel, 0.005f);
   EXPECT_EQ(cfg.confirm_windows, 2u);
@@ -69,6 +70,10 @@ TEST_F(Tracker, DefaultsAndInit)
   // the default rate passes the fastest real heating (0.0043 /K x 10 K/min), not a 1 % jump per window
   EXPECT_GT(cfg.rate_rel_per_s, 0.0043f * 10.0f / 60.0f);
   EXPECT_LT(cfg.rate_rel_per_s * 1.0f, 0.01f);
+  // the default fall-back is the fastest a rotor cools (0.0039 /K x 80 K rise / 1200 s), slower
+  // than the rate limit
+  EXPECT_NEAR(cfg.fallback_rel_per_s, 0.0039 * 80.0 / 1200.0, 1e-6);
+  EXPECT_LT(cfg.fallback_rel_per_s, cfg.rate_rel_per_s);
 }
 
 TEST_F(Tracker, StateNames)
@@ -120,6 +125,7 @@ TEST_F(Tracker, BadConfigsRejected)
       EXPECT_EQ(imest_tracker_init(&u, &c), IMEST_ERR_CONFIG);
       unsigned char expect[sizeof u];
       std::memset(expect, 0x5a, sizeof expect);
+      // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): every byte, padding too, must be unwritten
       EXPECT_EQ(std::memcmp(&u, expect, sizeof u), 0) << "init changed the tracker on a bad config";
     }
   }
@@ -149,12 +155,14 @@ TEST_F(Tracker, NullAndInvalidInputs)
   imest_tracker_config_default(nullptr, 0.1f); // no crash
 
   acquire(0.1);
-  const imest_tracker_t before = t;
+  unsigned char before[sizeof t]; // its bytes, padding too (a struct copy need not copy padding)
+  std::memcpy(before, &t, sizeof t);
   imest_result_t bad = result(std::numeric_limits<double>::quiet_NaN(), 1, 0.1);
   EXPECT_EQ(imest_tracker_update(&t, &bad), IMEST_ERR_ARG);
   bad.t_end_s = now - 0.5; // earlier than the previous result: the estimator was re-initialised
   EXPECT_EQ(imest_tracker_update(&t, &bad), IMEST_ERR_ARG);
-  EXPECT_EQ(std::memcmp(&before, &t, sizeof t), 0) << "a refused result changed the tracker";
+  // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): every byte, padding too, must be unwritten
+  EXPECT_EQ(std::memcmp(before, &t, sizeof t), 0) << "a refused result changed the tracker";
 
   // valid verdict with an unusable number: counts as not valid
   EXPECT_EQ(feed(1, std::numeric_limits<double>::quiet_NaN()), 0);
@@ -316,39 +324,67 @@ TEST_F(Tracker, RampFasterThanTheLimitLagsByTheRateOnly)
   }
 }
 
-TEST_F(Tracker, StaleFallsBackToNominal)
+// Falls back from 0.09 s to the nominal once stale, at the configured fall-back rate: returns the
+// number of 1-s steps after the first stale one until tr_s is on the nominal.
+int stale_fallback_steps(Tracker &f, double rate)
 {
-  acquire(0.09);
+  f.acquire(0.09);
   for (int k = 1; k <= 60; ++k) {
-    feed(0, 0.0);
-    ASSERT_EQ(t.state, IMEST_TRACKER_HOLDING) << k;
-    ASSERT_FLOAT_EQ(t.tr_s, 0.09f);
+    f.feed(0, 0.0);
+    EXPECT_EQ(f.t.state, IMEST_TRACKER_HOLDING) << k;
+    EXPECT_FLOAT_EQ(f.t.tr_s, 0.09f);
   }
-  feed(0, 0.0); // 61 s: stale
-  EXPECT_EQ(t.state, IMEST_TRACKER_STALE);
-  EXPECT_NEAR(t.tr_s, 0.09 * (1.0 + kRate), 1e-7);
+  f.feed(0, 0.0); // 61 s: stale
+  EXPECT_EQ(f.t.state, IMEST_TRACKER_STALE);
+  EXPECT_NEAR(f.t.tr_s, 0.09 * (1.0 + rate), 1e-7);
   int k = 0;
-  while (t.tr_s < kNominal && k < 1000) {
-    feed(0, 0.0);
-    EXPECT_EQ(t.state, IMEST_TRACKER_STALE);
+  float prev = f.t.tr_s;
+  while (f.t.tr_s < kNominal && k < 10000) {
+    f.feed(0, 0.0);
+    EXPECT_EQ(f.t.state, IMEST_TRACKER_STALE);
+    // never faster than the configured rate (to float32 rounding of the value)
+    EXPECT_LE(static_cast<double>(f.t.tr_s) - prev, rate * prev + 1.5e-8) << k;
+    prev = f.t.tr_s;
     ++k;
   }
-  EXPECT_FLOAT_EQ(t.tr_s, kNominal);
-  EXPECT_EQ(k, 287); // ln(0.12/0.09)/ln(1.001) = 287.8 s at the rate limit, less the first step
-  EXPECT_NEAR(t.tr_bound_rel, 0.35, 1e-6); // at the nominal: the nominal's bound
-  feed(0, 0.0, 100.0);
-  EXPECT_FLOAT_EQ(t.tr_s, kNominal);
-  EXPECT_EQ(t.state, IMEST_TRACKER_STALE);
+  EXPECT_FLOAT_EQ(f.t.tr_s, kNominal);
+  EXPECT_NEAR(f.t.tr_bound_rel, 0.35, 1e-6); // at the nominal: the nominal's bound
+  f.feed(0, 0.0, 100.0);
+  EXPECT_FLOAT_EQ(f.t.tr_s, kNominal);
+  EXPECT_EQ(f.t.state, IMEST_TRACKER_STALE);
+  return k;
+}
+
+// ln(0.12/0.09) / ln(1 + rate) steps of 1 s reach the nominal; the first was taken on going stale
+int expected_steps(double rate)
+{
+  return static_cast<int>(std::ceil(std::log(0.12 / 0.09) / std::log1p(rate))) - 1;
+}
+
+TEST_F(Tracker, StaleFallsBackToNominalAtTheCoolingRate)
+{
+  const int k = stale_fallback_steps(*this, kFallback);
+  EXPECT_EQ(k, expected_steps(kFallback)); // 1106.6 s at 2.6e-4 /s, less the first step
+  EXPECT_EQ(k, 1106);
+}
+
+TEST_F(Tracker, StaleFallsBackAtTheRateLimitWhenConfigured)
+{
+  cfg.fallback_rel_per_s = cfg.rate_rel_per_s; // the fall-back of earlier versions
+  ASSERT_EQ(imest_tracker_init(&t, &cfg), IMEST_OK);
+  const int k = stale_fallback_steps(*this, kRate);
+  EXPECT_EQ(k, expected_steps(kRate)); // 287.8 s at 1e-3 /s, less the first step
+  EXPECT_EQ(k, 287);
 }
 
 TEST_F(Tracker, StaleFallbackRateIsItsOwn)
 {
-  cfg.fallback_rel_per_s = 2.5e-4f; // a rotor's cooling rate
+  cfg.fallback_rel_per_s = 5e-4f; // a small motor's cooling (10-min thermal time constant)
   ASSERT_EQ(imest_tracker_init(&t, &cfg), IMEST_OK);
   acquire(0.09);
-  feed(0, 0.0, 61.0); // stale: 61 s at a quarter of the rate limit
+  feed(0, 0.0, 61.0); // stale: 61 s at half the rate limit
   EXPECT_EQ(t.state, IMEST_TRACKER_STALE);
-  EXPECT_NEAR(t.tr_s, 0.09 * (1.0 + 61 * 2.5e-4), 1e-7);
+  EXPECT_NEAR(t.tr_s, 0.09 * (1.0 + 61 * 5e-4), 1e-7);
   cfg.fallback_rel_per_s = 0.0f; // hold, but say it is stale
   ASSERT_EQ(imest_tracker_init(&t, &cfg), IMEST_OK);
   now = 0.0;
@@ -364,7 +400,7 @@ TEST_F(Tracker, StaleReacquiresWithConfirmationAndJumps)
   acquire(0.09);
   feed(0, 0.0, 200.0); // one late result: stale, and 200 s towards the nominal
   EXPECT_EQ(t.state, IMEST_TRACKER_STALE);
-  EXPECT_NEAR(t.tr_s, 0.09 * 1.2, 1e-6);
+  EXPECT_NEAR(t.tr_s, 0.09 * (1.0 + 200 * kFallback), 1e-6);
   // a window within the (now wide) drift of the last accepted one still needs confirmation
   EXPECT_EQ(feed(1, 0.092), 0);
   EXPECT_EQ(t.state, IMEST_TRACKER_STALE);
