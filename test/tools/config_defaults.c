@@ -3,11 +3,13 @@
  * of imest_config_t (inverter fields as inverter.NAME), then "sizeof imest_t
  * N" for this host. test_documented_defaults.py compares it with the
  * defaults the header's comments and imest-replay --help state, and checks
- * that every field the header declares is listed here. */
+ * that every field the header declares is listed here; likewise the T_R
+ * tracker's imest_tracker_config_default() (tracker.NAME). */
 #include <stddef.h>
 #include <stdio.h>
 
 #include "imest/imest.h"
+#include "imest/imest_tracker.h"
 
 #define F(name)                                                                                              \
   {                                                                                                          \
@@ -71,6 +73,17 @@ int main(void)
   printf("pwm_timing %s\n", c.pwm_timing == IMEST_PWM_NEXT_PERIOD ? "NEXT_PERIOD"
                             : c.pwm_timing == IMEST_PWM_CENTRED   ? "CENTRED"
                                                                   : "LAST_PERIOD");
+  /* the T_R tracker's defaults (imest_tracker.h), as tracker.NAME; the nominal T_R is the
+     caller's argument, not a default */
+  imest_tracker_config_t t;
+  imest_tracker_config_default(&t, 0.1f);
+  printf("tracker.nominal_bound_rel %.9g\n", (double)t.nominal_bound_rel);
+  printf("tracker.rate_rel_per_s %.9g\n", (double)t.rate_rel_per_s);
+  printf("tracker.stale_after_s %.9g\n", (double)t.stale_after_s);
+  printf("tracker.fallback_rel_per_s %.9g\n", (double)t.fallback_rel_per_s);
+  printf("tracker.gate_min_rel %.9g\n", (double)t.gate_min_rel);
+  printf("tracker.confirm_windows %u\n", t.confirm_windows);
+  printf("tracker.acquire_jump %d\n", t.acquire_jump);
   printf("sizeof imest_t %zu\n", sizeof(imest_t));
   return 0;
 }

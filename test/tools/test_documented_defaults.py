@@ -8,6 +8,8 @@ against
     "negative: ... (default)", "(default NAME)" for an enum;
   * imest-replay --help: "(default X)" of every option that sets a config field
     (the option table k_numeric of tools/replay/replay_options.c maps options to fields);
+  * the comments of imest_tracker_config_t in include/imest/imest_tracker.h against
+    imest_tracker_config_default() (every field but the caller's nominal T_R must state one);
   * README.md: "`field` (default X)" and "(default X %)";
   * the instance size: README.md, fw/README.md and include/imest/imest_instance.h state
     sizeof(imest_t) measured on the Cortex-M4F/M7; it is checked against this host's
@@ -45,8 +47,8 @@ def value(num, unit):
 ORPHANS = []
 
 
-def header_fields(text):
-    """[(field, doc)] of imest_config_t in declaration order, imest_inverter_t's as inverter.*"""
+def header_fields(text, struct="imest_config_t"):
+    """[(field, doc)] of a config struct in declaration order, imest_inverter_t's as inverter.*"""
 
     def body(name):
         end = text.index("} %s;" % name)
@@ -75,7 +77,7 @@ def header_fields(text):
                 pending = ""
         return out
 
-    return [(f, re.sub(r"\s*\*\s*", " ", d)) for f, d in parse(body("imest_config_t"))]
+    return [(f, re.sub(r"\s*\*\s*", " ", d)) for f, d in parse(body(struct))]
 
 
 def header_claims(fields):
@@ -163,13 +165,13 @@ def main():
             ok = f32(doc) == f32(float(have))
         checked.append((where, field, doc, have))
         if not ok:
-            fails.append("%s: %s: documented %s, imest_config_default() sets %s" % (where, field, doc, have))
+            fails.append("%s: %s: documented %s, the code's default (imest_config_default(), imest_tracker_config_default()) is %s" % (where, field, doc, have))
 
     # 1. the header's comments
     with open(os.path.join(src, "include/imest/imest.h")) as f:
         fields = header_fields(f.read())
     declared = [f for f, _ in fields]
-    probed = [n for n in code if n != "sizeof imest_t"]
+    probed = [n for n in code if n != "sizeof imest_t" and not n.startswith("tracker.")]
     for f in declared:
         if f not in code:
             fails.append("include/imest/imest.h declares %s: add it to test/tools/config_defaults.c" % f)
@@ -182,6 +184,19 @@ def main():
     claims = header_claims(fields)
     for f, doc in claims.items():
         compare("include/imest/imest.h", f, doc)
+
+    # 1b. the T_R tracker's header (imest_tracker.h): every field but the caller's nominal
+    with open(os.path.join(src, "include/imest/imest_tracker.h")) as f:
+        tfields = [("tracker." + n, d) for n, d in header_fields(f.read(), "imest_tracker_config_t")]
+    tclaims = header_claims(tfields)
+    for f, _ in tfields:
+        if f != "tracker.tr_nominal_s" and f not in tclaims:
+            fails.append("include/imest/imest_tracker.h: %s states no default" % f)
+        if f != "tracker.tr_nominal_s" and f not in code:
+            fails.append("include/imest/imest_tracker.h declares %s: add it to "
+                         "test/tools/config_defaults.c" % f)
+    for f, doc in tclaims.items():
+        compare("include/imest/imest_tracker.h", f, doc)
 
     # 2. imest-replay --help, through replay's option table
     with open(os.path.join(src, "tools/replay/replay_options.c")) as f:
