@@ -127,6 +127,32 @@ TEST(ReplayBounds, CombinedWindowsDeliverTrWhereOneWindowCannot)
   EXPECT_GE(combined_valid, 1) << o.out;
 }
 
+// The same record with the core built without window combination
+// (IMEST_COMBINE=OFF): every window stands alone, and none of them is valid
+// (each is poorly determined alone), so leaving the stage out costs exactly
+// the combined windows above and gives no wrong T_R instead.
+TEST(ReplayBounds, WithoutCombinationLightLoadWindowsStayAlone)
+{
+  const std::string &csv =
+      sim_csv("paper_9hz_l25.csv", "--preset 4kw --pole-pairs 2 --ls 0.2908 --lr 0.2908 "
+                                   "--sigma 0.096 --rs 5.04 --tr 0.12 --j 1.2e-3 --b 1e-4 "
+                                   "--i-range 6 --u-range 250 --no-thermal --start steady "
+                                   "--vdc 340 --freq 9 --vll 34.5 --load-nm 0.516 --duration 12 "
+                                   "--encoder-counts 16384 --no-progress");
+  const Out o = run(std::string(REPLAY_NOCOMBINE_BIN) + kReplay + csv);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto r = rows(o.out);
+  const int v = col(r, "tr_valid"), n = col(r, "windows"), why = col(r, "tr_reason");
+  int poorly = 0;
+  ASSERT_GE(r.size(), 10u) << o.out;
+  for (size_t k = 1; k < r.size(); ++k) {
+    EXPECT_EQ(r[k][n], "1") << o.out;
+    EXPECT_EQ(r[k][v], "0") << o.out;
+    poorly += r[k][why] == "poorly_determined" ? 1 : 0;
+  }
+  EXPECT_GE(poorly, 8) << o.out;
+}
+
 // A current sensor reading 2 % high (three sensors): the zero sequence shows
 // it; R_S (-8 %) is refused as gain_mismatch, T_R stays valid and within 1 %.
 TEST(ReplayBounds, GainMismatchRefusesRsNotTr)

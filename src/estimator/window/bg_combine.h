@@ -6,6 +6,14 @@
 
 #include "bg_solve.h"
 
+/* Window combination is built in unless the build defines IMEST_WITH_COMBINE=0
+ * (CMake: -DIMEST_COMBINE=OFF), for a firmware short of flash: the stage's code
+ * is then not linked (fw/README.md gives the saving) and a window that is
+ * poorly determined alone stays so (`windows` is always 1). */
+#ifndef IMEST_WITH_COMBINE
+#define IMEST_WITH_COMBINE 1
+#endif
+
 /* At most this many windows are combined (the span grows to this many windows). */
 #define BG_COMBINE_MAX 9u
 

@@ -83,7 +83,8 @@ static void combine_join(imest_t *s, const imest_window_t *w, double m, bg_step_
   x->e_c0 = x->nz.e_c0;
   x->noise_share = 1.0;
   x->fits = x->sums.centred && x->sums.ree <= (double)s->max_ei * (double)s->max_ei * x->ry_raw;
-  x->combined = s->combo.n > 0u && s->combo.n < BG_COMBINE_MAX && x->steady && !x->dirty && x->fits;
+  x->combined = IMEST_WITH_COMBINE && s->combo.n > 0u && s->combo.n < BG_COMBINE_MAX && x->steady &&
+                !x->dirty && x->fits;
   if (!x->combined) {
     s->combo.n = 0u;
     return;
@@ -161,7 +162,7 @@ static void result_from_solve(const bg_step_t *x, const imest_t *s, const bg_sol
  * up to BG_COMBINE_MAX windows; a window poorly determined alone starts one. */
 static void combine_after(imest_t *s, const imest_window_t *w, const bg_step_t *x, const imest_result_t *out)
 {
-  if (out->tr_valid || !x->steady || x->dirty || !x->fits ||
+  if (!IMEST_WITH_COMBINE || out->tr_valid || !x->steady || x->dirty || !x->fits ||
       out->tr_reason != IMEST_REASON_POORLY_DETERMINED || s->combo.n >= BG_COMBINE_MAX)
     s->combo.n = 0u;
   else if (!x->combined)
