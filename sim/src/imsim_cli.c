@@ -600,7 +600,7 @@ static void note_stall(const imsim_t *sim, const imsim_config_t *c)
   const double w_sync = 2.0 * 3.14159265358979323846 * c->freq_hz / (double)c->pole_pairs;
   fprintf(stderr,
           "imest-sim: note: the motor stalled at t = %.4f s: the load (%.4g N m) exceeded the motor's torque "
-          "(%.4g N m) and %s (supply %.4g Hz, synchronous speed %.4g rad/s)\n",
+          "(%.4g N m) and %s (--freq %.4g Hz, synchronous speed %.4g rad/s)\n",
           st.first_t_s, st.first_load_nm, st.first_torque_nm,
           c->load_kind == IMSIM_LOAD_ACTIVE ? "turned the rotor backwards (active load)"
                                             : "the rotor stopped (speed 0 rad/s)",
