@@ -72,8 +72,12 @@ static const char USAGE[] =
     "                        slope: switch V_sw + r_sw |i|, diode V_d + r_d |i| (0: ideal)\n"
     "  --pwm-segments        integrate piecewise between switching instants (reference accuracy,\n"
     "                        about 2.3x slower; default: one step per half carrier period)\n"
-    "load (opposes rotation):\n"
+    "load:\n"
     "  --load-nm NM (exp1 0, exp2 2.064)  --load-on S (exp2 1.5)  --load-ramp S (exp2 1)\n"
+    "  --load-kind passive|active   passive: friction-like, |NM| opposes the motion and holds\n"
+    "                        a rotor at rest while the motor's torque is below it (a fan, pump,\n"
+    "                        conveyor); active: NM opposes positive rotation at any speed and\n"
+    "                        drives a stopped rotor backwards (a hoist's weight) (passive)\n"
     "IFOC (--supply ifoc):\n"
     "  --ifoc-mode speed|torque (speed)\n"
     "  --speed-ref RPM (exp1 1750, exp2 850)  --speed-ramp S (exp1 0.5, exp2 1)\n"
@@ -102,7 +106,8 @@ static const char USAGE[] =
     "  --integrator fast|rk4 (fast; rk4 = slow reference)  --rk4-substeps N (8)\n"
     "  --steps-per-sample N  steps per sample for the ideal supplies (0 = auto: 5; PWM: fixed)\n"
     "\n"
-    "Exit status: 0 done (a warning on stderr says when the PWM modulation was clipped);\n"
+    "Exit status: 0 done (a warning on stderr says when the PWM modulation was clipped; a note\n"
+    "when the motor stalled: the load stopped it, or an active load turned it backwards);\n"
     "1 the output cannot be written; 2 a bad flag or value, or an impossible configuration.\n";
 
 /* ---- parse ------------------------------------------------------------------------------ */
@@ -207,7 +212,7 @@ static const int_flag INT_FLAGS[] = {
 _Static_assert(sizeof(imsim_supply_t) == sizeof(int) && sizeof(imsim_vmeas_t) == sizeof(int) &&
                    sizeof(imsim_start_t) == sizeof(int) && sizeof(imsim_ifoc_mode_t) == sizeof(int) &&
                    sizeof(imsim_integrator_t) == sizeof(int) && sizeof(imsim_timing_t) == sizeof(int) &&
-                   sizeof(imsim_modulation_t) == sizeof(int),
+                   sizeof(imsim_modulation_t) == sizeof(int) && sizeof(imsim_load_kind_t) == sizeof(int),
                "choice flags store enums as int");
 typedef struct {
   const char *flag;
@@ -245,6 +250,10 @@ static const choice_flag CHOICE_FLAGS[] = {
      CFG(modulation),
      {"spwm", "svpwm", NULL, NULL, NULL},
      {IMSIM_MOD_SPWM, IMSIM_MOD_SVPWM, 0, 0, 0}},
+    {"--load-kind",
+     CFG(load_kind),
+     {"passive", "active", NULL, NULL, NULL},
+     {IMSIM_LOAD_PASSIVE, IMSIM_LOAD_ACTIVE, 0, 0, 0}},
 };
 
 /* Per-phase flags: three comma-separated numbers for phases a, b, c. */
@@ -582,6 +591,44 @@ static void report_clipping(const imsim_t *sim, const imsim_config_t *c)
       c->vdc_v);
 }
 
+/* A motor that the load stops is no longer at the operating point the flags describe: say so
+   when it happens (note_stall) and at the end (report_stall), with the numbers. */
+static void note_stall(const imsim_t *sim, const imsim_config_t *c)
+{
+  imsim_stall_t st;
+  imsim_get_stall(sim, &st);
+  const double w_sync = 2.0 * 3.14159265358979323846 * c->freq_hz / (double)c->pole_pairs;
+  fprintf(stderr,
+          "imest-sim: note: the motor stalled at t = %.4f s: the load (%.4g N m) exceeded the motor's torque "
+          "(%.4g N m) and %s (--freq %.4g Hz, synchronous speed %.4g rad/s)\n",
+          st.first_t_s, st.first_load_nm, st.first_torque_nm,
+          c->load_kind == IMSIM_LOAD_ACTIVE ? "turned the rotor backwards (active load)"
+                                            : "the rotor stopped (speed 0 rad/s)",
+          c->freq_hz, w_sync);
+}
+
+static void report_stall(const imsim_t *sim, const imsim_config_t *c)
+{
+  imsim_stall_t st;
+  imsim_get_stall(sim, &st);
+  if (st.events == 0u && !st.at_rest_now) return;
+  if (st.events == 0u) {
+    fprintf(
+        stderr,
+        "imest-sim: note: the motor did not start: the load holds the rotor at rest at the end of the run "
+        "(%.4g s at rest in all)\n",
+        st.held_s);
+    return;
+  }
+  fprintf(stderr,
+          "imest-sim: note: stalled: %llu stall%s, the first at t = %.4f s (load %.4g N m, motor torque "
+          "%.4g N m); %.4g s held at rest by the load%s. The record is not of a running motor; "
+          "lower --load-nm or raise --vll.%s\n",
+          (unsigned long long)st.events, st.events == 1u ? "" : "s", st.first_t_s, st.first_load_nm,
+          st.first_torque_nm, st.held_s, st.at_rest_now ? ", at rest at the end" : "",
+          c->load_kind == IMSIM_LOAD_ACTIVE ? " (active load: the rotor was turned backwards)" : "");
+}
+
 /* Simulates c and writes the CSV. Returns the exit status. */
 static int run(const imsim_config_t *c, const imsim_cli_opts_t *o)
 {
@@ -598,13 +645,20 @@ static int run(const imsim_config_t *c, const imsim_cli_opts_t *o)
   progress_start(&bar, o->progress < 0 ? isatty(STDERR_FILENO) : o->progress, total, c->duration_s);
   fprintf(f, "%s\n", HEADER);
   imsim_cli_write_row(f, &smp);
+  bool stall_noted = false;
   for (uint64_t n = 1; n <= total; ++n) {
     imsim_step(&sim, &smp);
+    if (sim.stall_events != 0u && !stall_noted) {
+      stall_noted = true;
+      if (bar.on) fprintf(stderr, "\n");
+      note_stall(&sim, c);
+    }
     if ((n % (uint64_t)o->decimate) == 0u) imsim_cli_write_row(f, &smp);
     progress_update(&bar, n, smp.t);
   }
   if (bar.on) fprintf(stderr, "\n");
   report_clipping(&sim, c);
+  report_stall(&sim, c);
   int rc = 0;
   if (fflush(f) != 0 || ferror(f)) {
     fprintf(stderr, "imest-sim: write error\n");

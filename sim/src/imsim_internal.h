@@ -85,9 +85,21 @@ static inline double ims_torque_rate(const imsim_t *s, cpx i, cpx psi, double w,
 #define IMS_MOTOR_PRESET_NAMES "4kw|11kw|15kw|37kw|75kw"
 int ims_motor_preset(imsim_config_t *c, const char *name);
 
-/* load.c: load torque at t. supply.c: reference of the open-loop supplies (alpha-beta amplitude =
+/* load.c: the load profile's value at t; the torque it applies in the present state (load_kind:
+   passive = friction-like, see load.c); one integration step under it: begin (returns the torque
+   to hold over the step) and end (passive: holds a rotor at rest, stops one whose speed changed
+   sign; records stalls). supply.c: reference of the open-loop supplies (alpha-beta amplitude =
    V_ll rms, phase, frequency). */
+typedef struct {
+  double w0, th0; /* speed and angle at the step's start */
+  double l_nm;    /* the profile's value                 */
+  double tl;      /* the torque applied over the step    */
+  bool held;      /* passive: the rotor is held at rest  */
+} ims_load_step_t;
 double ims_load_at(const imsim_t *s, double t);
+double ims_load_torque(const imsim_t *s, double l_nm);
+double ims_load_begin(const imsim_t *s, double l_nm, ims_load_step_t *ls);
+void ims_load_end(imsim_t *s, const ims_load_step_t *ls, double t_end, double h);
 void ims_vf_ref(const imsim_t *s, double t, double *amp, double *phase, double *f_hz);
 
 /* thermal.c: present R_S, R_R, T_R and the derived gamma, beta from the temperatures; one

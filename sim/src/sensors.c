@@ -73,7 +73,7 @@ void ims_fill_sample(imsim_t *s, imsim_sample_t *o)
   o->theta_true = s->th;
   o->speed_rad_s = s->w;
   o->torque_nm = s->te;
-  o->load_nm = ims_load_at(s, s->t);
+  o->load_nm = ims_load_torque(s, ims_load_at(s, s->t));
   o->accel_rad_s2 = (s->te - o->load_nm - c->b_nms * s->w) / c->j_kgm2;
   o->tr_s = s->tr;
   o->rs_ohm = s->rs;

@@ -147,7 +147,9 @@ int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first)
     s->c.load_ramp_s = 0.0;
   }
   s->te = ims_torque_of(s, s->x[0], s->x[1]);
-  s->acc = (s->te - ims_load_at(s, 0.0) - c->b_nms * s->w) / c->j_kgm2;
+  s->acc = (s->te - ims_load_torque(s, ims_load_at(s, 0.0)) - c->b_nms * s->w) / c->j_kgm2;
+  s->load_stuck = s->w == 0.0 && c->load_kind == IMSIM_LOAD_PASSIVE && fabs(ims_load_at(s, 0.0)) > 0.0 &&
+                  fabs(s->te) <= fabs(ims_load_at(s, 0.0));
   if (c->supply == IMSIM_SUPPLY_SINE || c->supply == IMSIM_SUPPLY_VF) {
     double amp, ph, f;
     ims_vf_ref(s, 0.0, &amp, &ph, &f);
@@ -168,8 +170,9 @@ void imsim_step(imsim_t *s, imsim_sample_t *out)
   const double ts = s->ts_s, h = s->h_s;
   /* 1. thermal: copper losses at t_n drive both first-order models (exact exponential step) */
   if (c->thermal) ims_thermal_step(s);
-  /* 2. load torque, held over the sample period (value at its centre) */
-  const double tl = ims_load_at(s, s->t + 0.5 * ts);
+  /* 2. load profile, held over the sample period (value at its centre); the torque it applies
+     is decided per integration step (passive load: from the speed and torque, load.c) */
+  const double l_nm = ims_load_at(s, s->t + 0.5 * ts);
   /* 3. controller; with firmware timing it computes the duties of the next sample period */
   if (c->supply == IMSIM_SUPPLY_IFOC) ims_ifoc_update(s);
   const bool fw = ims_firmware_timing(c);
@@ -224,7 +227,10 @@ void imsim_step(imsim_t *s, imsim_sample_t *out)
       in.we = 2.0 * PI * f_m;
       in.p = ims_taylor_order(s, s->w, &in);
     }
+    ims_load_step_t ls;
+    const double tl = ims_load_begin(s, l_nm, &ls);
     ims_advance(s, &in, &ph, tl);
+    ims_load_end(s, &ls, t0 + h, h);
     if (pwm) {
       const int slot = s->hp_count & 1;
       s->u_hp_cmd[slot][0] = ph.cmd_avg[0];

@@ -7,7 +7,8 @@
  *
  * parse (replay_options.c) -> scan: time base, clipping, conventions
  * (replay_scan.c) -> configure, with advice on what the estimator refuses
- * (replay_advice.c) -> run: the drive loop (tools/common/drive_loop.c). */
+ * (replay_advice.c) -> run: the drive loop (tools/common/drive_loop.c) -> the
+ * alignment check of the voltage columns (replay_align.c). */
 #define _POSIX_C_SOURCE 200809L /* dup, fdopen */
 #include <errno.h>
 #include <math.h>
@@ -20,6 +21,7 @@
 #include "imest/imest.h"
 #include "imest/imest_can.h"
 #include "replay_advice.h"
+#include "replay_align.h"
 #include "replay_options.h"
 #include "replay_scan.h"
 #include "tool_args.h"
@@ -387,6 +389,11 @@ int main(int argc, char **argv)
     goto done;
   }
   if (!o.quiet) summary(&d, &s, &cfg, &seg, rest, flushed);
+  /* the voltage columns one row off: a note, nothing changed (replay_align.c) */
+  replay_align_t al;
+  if (!o.quiet && o.align_check && !d.error && d.windows > 0 &&
+      (rc = replay_align_check(&r, &o, &s, &cfg, &al)) >= 0)
+    goto done;
   if (d.error) {
     fprintf(stderr, "%s: imest_background failed: %s\n", k_prog, imest_err_name(d.error));
     rc = TOOL_EXIT_DATA;

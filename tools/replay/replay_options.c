@@ -124,7 +124,14 @@ static void usage(FILE *o)
              "                      WHICH = 1: valid (the default: T_R and R_S), tr (the\n"
              "                      tr_valid column) or rs (rs_valid); the value only as\n"
              "                      --require-valid=WHICH\n"
-             "  --quiet             no notes or summary on stderr\n"
+             "  --no-align-check    skip the alignment check: after the run the record is\n"
+             "                      fitted again with the voltage (or duty and v_dc) columns\n"
+             "                      one row earlier and later; a note names the shift and the\n"
+             "                      option that would fix it when one fits clearly better\n"
+             "                      (R_S then no longer changes with the frequency; needs a\n"
+             "                      record over more than one operating point). Never changes\n"
+             "                      the output or the exit status; costs two more runs\n"
+             "  --quiet             no notes or summary on stderr (and no alignment check)\n"
              "  -h, --help          this text\n"
              "  --version           the version and licence\n"
              "\n"
@@ -272,6 +279,7 @@ static int limit_value(tool_args_t *a, double *out)
 int replay_parse(int argc, char **argv, replay_opts_t *o)
 {
   memset(o, 0, sizeof *o);
+  o->align_check = 1;
   imest_config_default(&o->cfg);
   o->can_iface = "vcan0";
   o->can_id = IMEST_CAN_DEFAULT_BASE_ID;
@@ -397,6 +405,9 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
     } else if (tool_args_is(&a, "--quiet")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       o->quiet = 1;
+    } else if (tool_args_is(&a, "--no-align-check")) {
+      if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
+      o->align_check = 0;
     } else {
       return tool_args_unknown(&a);
     }

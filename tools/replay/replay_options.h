@@ -28,7 +28,8 @@ typedef struct {
   int from_rest;            /* -1 = auto, 0 no, 1 yes */
   int gaps_restart;         /* --gaps restart: missing samples restart the estimator (0: refused) */
   int quiet;
-  int require; /* --require-valid: a tool_require_t */
+  int align_check; /* 0 after --no-align-check */
+  int require;     /* --require-valid: a tool_require_t */
 } replay_opts_t;
 
 /* Parses argv into *o. Returns -1 to go on, or the exit code to end with

@@ -67,6 +67,12 @@ typedef enum {
 } imsim_vmeas_t;
 
 typedef enum { IMSIM_START_REST = 0, IMSIM_START_STEADY = 1 } imsim_start_t;
+/* Load kind. PASSIVE (default): friction-like (a fan, pump, conveyor, brake): |load| opposes
+   the motion and never drives the rotor; at rest it holds the rotor while |T_e| <= |load|
+   (static friction) and breaks away when the motor's torque exceeds it. ACTIVE: a constant
+   torque of load_nm opposing positive rotation whatever the speed (a hoist's weight, a
+   dynamometer): it drives a rotor that stops backwards. See sim/README.md, Load. */
+typedef enum { IMSIM_LOAD_PASSIVE = 0, IMSIM_LOAD_ACTIVE = 1 } imsim_load_kind_t;
 typedef enum { IMSIM_IFOC_SPEED = 0, IMSIM_IFOC_TORQUE = 1 } imsim_ifoc_mode_t;
 typedef enum {
   IMSIM_INTEGRATOR_FAST = 0, /* exact Taylor-Horner propagation of the linear electrical part
@@ -96,9 +102,12 @@ typedef struct {
   double rth_rotor_k_per_w, tau_rotor_s;
   double thermal_speedup; /* multiplies both thermal rates (1 = physical), for short tests */
 
-  /* Load torque (opposes positive rotation): 0 before load_on_s, linear ramp over
-     load_ramp_s, then load_nm. imsim_set_load() overrides it at run time. */
+  /* Load torque: 0 before load_on_s, linear ramp over load_ramp_s, then load_nm.
+     imsim_set_load() overrides it at run time. load_kind PASSIVE (default): |load_nm| opposes
+     the motion (at rest: up to |load_nm| of the motor's torque); ACTIVE: load_nm opposes
+     positive rotation at any speed. */
   double load_nm, load_on_s, load_ramp_s;
+  imsim_load_kind_t load_kind;
 
   /* Supply. vll_v = line-to-line rms, freq_hz = electrical frequency. The V/f ramp (VF, PWM)
      raises frequency and voltage linearly from 0 over vf_ramp_s (0 = apply at once);
@@ -219,6 +228,10 @@ typedef struct {
   double temp_s, temp_r;
   double load_override;
   bool load_overridden;
+  /* load.c: passive load holding the rotor at rest; stall record (imsim_get_stall) */
+  bool load_stuck;
+  uint64_t stall_events;
+  double stall_first_t_s, stall_first_load_nm, stall_first_torque_nm, stall_held_s;
   /* supply bookkeeping */
   double u_hp_cmd[2][2], u_hp_act[2][2]; /* last two half-period averages (re, im) */
   int hp_count;
@@ -251,6 +264,20 @@ typedef struct {
   double vdc_needed_v;           /* bus voltage that the largest reference so far would need  */
 } imsim_pwm_stats_t;
 
+/* Stall record: a run whose motor the load stops. An event is a moving rotor brought to rest
+   by a passive load (its speed would have changed sign within an integration step), or, with
+   an ACTIVE load, turned backwards by it (speed from > 0 to <= 0 while load_nm > 0, or the
+   mirror image). */
+typedef struct {
+  uint64_t events;        /* stall events so far (0: the motor never stalled)                */
+  double first_t_s;       /* time of the first event (NaN if none)                          */
+  double first_load_nm;   /* load torque magnitude at it (NaN if none)                      */
+  double first_torque_nm; /* the motor's electromagnetic torque at it (NaN if none)         */
+  double held_s;          /* total time a passive load held the rotor at rest (static friction,
+                             |T_e| <= |load|), including a start from rest before breakaway */
+  bool at_rest_now;       /* a passive load holds the rotor at rest at the present sample    */
+} imsim_stall_t;
+
 /* Fills c with the paper's motor and the exp1 experiment (same as preset "exp1"). */
 void imsim_config_default(imsim_config_t *c);
 /* name: "exp1", "exp2" (the paper's motor and experiments) or one of the industrial drives
@@ -271,6 +298,7 @@ void imsim_step(imsim_t *sim, imsim_sample_t *out);
 
 /* Modulation statistics since imsim_init (all zero without a PWM stage). */
 void imsim_get_pwm_stats(const imsim_t *sim, imsim_pwm_stats_t *out);
+void imsim_get_stall(const imsim_t *sim, imsim_stall_t *out); /* see imsim_stall_t              */
 
 /* Run-time controls. */
 void imsim_set_ifoc_tr(imsim_t *sim, double tr_s);  /* controller's T_R, takes effect at the next step */

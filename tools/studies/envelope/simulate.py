@@ -98,8 +98,8 @@ NOT_HELD = "not held"  # run_point's answer when the motor left its operating po
 def held(p, truth_path):
     """Whether the recording kept its operating point: every window's mean speed positive and
     within 20 % of synchronous speed of the planned one. A drive that stalls (a small motor at
-    5 % frequency under full load with dead time: the rotor reverses and the load runs it away)
-    is not an operating point to estimate at."""
+    5 % frequency under full load with dead time: the rotor stops and the passive load holds it
+    at rest; imest-sim notes it) is not an operating point to estimate at."""
     m = motor_of(p)
     w_sync = 2.0 * 3.141592653589793 * p["f_hz"] / motors.constants(m)["np"]
     with open(truth_path) as f:
