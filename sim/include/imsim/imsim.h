@@ -153,6 +153,19 @@ typedef struct {
   imsim_integrator_t integrator;
   int rk4_substeps; /* RK4 steps per constant-input piece */
 
+  /* Real-motor effects (sim/README.md, Real-motor effects). All 0 = off (the default): the
+     paper's linear machine, integrated as above. Any of them on: the flux-linkage model
+     (states psi_S, psi_R1, psi_R2, psi_m), integrated by sub-stepped RK4 whatever integrator
+     says. The rated point (V_n, f_n, T_n) is rated_voltage_v/rated_freq_hz/rated_torque_nm when
+     given, else vll_v/freq_hz/load_nm; psi_n = |psi_m| of the linear model there.
+     sat_fraction in [0, 0.6): static L_m at psi_n is M = sqrt((1 - sigma) L_S L_R) and the
+       unsaturated L_m0 = M / (1 - sat_fraction); i_m = psi/L_m0 (1 + a (psi/psi_n)^6).
+     iron_loss_fraction in [0, 0.2): R_fe across the magnetising branch, R_fe = (2 pi f_n psi_n)^2
+       / (fraction P_n), P_n = rated_power_w (or the rated point's shaft power).
+     rotor_cage_ratio: 0 = single cage; > 1: double cage whose R_R at f_n (standstill) is
+       ratio x its DC value R_R, with the DC R_R and DC leakage of the single cage. */
+  double sat_fraction, iron_loss_fraction, rotor_cage_ratio;
+
   double duration_s; /* used by the CLI and the benchmark only */
 } imsim_config_t;
 
@@ -178,6 +191,11 @@ typedef struct {
   double i_ab_true[2], psi_ab[2], u_ab_true[2]; /* alpha-beta state (power invariant)   */
   double accel_rad_s2;                          /* d omega / dt from the model at t               */
   double p_cu_stator_w, p_cu_rotor_w;
+  /* Real-motor effects (NaN when all are off; sim/README.md, Real-motor effects): main flux
+     |psi_m|, static L_m(|psi_m|), the single-cage equivalent an IFOC's slip relation needs at
+     the present slip frequency (L_R = L_m + L_lr,eff, R_R,eff; tr_s is then L_R / R_R,eff),
+     iron loss, stored magnetic energy. */
+  double psi_m_wb, lm_h, lr_eff_h, rr_eff_ohm, p_fe_w, w_mag_j;
   /* IFOC (NaN when not IFOC). */
   double ifoc_torque_ref_nm, ifoc_flux_ref_wb, ifoc_tr_s, ifoc_speed_ref_rad_s;
   /* Drive (PWM stages). duty: upper-switch duty of each leg, in [0, 1], applied during
@@ -192,6 +210,8 @@ typedef struct {
   double speed_rad_s, speed_rpm, slip;
   double i_rms_phase, torque_nm, psi_r_wb;
   double i_ab[2], psi_ab[2]; /* alpha-beta state at supply phase 0 (u = vll + j0) */
+  /* Real-motor effects (0 when off): main flux |psi_m|, static L_m there, iron loss. */
+  double psi_m_wb, lm_h, p_fe_w;
 } imsim_steady_t;
 
 /* Private state. Declared here only so that the caller can own the storage (no malloc). */
@@ -203,9 +223,23 @@ typedef struct {
   double spare;  /* second Gaussian of the polar method */
   bool has_spare;
 } imsim_rng_t;
+/* Real-motor model: derived parameters and flux-linkage state (realmotor.c). */
+typedef struct {
+  bool on, fe, dc;
+  double lls_h, llr_h;          /* stator leakage; single-cage rotor leakage L_R - M       */
+  double lm0_h, psi_n_wb, sat_a; /* unsaturated L_m, rated main flux, curve coefficient    */
+  double rfe_ohm;               /* iron-loss resistance (fe)                               */
+  double r1_ohm, l1_h, r2_ohm, l2_h; /* cold cage branches (single cage: r1 = R_R, l1 = L_lr) */
+  double f_n_hz, h_max_s;
+  imsim_cpx_t fl[4]; /* psi_S, psi_R1, psi_R2, psi_m (psi_m a state with R_fe only) */
+  imsim_cpx_t psi_m_prev;
+  bool has_prev;
+} imsim_real_t;
+
 typedef struct {
   imsim_config_t c;
   char err[320];
+  imsim_real_t rm;
   /* derived constants */
   double m_h, rr0_ohm, ts_s, h_s;
   int k_steps;
@@ -258,6 +292,10 @@ void imsim_config_default(imsim_config_t *c);
    firmware timing, at rated load; see sim/README.md, Presets). Returns 0, or -1 for an
    unknown name (c then holds exp1). */
 int imsim_config_preset(imsim_config_t *c, const char *name);
+/* Turns on the real-motor effects with realistic sizes for the motor in c (by its
+   rated_power_w: the drive presets' own; otherwise those of the exp presets), see sim/README.md,
+   Real-motor effects. */
+void imsim_config_real_motor(imsim_config_t *c);
 /* The preset names, separated by '|'. */
 const char *imsim_preset_names(void);
 
