@@ -453,3 +453,25 @@ int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v,
   }
   return 0;
 }
+
+int imsim_real_params(const imsim_config_t *c, imsim_real_params_t *out)
+{
+  imsim_real_t rm;
+  char err[8];
+  memset(out, 0, sizeof *out);
+  if (ims_rm_derive(c, &rm, err, sizeof err) != 0) return -1;
+  if (!rm.on) return 0;
+  out->lm0_h = rm.lm0_h;
+  out->psi_n_wb = rm.psi_n_wb;
+  out->sat_a = rm.sat_a;
+  out->lls_h = rm.lls_h;
+  out->llr_h = rm.llr_h;
+  out->rfe_ohm = rm.fe ? rm.rfe_ohm : 0.0;
+  out->r1_ohm = rm.r1_ohm;
+  out->l1_h = rm.l1_h;
+  out->r2_ohm = rm.dc ? rm.r2_ohm : 0.0;
+  out->l2_h = rm.dc ? rm.l2_h : 0.0;
+  out->f_n_hz = rm.f_n_hz;
+  out->h_max_s = rm.h_max_s;
+  return 0;
+}

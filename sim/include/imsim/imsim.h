@@ -334,6 +334,16 @@ int imsim_set_voltage(imsim_t *sim, const double u_abc[3]);
 int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, double load_nm,
                        imsim_steady_t *out);
 
+/* The real-motor parameters derived from c (sim/README.md, Real-motor effects), cold:
+   magnetising curve i_m(psi) = psi/lm0_h (1 + sat_a (psi/psi_n_wb)^6) (sat_a = 0: linear,
+   lm0_h = M); leakages; rfe_ohm (0 = no iron loss); rotor branches r1/l1 and r2/l2 (single
+   cage: r1 = R_R, l1 = L_R - M, r2 = l2 = 0); the rated frequency f_n_hz; the RK4 step bound.
+   Returns 0 (all zero when no effect is on), or -1 for an impossible configuration. */
+typedef struct {
+  double lm0_h, psi_n_wb, sat_a, lls_h, llr_h, rfe_ohm, r1_ohm, l1_h, r2_ohm, l2_h, f_n_hz, h_max_s;
+} imsim_real_params_t;
+int imsim_real_params(const imsim_config_t *c, imsim_real_params_t *out);
+
 /* Power-invariant transforms (docs/METHOD.md §1). */
 void imsim_abc_to_ab(const double abc[3], double ab[2]);
 void imsim_ab_to_abc(const double ab[2], double abc[3]);
