@@ -114,8 +114,8 @@ void ims_rm_piece(imsim_t *s, double len, cpx u_pwm, const step_input_t *in, dou
 void ims_rm_sync(imsim_t *s, double tl);
 double ims_rm_p_rotor(const imsim_t *s);
 void ims_rm_fill(imsim_t *s, imsim_sample_t *o);
-int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double freq_hz, double load_nm,
-                  imsim_steady_t *out, cpx fl[4]);
+int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double freq_hz,
+                  double load_nm, imsim_steady_t *out, cpx fl[4]);
 
 /* ---- integration ---------------------------------------------------------------------------- */
 

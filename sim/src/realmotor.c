@@ -14,11 +14,11 @@
 
 #include "imsim_internal.h"
 
-#define SAT_EXP  6    /* i_m = psi/L_m0 (1 + a (psi/psi_n)^6): a polynomial a1 psi + a7 psi^7 */
-#define CAGE_C   0.05 /* double cage: outer-cage leakage / inner-cage leakage                 */
-#define FE_HMAX  1.5  /* RK4 step x fastest (iron-loss) eigenvalue, well inside RK4's 2.78     */
-#define EL_HMAX  0.05 /* RK4 step x the fastest other electrical rate                          */
-#define H_CAP_S  20e-6
+#define SAT_EXP 6    /* i_m = psi/L_m0 (1 + a (psi/psi_n)^6): a polynomial a1 psi + a7 psi^7 */
+#define CAGE_C  0.05 /* double cage: outer-cage leakage / inner-cage leakage                 */
+#define FE_HMAX 1.5  /* RK4 step x fastest (iron-loss) eigenvalue, well inside RK4's 2.78     */
+#define EL_HMAX 0.05 /* RK4 step x the fastest other electrical rate                          */
+#define H_CAP_S 20e-6
 
 bool ims_rm_wanted(const imsim_config_t *c)
 {
@@ -105,8 +105,9 @@ int ims_rm_derive(const imsim_config_t *c, imsim_real_t *rm, char *err, size_t e
   const double tn = c->rated_torque_nm > 0.0 ? c->rated_torque_nm : c->load_nm;
   imsim_steady_t st;
   if (!(vn > 0.0 && fn > 0.0) || imsim_steady_state(&lin, vn, fn, tn, &st) != 0) {
-    snprintf(err, errlen, "real-motor effects need a rated point (rated or supply voltage and frequency "
-                          "> 0, load below breakdown)");
+    snprintf(err, errlen,
+             "real-motor effects need a rated point (rated or supply voltage and frequency "
+             "> 0, load below breakdown)");
     return -1;
   }
   const cpx i = cx(st.i_ab[0], st.i_ab[1]), psir = cx(st.psi_ab[0], st.psi_ab[1]);
@@ -340,8 +341,7 @@ void ims_rm_fill(imsim_t *s, imsim_sample_t *o)
   double wsl = 0.0;
   if (rm->has_prev && x > 0.0 && cabs2(rm->psi_m_prev) > 0.0) {
     const cpx p = rm->psi_m_prev;
-    const double dphi =
-        atan2(p.re * k.psim.im - p.im * k.psim.re, p.re * k.psim.re + p.im * k.psim.im);
+    const double dphi = atan2(p.re * k.psim.im - p.im * k.psim.re, p.re * k.psim.re + p.im * k.psim.im);
     wsl = dphi * s->c.fs_hz - (double)s->c.pole_pairs * s->w;
   }
   rm->psi_m_prev = k.psim;
@@ -402,8 +402,8 @@ static void phasor_at(const imsim_config_t *c, const imsim_real_t *rm, double vl
   o->te = (double)c->pole_pairs * (ir.re * o->psim.im - ir.im * o->psim.re);
 }
 
-int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double freq_hz, double load_nm,
-                  imsim_steady_t *out, cpx fl[4])
+int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double freq_hz,
+                  double load_nm, imsim_steady_t *out, cpx fl[4])
 {
   if (!(freq_hz > 0.0)) return -1;
   const double we = 2.0 * PI * freq_hz;

@@ -113,8 +113,11 @@ TEST(SimRealMotor, SteadyStateMatchesEquivalentCircuitWithEffects)
   struct Case {
     const char *preset;
     double sat, fe, cage;
-  } cases[] = {{"4kw", 0.25, 0.035, 1.3}, {"4kw", 0.2, 0, 0}, {"4kw", 0, 0.04, 0},
-               {"4kw", 0, 0, 1.5},        {"37kw", 0.18, 0.02, 1.8}};
+  } cases[] = {{"4kw", 0.25, 0.035, 1.3},
+               {"4kw", 0.2, 0, 0},
+               {"4kw", 0, 0.04, 0},
+               {"4kw", 0, 0, 1.5},
+               {"37kw", 0.18, 0.02, 1.8}};
   for (const auto &k : cases) {
     const imsim_config_t c = real_sine(k.preset, k.sat, k.fe, k.cage);
     imsim_real_params_t p;
@@ -167,7 +170,7 @@ TEST(SimRealMotor, EnergyBalanceWithEffects)
 {
   imsim_config_t c = real_sine("4kw", 0.25, 0.035, 1.3);
   c.load_nm = 0.8 * c.rated_torque_nm; // off the start point: the machine decelerates, dW != 0
-  const long n = 800;                   // 0.1 s at 8 kHz, an even number of intervals
+  const long n = 800;                  // 0.1 s at 8 kHz, an even number of intervals
   const auto s = run(c, n);
   ASSERT_FALSE(s.empty());
   auto simpson = [&](auto f) {
@@ -184,14 +187,14 @@ TEST(SimRealMotor, EnergyBalanceWithEffects)
   const double dw = s.back().w_mag_j - s.front().w_mag_j;
   const double e_out = e_cu + e_fe + e_mech + dw;
   EXPECT_GT(e_in, 300.0);
-  EXPECT_NEAR(e_out / e_in, 1.0, 5e-3) << "in " << e_in << " cu " << e_cu << " fe " << e_fe << " mech " << e_mech
-                                       << " dW " << dw;
+  EXPECT_NEAR(e_out / e_in, 1.0, 5e-3)
+      << "in " << e_in << " cu " << e_cu << " fe " << e_fe << " mech " << e_mech << " dW " << dw;
   EXPECT_GT(std::abs((e_out - e_fe) / e_in - 1.0), 5e-3);
   // and the mechanical side: T_e w = load + friction power + d(kinetic)/dt
-  const double e_load = simpson([&](const imsim_sample_t &x) {
-    return (x.load_nm + c.b_nms * x.speed_rad_s) * x.speed_rad_s;
-  });
-  const double dkin = 0.5 * c.j_kgm2 * (std::pow(s.back().speed_rad_s, 2) - std::pow(s.front().speed_rad_s, 2));
+  const double e_load =
+      simpson([&](const imsim_sample_t &x) { return (x.load_nm + c.b_nms * x.speed_rad_s) * x.speed_rad_s; });
+  const double dkin =
+      0.5 * c.j_kgm2 * (std::pow(s.back().speed_rad_s, 2) - std::pow(s.front().speed_rad_s, 2));
   EXPECT_NEAR((e_load + dkin) / e_mech, 1.0, 5e-3);
 }
 
@@ -217,8 +220,8 @@ TEST(SimRealMotor, DefaultStepAgreesWithFinerStep)
     ipk = std::max(ipk, std::abs(iab(b[k])));
     dw = std::max(dw, std::abs(a[k].speed_rad_s - b[k].speed_rad_s));
   }
-  EXPECT_LT(di / ipk, 1e-4) << "current error " << di << " of " << ipk;
-  EXPECT_LT(dw, 1e-4 * b.back().speed_rad_s) << "speed error " << dw;
+  EXPECT_LT(di / ipk, 1e-6) << "current error " << di << " of " << ipk;
+  EXPECT_LT(dw, 1e-8 * b.back().speed_rad_s) << "speed error " << dw;
   RecordProperty("current_rel_err", std::to_string(di / ipk));
 }
 

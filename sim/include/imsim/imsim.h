@@ -226,9 +226,9 @@ typedef struct {
 /* Real-motor model: derived parameters and flux-linkage state (realmotor.c). */
 typedef struct {
   bool on, fe, dc;
-  double lls_h, llr_h;          /* stator leakage; single-cage rotor leakage L_R - M       */
-  double lm0_h, psi_n_wb, sat_a; /* unsaturated L_m, rated main flux, curve coefficient    */
-  double rfe_ohm;               /* iron-loss resistance (fe)                               */
+  double lls_h, llr_h;               /* stator leakage; single-cage rotor leakage L_R - M       */
+  double lm0_h, psi_n_wb, sat_a;     /* unsaturated L_m, rated main flux, curve coefficient    */
+  double rfe_ohm;                    /* iron-loss resistance (fe)                               */
   double r1_ohm, l1_h, r2_ohm, l2_h; /* cold cage branches (single cage: r1 = R_R, l1 = L_lr) */
   double f_n_hz, h_max_s;
   imsim_cpx_t fl[4]; /* psi_S, psi_R1, psi_R2, psi_m (psi_m a state with R_fe only) */
