@@ -169,7 +169,7 @@ TEST(SimRealMotor, SteadyStateMatchesEquivalentCircuitWithEffects)
 TEST(SimRealMotor, EnergyBalanceWithEffects)
 {
   imsim_config_t c = real_sine("4kw", 0.25, 0.035, 1.3);
-  c.load_nm = 0.8 * c.rated_torque_nm; // off the start point: the machine decelerates, dW != 0
+  c.load_nm = 0.8 * c.rated_torque_nm; // steady start at this load: d(stored energy) is ~0
   const long n = 800;                  // 0.1 s at 8 kHz, an even number of intervals
   const auto s = run(c, n);
   ASSERT_FALSE(s.empty());

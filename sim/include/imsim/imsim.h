@@ -8,7 +8,9 @@
  * space-vector modulation; ideal or firmware timing), indirect field-oriented control (IFOC),
  * and commands from a controller outside the simulator (closed loop, firmware timing).
  * Sensors: ADCs (bits, range, clipping, seeded white noise), optional 2nd-order analog
- * anti-alias filter, incremental encoder. Thermal drift of R_S and R_R.
+ * anti-alias filter, incremental encoder. Thermal drift of R_S and R_R. Optional real-motor
+ * effects (off by default): main-flux saturation, iron loss, double-cage rotor, in a
+ * flux-linkage model (sim/README.md, Real-motor effects).
  *
  * Host only: never linked into the firmware. No malloc: the caller owns every struct.
  *
