@@ -331,8 +331,11 @@ int imsim_set_duty(imsim_t *sim, const double duty[3]);
 int imsim_set_voltage(imsim_t *sim, const double u_abc[3]);
 
 /* Phasor steady state of the configured motor (cold parameters) at the given supply and load
-   (load opposes rotation; viscous friction included). Returns 0, or -1 if the load exceeds
-   the breakdown torque. */
+   (load opposes rotation; viscous friction included). With a real-motor effect on, the phasor
+   solution of the flux-linkage model (R_fe || jX_m(|psi_m|), the cage's branches; exact, since
+   |psi_m| is constant under a balanced sine), psi_r_wb/psi_ab then = psi_m + L_lr i_R, and
+   psi_m_wb, lm_h, p_fe_w are set (0 otherwise). Returns 0, or -1 if the load exceeds the
+   breakdown torque (or the real-motor configuration is impossible). */
 int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, double load_nm,
                        imsim_steady_t *out);
 
