@@ -20,10 +20,17 @@ static const char HEADER[] =
     "i_a_true,i_b_true,i_c_true,theta_true,u_a_true,u_b_true,u_c_true,"
     "ifoc_torque_ref_nm,ifoc_flux_ref_wb,ifoc_tr_s,ifoc_speed_ref_rad_s,"
     "d_a,d_b,d_c,v_dc";
+/* Appended when a real-motor effect is on (sim/README.md, Real-motor effects). */
+static const char HEADER_REAL[] = ",psi_m_wb,lm_h,lr_eff_h,rr_eff_ohm,p_fe_w";
 
 const char *imsim_cli_header(void)
 {
   return HEADER;
+}
+
+const char *imsim_cli_header_real(void)
+{
+  return HEADER_REAL;
 }
 
 static const char USAGE[] =
@@ -105,6 +112,18 @@ static const char USAGE[] =
     "integrator:\n"
     "  --integrator fast|rk4 (fast; rk4 = slow reference)  --rk4-substeps N (8)\n"
     "  --steps-per-sample N  steps per sample for the ideal supplies (0 = auto: 5; PWM: fixed)\n"
+    "real-motor effects (all off by default; any on: flux-linkage model, sub-stepped RK4, and the\n"
+    "CSV gains psi_m_wb,lm_h,lr_eff_h,rr_eff_ohm,p_fe_w; see sim/README.md, Real-motor effects):\n"
+    "  --saturation F        main-flux saturation: static L_m at rated flux F below unsaturated,\n"
+    "                        0 <= F < 0.6 (0)\n"
+    "  --iron-loss F         core-loss resistance across the magnetising branch, sized to F x rated\n"
+    "                        power at rated V/f, 0 <= F < 0.2 (0)\n"
+    "  --rotor single|double-cage:RATIO   double cage whose R_R at rated frequency is RATIO x its\n"
+    "                        DC value, 1 < RATIO <= 4 (single)\n"
+    "  --real-motor          the preset's realistic sizes of all three (4kw: 0.25, 0.035, 1.3;\n"
+    "                        11kw: 0.22, 0.03, 1.6; 15kw: 0.20, 0.025, 1.5; 37kw: 0.18, 0.02, 1.8;\n"
+    "                        75kw: 0.15, 0.015, 2.0; exp1/exp2: 0.25, 0.04, 1.5); flags after it\n"
+    "                        override\n"
     "\n"
     "Exit status: 0 done (a warning on stderr says when the PWM modulation was clipped; a note\n"
     "when the motor stalled: the load stopped it, or an active load turned it backwards);\n"
@@ -191,6 +210,8 @@ static const real_flag REAL_FLAGS[] = {
     {"--aa-hz", CFG(aa_hz), 0.0, NONE_HI, false, true, ">= 0 Hz (0 = off)"},
     {"--t-amb", CFG(t_amb_c), -273.15, NONE_HI, true, true, "degC"},
     {"--thermal-speedup", CFG(thermal_speedup), 0.0, NONE_HI, true, true, "> 0"},
+    {"--saturation", CFG(sat_fraction), 0.0, 0.6, false, true, "0 <= F < 0.6"},
+    {"--iron-loss", CFG(iron_loss_fraction), 0.0, 0.2, false, true, "0 <= F < 0.2"},
 };
 
 /* Integer flags (int fields), value in [lo, hi]. */
@@ -278,8 +299,8 @@ static void *field(imsim_config_t *c, size_t off)
 /* Flags without a value, and the valued flags handled one by one in parse_valued. */
 static const char *const SWITCH_FLAGS[] = {"--help",        "--version",          "--ideal-sensors",
                                            "--no-thermal",  "--ifoc-ideal-stage", "--progress",
-                                           "--no-progress", "--pwm-segments"};
-static const char *const OTHER_FLAGS[] = {"--preset", "--output", "--out", "--decimate", "--seed"};
+                                           "--no-progress", "--pwm-segments",     "--real-motor"};
+static const char *const OTHER_FLAGS[] = {"--preset", "--output", "--out", "--decimate", "--seed", "--rotor"};
 
 size_t imsim_cli_flags(const char **names, size_t max)
 {
@@ -323,6 +344,8 @@ static int parse_switch(const char *name, imsim_config_t *c, imsim_cli_opts_t *o
     o->progress = 0;
   else if (strcmp(name, "--pwm-segments") == 0)
     c->pwm_moments = false;
+  else if (strcmp(name, "--real-motor") == 0)
+    imsim_config_real_motor(c);
   else
     return 0;
   return 1;
@@ -352,6 +375,19 @@ static int parse_valued(const char *name, const char *val, imsim_config_t *c, im
     if (errno != 0 || end == val || *end != '\0' || val[0] == '-')
       return perr(err, errlen, "invalid value for --seed (unsigned integer): ", val);
     c->seed = (uint64_t)u;
+    return 0;
+  }
+  if (strcmp(name, "--rotor") == 0) {
+    static const char DC[] = "double-cage:";
+    double r = 0.0;
+    if (strcmp(val, "single") == 0) {
+      c->rotor_cage_ratio = 0.0;
+    } else if (strncmp(val, DC, sizeof DC - 1) == 0 && num(val + sizeof DC - 1, &r) == 0 && r > 1.0 &&
+               r <= 4.0) {
+      c->rotor_cage_ratio = r;
+    } else {
+      return perr(err, errlen, "invalid value for --rotor (single|double-cage:RATIO, 1 < RATIO <= 4): ", val);
+    }
     return 0;
   }
   for (size_t k = 0; k < COUNT(PHASE_FLAGS); ++k) {
@@ -512,12 +548,17 @@ void imsim_cli_write_row(FILE *f, const imsim_sample_t *s)
 {
   fprintf(f,
           "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,"
-          "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+          "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g",
           s->t, s->u_abc[0], s->u_abc[1], s->u_abc[2], s->i_abc[0], s->i_abc[1], s->i_abc[2], s->theta,
           s->tr_s, s->rs_ohm, s->speed_rad_s, s->torque_nm, s->load_nm, s->psi_r_wb, s->temp_stator_c,
           s->temp_rotor_c, s->i_abc_true[0], s->i_abc_true[1], s->i_abc_true[2], s->theta_true,
           s->u_abc_true[0], s->u_abc_true[1], s->u_abc_true[2], s->ifoc_torque_ref_nm, s->ifoc_flux_ref_wb,
           s->ifoc_tr_s, s->ifoc_speed_ref_rad_s, s->duty[0], s->duty[1], s->duty[2], s->vdc_v);
+  /* real-motor truth: only when an effect is on (NaN otherwise), so that the record of the
+     linear machine keeps its columns */
+  if (!isnan(s->psi_m_wb))
+    fprintf(f, ",%.9g,%.9g,%.9g,%.9g,%.9g", s->psi_m_wb, s->lm_h, s->lr_eff_h, s->rr_eff_ohm, s->p_fe_w);
+  fputc('\n', f);
 }
 
 static double now_s(void)
@@ -643,7 +684,7 @@ static int run(const imsim_config_t *c, const imsim_cli_opts_t *o)
   const uint64_t total = (uint64_t)llround(c->duration_s * c->fs_hz);
   progress bar;
   progress_start(&bar, o->progress < 0 ? isatty(STDERR_FILENO) : o->progress, total, c->duration_s);
-  fprintf(f, "%s\n", HEADER);
+  fprintf(f, "%s%s\n", HEADER, isnan(smp.psi_m_wb) ? "" : HEADER_REAL);
   imsim_cli_write_row(f, &smp);
   bool stall_noted = false;
   for (uint64_t n = 1; n <= total; ++n) {

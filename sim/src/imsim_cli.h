@@ -22,6 +22,8 @@ typedef struct {
 
 /* The CSV header line (no newline). */
 const char *imsim_cli_header(void);
+/* The columns appended to it (and to every row) when a real-motor effect is on. */
+const char *imsim_cli_header_real(void);
 
 /* The --help text. */
 const char *imsim_cli_usage(void);

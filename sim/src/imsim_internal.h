@@ -9,6 +9,7 @@
 #define IMSIM_INTERNAL_H
 
 #include <math.h>
+#include <stddef.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -111,16 +112,33 @@ void ims_thermal_step(imsim_t *s);
 void ims_rng_seed(imsim_rng_t *r, uint64_t *sm);
 double ims_rng_gauss(imsim_rng_t *r);
 
+/* realmotor.c: real-motor effects (saturation, iron loss, double cage; sim/README.md).
+   ims_rm_wanted: any effect configured. ims_rm_derive: the derived parameters (rm->on false
+   when no effect is configured); 0, or -1 with a message. ims_rm_piece: sub-stepped RK4 over
+   one constant-input piece (input as for ims_rk4_piece); ims_rm_sync: i, psi_R, T_e and the
+   acceleration from the flux states. ims_rm_fill: the real-motor truth of a sample.
+   ims_rm_steady: phasor steady state with the effects (fl: flux states, may be NULL). */
+bool ims_rm_wanted(const imsim_config_t *c);
+int ims_rm_derive(const imsim_config_t *c, imsim_real_t *rm, char *err, size_t errlen);
+double ims_rm_lm_static(const imsim_real_t *rm, double psi_m_wb);
+typedef struct step_input step_input_t;
+void ims_rm_piece(imsim_t *s, double len, cpx u_pwm, const step_input_t *in, double tl);
+void ims_rm_sync(imsim_t *s, double tl);
+double ims_rm_p_rotor(const imsim_t *s);
+void ims_rm_fill(imsim_t *s, imsim_sample_t *o);
+int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double freq_hz,
+                  double load_nm, imsim_steady_t *out, cpx fl[4]);
+
 /* ---- integration ---------------------------------------------------------------------------- */
 
 /* Input of one integration step. */
-typedef struct {
+struct step_input {
   bool aa, src, pwm;
   bool piecewise; /* PWM, fast path: integrate this half period piecewise (else by moments) */
   int p;          /* Taylor order */
   double we;      /* source rotation (rad/s), src only */
   cpx mom[32];    /* PWM input moments m_k = int_0^h (h-s)^k/k! u(s) ds */
-} step_input_t;
+};
 
 /* One PWM half carrier period (time from its start). */
 typedef struct {

@@ -69,6 +69,30 @@ void ims_advance(imsim_t *s, const step_input_t *in, pwm_half_t *ph, double tl)
 {
   const imsim_config_t *c = &s->c;
   const double h = s->h_s;
+  if (s->rm.on) {
+    /* flux-linkage model: sub-stepped RK4, split at the switching instants */
+    if (!in->pwm) {
+      ims_rm_piece(s, h, cx(0.0, 0.0), in, tl);
+      return;
+    }
+    double b[8], vs[2] = {0.0, 0.0};
+    const int nb = ims_pwm_breaks(ph, h, b);
+    for (int piece = 0; piece < nb - 1; ++piece) {
+      const double t0 = b[piece], t1 = b[piece + 1];
+      if (t1 <= t0) continue;
+      double iabc[3];
+      piece_currents(c, s->x[0], iabc);
+      const cpx u = ims_pwm_piece_voltage(s, ph, 0.5 * (t0 + t1), iabc);
+      vs[0] += u.re * (t1 - t0);
+      vs[1] += u.im * (t1 - t0);
+      ims_rm_piece(s, t1 - t0, u, in, tl);
+    }
+    if (!ims_inverter_is_ideal(c)) {
+      ph->act_avg[0] = vs[0] / h;
+      ph->act_avg[1] = vs[1] / h;
+    }
+    return;
+  }
   if (c->integrator == IMSIM_INTEGRATOR_FAST) {
     if (!in->pwm) {
       fast_piece(s, h, s->hk, in, tl, s->x[6], s->x[6], NULL);

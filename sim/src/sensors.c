@@ -82,6 +82,10 @@ void ims_fill_sample(imsim_t *s, imsim_sample_t *o)
   const cpx ir = cscale(cadd(s->x[1], cscale(s->x[0], -s->m_h)), 1.0 / c->lr_h);
   o->p_cu_stator_w = s->rs * cabs2(s->x[0]);
   o->p_cu_rotor_w = s->rr * cabs2(ir);
+  if (s->rm.on)
+    ims_rm_fill(s, o);
+  else
+    o->psi_m_wb = o->lm_h = o->lr_eff_h = o->rr_eff_ohm = o->p_fe_w = o->w_mag_j = NAN_D;
   double utrue[2];
   const bool fw = ims_firmware_timing(c);
   if (fw) {

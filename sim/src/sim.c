@@ -101,6 +101,7 @@ int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first)
   s->rr0_ohm = c->lr_h / c->tr_s;
   s->temp_s = s->temp_r = c->t_amb_c;
   ims_update_params(s);
+  if (ims_rm_derive(c, &s->rm, s->err, sizeof s->err) != 0) return -1;
 
   uint64_t sm = c->seed;
   ims_rng_seed(&s->rng, &sm);     /* phase channels: the same stream as ever */
@@ -132,6 +133,7 @@ int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first)
     s->x[0] = cx(st.i_ab[0], st.i_ab[1]);
     s->x[1] = cx(st.psi_ab[0], st.psi_ab[1]);
     s->w = st.speed_rad_s;
+    if (s->rm.on) (void)ims_rm_steady(c, &s->rm, c->vll_v, c->freq_hz, c->load_nm, &st, s->rm.fl);
     /* AA filter states in sinusoidal steady state: f1 = H(j we) x, f2 = (j we / wc) f1 */
     if (c->aa_hz > 0.0 && !c->ideal_sensors) {
       const double wc = 2.0 * PI * c->aa_hz, we = 2.0 * PI * c->freq_hz;
@@ -147,6 +149,7 @@ int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first)
     s->c.load_ramp_s = 0.0;
   }
   s->te = ims_torque_of(s, s->x[0], s->x[1]);
+  if (s->rm.on) ims_rm_sync(s, 0.0); /* the real motor's currents and torque from its flux state */
   s->acc = (s->te - ims_load_torque(s, ims_load_at(s, 0.0)) - c->b_nms * s->w) / c->j_kgm2;
   s->load_stuck = s->w == 0.0 && c->load_kind == IMSIM_LOAD_PASSIVE && fabs(ims_load_at(s, 0.0)) > 0.0 &&
                   fabs(s->te) <= fabs(ims_load_at(s, 0.0));

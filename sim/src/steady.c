@@ -27,6 +27,12 @@ static void steady_at(const imsim_config_t *c, double m, double tr, double w, do
 int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, double load_nm,
                        imsim_steady_t *out)
 {
+  if (ims_rm_wanted(c)) {
+    imsim_real_t rm;
+    char err[8];
+    if (ims_rm_derive(c, &rm, err, sizeof err) != 0) return -1;
+    return ims_rm_steady(c, &rm, vll_v, freq_hz, load_nm, out, NULL);
+  }
   const double m = sqrt((1.0 - c->sigma) * c->ls_h * c->lr_h);
   const double we = 2.0 * PI * freq_hz;
   const double wsync = we / (double)c->pole_pairs;
@@ -67,5 +73,6 @@ int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, do
   out->i_ab[1] = i.im;
   out->psi_ab[0] = psi.re;
   out->psi_ab[1] = psi.im;
+  out->psi_m_wb = out->lm_h = out->p_fe_w = 0.0;
   return 0;
 }

@@ -20,7 +20,7 @@ void ims_thermal_step(imsim_t *s)
   const double ts = s->ts_s;
   const cpx ir = cscale(cadd(s->x[1], cscale(s->x[0], -s->m_h)), 1.0 / c->lr_h);
   const double ps = s->rs * cabs2(s->x[0]);
-  const double pr = s->rr * cabs2(ir);
+  const double pr = s->rm.on ? ims_rm_p_rotor(s) : s->rr * cabs2(ir);
   const double ks = 1.0 - exp(-ts * c->thermal_speedup / c->tau_stator_s);
   const double kr = 1.0 - exp(-ts * c->thermal_speedup / c->tau_rotor_s);
   s->temp_s += ks * (c->t_amb_c + c->rth_stator_k_per_w * ps - s->temp_s);

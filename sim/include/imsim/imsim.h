@@ -8,7 +8,9 @@
  * space-vector modulation; ideal or firmware timing), indirect field-oriented control (IFOC),
  * and commands from a controller outside the simulator (closed loop, firmware timing).
  * Sensors: ADCs (bits, range, clipping, seeded white noise), optional 2nd-order analog
- * anti-alias filter, incremental encoder. Thermal drift of R_S and R_R.
+ * anti-alias filter, incremental encoder. Thermal drift of R_S and R_R. Optional real-motor
+ * effects (off by default): main-flux saturation, iron loss, double-cage rotor, in a
+ * flux-linkage model (sim/README.md, Real-motor effects).
  *
  * Host only: never linked into the firmware. No malloc: the caller owns every struct.
  *
@@ -162,6 +164,19 @@ typedef struct {
   imsim_integrator_t integrator;
   int rk4_substeps; /* RK4 steps per constant-input piece */
 
+  /* Real-motor effects (sim/README.md, Real-motor effects). All 0 = off (the default): the
+     paper's linear machine, integrated as above. Any of them on: the flux-linkage model
+     (states psi_S, psi_R1, psi_R2, psi_m), integrated by sub-stepped RK4 whatever integrator
+     says. The rated point (V_n, f_n, T_n) is rated_voltage_v/rated_freq_hz/rated_torque_nm when
+     given, else vll_v/freq_hz/load_nm; psi_n = |psi_m| of the linear model there.
+     sat_fraction in [0, 0.6): static L_m at psi_n is M = sqrt((1 - sigma) L_S L_R) and the
+       unsaturated L_m0 = M / (1 - sat_fraction); i_m = psi/L_m0 (1 + a (psi/psi_n)^6).
+     iron_loss_fraction in [0, 0.2): R_fe across the magnetising branch, R_fe = (2 pi f_n psi_n)^2
+       / (fraction P_n), P_n = rated_power_w (or the rated point's shaft power).
+     rotor_cage_ratio: 0 = single cage; > 1: double cage whose R_R at f_n (standstill) is
+       ratio x its DC value R_R, with the DC R_R and DC leakage of the single cage. */
+  double sat_fraction, iron_loss_fraction, rotor_cage_ratio;
+
   double duration_s; /* used by the CLI and the benchmark only */
 } imsim_config_t;
 
@@ -187,6 +202,11 @@ typedef struct {
   double i_ab_true[2], psi_ab[2], u_ab_true[2]; /* alpha-beta state (power invariant)   */
   double accel_rad_s2;                          /* d omega / dt from the model at t               */
   double p_cu_stator_w, p_cu_rotor_w;
+  /* Real-motor effects (NaN when all are off; sim/README.md, Real-motor effects): main flux
+     |psi_m|, static L_m(|psi_m|), the single-cage equivalent an IFOC's slip relation needs at
+     the present slip frequency (L_R = L_m + L_lr,eff, R_R,eff; tr_s is then L_R / R_R,eff),
+     iron loss, stored magnetic energy. */
+  double psi_m_wb, lm_h, lr_eff_h, rr_eff_ohm, p_fe_w, w_mag_j;
   /* IFOC (NaN when not IFOC). */
   double ifoc_torque_ref_nm, ifoc_flux_ref_wb, ifoc_tr_s, ifoc_speed_ref_rad_s;
   /* Drive (PWM stages). duty: upper-switch duty of each leg, in [0, 1], applied during
@@ -201,6 +221,8 @@ typedef struct {
   double speed_rad_s, speed_rpm, slip;
   double i_rms_phase, torque_nm, psi_r_wb;
   double i_ab[2], psi_ab[2]; /* alpha-beta state at supply phase 0 (u = vll + j0) */
+  /* Real-motor effects (0 when off): main flux |psi_m|, static L_m there, iron loss. */
+  double psi_m_wb, lm_h, p_fe_w;
 } imsim_steady_t;
 
 /* Private state. Declared here only so that the caller can own the storage (no malloc). */
@@ -212,9 +234,23 @@ typedef struct {
   double spare;  /* second Gaussian of the polar method */
   bool has_spare;
 } imsim_rng_t;
+/* Real-motor model: derived parameters and flux-linkage state (realmotor.c). */
+typedef struct {
+  bool on, fe, dc;
+  double lls_h, llr_h;               /* stator leakage; single-cage rotor leakage L_R - M       */
+  double lm0_h, psi_n_wb, sat_a;     /* unsaturated L_m, rated main flux, curve coefficient    */
+  double rfe_ohm;                    /* iron-loss resistance (fe)                               */
+  double r1_ohm, l1_h, r2_ohm, l2_h; /* cold cage branches (single cage: r1 = R_R, l1 = L_lr) */
+  double f_n_hz, h_max_s;
+  imsim_cpx_t fl[4]; /* psi_S, psi_R1, psi_R2, psi_m (psi_m a state with R_fe only) */
+  imsim_cpx_t psi_m_prev;
+  bool has_prev;
+} imsim_real_t;
+
 typedef struct {
   imsim_config_t c;
   char err[320];
+  imsim_real_t rm;
   /* derived constants */
   double m_h, rr0_ohm, ts_s, h_s;
   int k_steps;
@@ -285,6 +321,10 @@ void imsim_config_default(imsim_config_t *c);
    firmware timing, at rated load; see sim/README.md, Presets). Returns 0, or -1 for an
    unknown name (c then holds exp1). */
 int imsim_config_preset(imsim_config_t *c, const char *name);
+/* Turns on the real-motor effects with realistic sizes for the motor in c (by its
+   rated_power_w: the drive presets' own; otherwise those of the exp presets), see sim/README.md,
+   Real-motor effects. */
+void imsim_config_real_motor(imsim_config_t *c);
 /* The preset names, separated by '|'. */
 const char *imsim_preset_names(void);
 
@@ -319,10 +359,23 @@ int imsim_set_duty(imsim_t *sim, const double duty[3]);
 int imsim_set_voltage(imsim_t *sim, const double u_abc[3]);
 
 /* Phasor steady state of the configured motor (cold parameters) at the given supply and load
-   (load opposes rotation; viscous friction included). Returns 0, or -1 if the load exceeds
-   the breakdown torque. */
+   (load opposes rotation; viscous friction included). With a real-motor effect on, the phasor
+   solution of the flux-linkage model (R_fe || jX_m(|psi_m|), the cage's branches; exact, since
+   |psi_m| is constant under a balanced sine), psi_r_wb/psi_ab then = psi_m + L_lr i_R, and
+   psi_m_wb, lm_h, p_fe_w are set (0 otherwise). Returns 0, or -1 if the load exceeds the
+   breakdown torque (or the real-motor configuration is impossible). */
 int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, double load_nm,
                        imsim_steady_t *out);
+
+/* The real-motor parameters derived from c (sim/README.md, Real-motor effects), cold:
+   magnetising curve i_m(psi) = psi/lm0_h (1 + sat_a (psi/psi_n_wb)^6) (sat_a = 0: linear,
+   lm0_h = M); leakages; rfe_ohm (0 = no iron loss); rotor branches r1/l1 and r2/l2 (single
+   cage: r1 = R_R, l1 = L_R - M, r2 = l2 = 0); the rated frequency f_n_hz; the RK4 step bound.
+   Returns 0 (all zero when no effect is on), or -1 for an impossible configuration. */
+typedef struct {
+  double lm0_h, psi_n_wb, sat_a, lls_h, llr_h, rfe_ohm, r1_ohm, l1_h, r2_ohm, l2_h, f_n_hz, h_max_s;
+} imsim_real_params_t;
+int imsim_real_params(const imsim_config_t *c, imsim_real_params_t *out);
 
 /* Power-invariant transforms (docs/METHOD.md §1). */
 void imsim_abc_to_ab(const double abc[3], double ab[2]);
