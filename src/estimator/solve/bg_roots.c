@@ -356,41 +356,34 @@ BG_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t
   sreal_t a = iv.a, b = iv.b;
   const sreal_t *p0 = CH(ch, 0);
   const int d0 = ch->deg[0];
-  sreal_t fa = horner_s(p0, d0, a), fb = horner_s(p0, d0, b);
-  if (sgn_s(fa) * sgn_s(fb) < 0) {
-    for (int it = 0; it < BG_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
-      const sreal_t m = a + (b - a) * (sreal_t)0.5;
-      if (!(m > a && m < b)) break;
-      ++st->bisect_steps;
-      const sreal_t fm = horner_s(p0, d0, m);
+  sreal_t fa = horner_s(p0, d0, a);
+  const sreal_t fb = horner_s(p0, d0, b);
+  const int by_sign = sgn_s(fa) * sgn_s(fb) < 0; /* else by the Sturm count */
+  int va = iv.va;
+  if (!by_sign && fb == 0) a = b; /* exact zero at b in chain precision */
+  for (int it = 0; it < BG_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
+    const sreal_t m = a + (b - a) * (sreal_t)0.5;
+    if (!(m > a && m < b)) break;
+    ++st->bisect_steps;
+    sreal_t fm = 0;
+    int vm = 0;
+    if (by_sign) {
+      fm = horner_s(p0, d0, m);
       if (fm == 0) {
         a = m;
         b = m;
         break;
       }
-      if (sgn_s(fm) == sgn_s(fa)) {
-        a = m;
-        fa = fm;
-      } else {
-        b = m;
-      }
+    } else {
+      vm = sign_changes(ch, m, st);
     }
-  } else if (fb != 0) {
-    int va = iv.va;
-    for (int it = 0; it < BG_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
-      const sreal_t m = a + (b - a) * (sreal_t)0.5;
-      if (!(m > a && m < b)) break;
-      ++st->bisect_steps;
-      const int vm = sign_changes(ch, m, st);
-      if (va - vm >= 1) {
-        b = m;
-      } else {
-        a = m;
-        va = vm;
-      }
+    if (by_sign ? sgn_s(fm) != sgn_s(fa) : va - vm >= 1) {
+      b = m;
+    } else {
+      a = m;
+      fa = fm;
+      va = vm;
     }
-  } else {
-    a = b; /* exact zero at b in chain precision */
   }
   const int kind = polish(pd, n, (double)a, (double)b, lo, hi, root, st);
   if (kind == 0) return 0;
