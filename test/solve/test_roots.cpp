@@ -412,3 +412,35 @@ TEST(SturmVsCompanion, BadInput)
   EXPECT_NEAR(r[0], 1.0, 1e-14);
   EXPECT_NEAR(r[1], 2.0, 1e-14);
 }
+
+// The float64 polish widens the refined bracket step by step (bg_roots.c): the
+// chain's root is a root of p rounded to float32 and can lie outside its 2^-20
+// bracket in float64, and a bracket as wide as the isolating interval can hold
+// another root or, for p' (a double root), two roots whose signs cancel. Each
+// polynomial below is one where jumping to the whole isolating interval missed
+// the root (found among random polynomials; reference roots by mpmath, 50
+// digits).
+TEST(SturmVsCompanion, PolishWidensStepByStep)
+{
+  double r[20];
+  // four positive roots 0.010006, 0.010224, 0.013679, 0.085602 (the float32
+  // chain does not separate the first two and reports one of them)
+  const double a[6] = {5.918032092679923e-09,  -1.6661526433278279e-06, 0.00016045829312313599,
+                       -0.0057422605793053614, 0.043500388760425578,    0.049404779703529494};
+  const int na = imest__bg_roots_positive(a, 5, r, 20);
+  ASSERT_GE(na, 3);
+  EXPECT_NEAR(r[0], 0.010006043248790885, 1e-12 * 0.010006043248790885);
+  EXPECT_NEAR(r[na - 1], 0.085601725588421607, 1e-12 * 0.085601725588421607);
+  // positive roots 597.39 and 604.24, in the domain (256, inf)
+  const double b[6] = {489689171.90689468, 508348458.96374649,  5620782932.7794466,
+                       5583474458.6510487, -18633667.114488292, 15519.957058722859};
+  const int nb = imest__bg_roots_positive(b, 5, r, 20);
+  ASSERT_GE(nb, 1);
+  EXPECT_NEAR(r[0], 597.3913832681715, 1e-12 * 597.3913832681715);
+  // a double root at 59.0996 (in float64 a complex pair 59.099622661284231 +- 7.6e-7 i):
+  // found as the root of p'
+  const double c[5] = {0.046940912814381529, -0.01579542373837961, 0.0023815431313159463,
+                       -6.7936827339999618e-05, 5.4035293076809761e-07};
+  ASSERT_EQ(imest__bg_roots_positive(c, 4, r, 20), 1);
+  EXPECT_NEAR(r[0], 59.099622661284231, 1e-12 * 59.099622661284231);
+}

@@ -36,22 +36,27 @@
  *  - Refinement in chain precision down to a relative width of 2^-20: sign
  *    bisection when p changes sign on the interval, else (even multiplicity, or
  *    float32 sign noise) bisection on the Sturm count; <= BG_ROOTS_MAX_BISECT.
- *  - Polish in float64 on the full (untruncated) polynomial: find a float64
- *    sign change (values only) on the refined bracket, widening it by 4x up to
+ *  - Polish in float64 on the full (untruncated) polynomial, one method
+ *    (polish) for p and, if float64 sees no sign change of p (even
+ *    multiplicity), for p' (odd multiplicity there): find a float64 sign
+ *    change (values only) on the refined bracket, widening it by 4x up to
  *    BG_ROOTS_MAX_EXPAND times (limited to the isolating interval plus 1/16
- *    of its width), then safeguarded Newton (a Newton step that leaves the
- *    bracket becomes a bisection; each step evaluates p and p' only),
- *    <= BG_ROOTS_MAX_POLISH evaluations, until
- *    a Newton step is <= 2^-30 |x| (then the error is ~ |x p''/(2p')| 2^-60 |x|:
- *    full double accuracy for simple roots) or the bracket is 4 ulp wide. If
- *    float64 sees no sign change (even multiplicity), the same is done on p'
- *    (odd multiplicity there), and the point is kept only if
+ *    of its width), then safeguarded Newton (newton_bracketed: a Newton step
+ *    that leaves the bracket becomes a bisection, the bracket is kept at every
+ *    step; each step evaluates p and p' only), <= BG_ROOTS_MAX_POLISH
+ *    evaluations, until a Newton step is <= 2^-30 |x| (then the error is
+ *    ~ |x p''/(2p')| 2^-60 |x|: full double accuracy for simple roots) or the
+ *    bracket is 4 ulp wide. A root of p' is kept only if
  *    |p(x)| <= 32 (n+1) eps_d sum|c_k x^k|; otherwise the interval is rejected
- *    (counted in stats.rejected).
+ *    (counted in stats.rejected). The widening is needed: the chain's root is
+ *    a root of p rounded to float32, which can lie outside its 2^-20 bracket
+ *    in float64, and one jump to the whole isolating interval finds the wrong
+ *    root or none (for p', whose roots the isolation does not separate).
  *  - Safety net in float64 (parity_rescue): if the odd-multiplicity roots
  *    found in a domain do not match the parity of the float64 sign change of p
  *    over the domain, p is sampled on a fixed grid (bg_bounds.h) and cells with a
- *    sign change but no root are solved in float64 (stats.rescues). Every
+ *    sign change but no root are solved by the same newton_bracketed
+ *    (stats.rescues). Every
  *    reported root is a float64 root (sign change or |p| at round-off level):
  *    a chain that lost accuracy can miss roots but never invent one.
  *
@@ -272,86 +277,69 @@ BG_NOINLINE static double newton_bracketed(const double *c, int n, int order, do
   return x;
 }
 
-/* Find a float64 sign change of p^(order) on [a,b] or a widening of it within
- * [lo,hi]; then polish. Returns 1 and *root on success. */
+/* The polish of one refined bracket [a,b] of an isolating interval [lo,hi],
+ * one method for p and, when float64 sees no sign change of p (even
+ * multiplicity), for p' (order 1): find a float64 sign change of p^(order) on
+ * [a,b] or on a widening of it by 4x per step, each step testing the left
+ * side first, within [lo,hi] widened by 1/16 of its width; then
+ * newton_bracketed on it. The root of p' is kept only if |p| is at round-off
+ * level there. Returns 0 (rejected), 1 (sign change of p: odd multiplicity)
+ * or 2 (even). */
 // One numeric iteration on shared state: a split would move arithmetic across calls (FMA
 // contraction; the results must stay bit-identical).
 // NOLINTNEXTLINE(readability-function-cognitive-complexity): see the line above
-BG_NOINLINE static int polish_order(const double *c, int n, int order, double a, double b, double lo,
-                                    double hi, double *root, bg_roots_stats_t *st)
-{
-  double fa = eval_v(c, n, order, a), fb = eval_v(c, n, order, b);
-  st->polish_evals += 2;
-  if (fa == 0.0) {
-    *root = a;
-    return 1;
-  }
-  if (fb == 0.0) {
-    *root = b;
-    return 1;
-  }
-  double w = b - a;
-  if (!(w > 0.0)) w = fabs(b) * 1e-6 + DBL_MIN;
-  for (int j = 0; sgn_d(fa) == sgn_d(fb) && j < BG_ROOTS_MAX_EXPAND; ++j) {
-    w *= 4.0;
-    const double a2 = (a - w > lo) ? a - w : lo, b2 = (b + w < hi) ? b + w : hi;
-    double fa2 = fa, fb2 = fb;
-    if (a2 < a) {
-      fa2 = eval_v(c, n, order, a2);
-      ++st->polish_evals;
-    }
-    if (sgn_d(fa2) != sgn_d(fa)) { /* sign change on [a2, a] */
-      b = a;
-      fb = fa;
-      a = a2;
-      fa = fa2;
-      break;
-    }
-    if (b2 > b) {
-      fb2 = eval_v(c, n, order, b2);
-      ++st->polish_evals;
-    }
-    if (sgn_d(fb2) != sgn_d(fb)) { /* sign change on [b, b2] */
-      a = b;
-      fa = fb;
-      b = b2;
-      fb = fb2;
-      break;
-    }
-    a = a2;
-    b = b2;
-    if (a2 <= lo && b2 >= hi) break;
-  }
-  if (sgn_d(fa) == sgn_d(fb) || sgn_d(fa) == 0 || sgn_d(fb) == 0) {
-    if (fa == 0.0) {
-      *root = a;
-      return 1;
-    }
-    if (fb == 0.0) {
-      *root = b;
-      return 1;
-    }
-    return 0;
-  }
-  *root = newton_bracketed(c, n, order, a, b, fa, st);
-  return 1;
-}
-
 static int polish(const double *c, int n, double a, double b, double lo, double hi, double *root,
                   bg_roots_stats_t *st)
 {
   const double ext = (hi - lo) * 0.0625;
   lo = (lo - ext > 0.0) ? lo - ext : 0.0;
   hi = hi + ext;
-  if (polish_order(c, n, 0, a, b, lo, hi, root, st)) return 1;
-  /* no float64 sign change: even multiplicity? polish the root of p' */
-  double x;
-  if (!polish_order(c, n, 1, a, b, lo, hi, &x, st)) return 0;
-  const double px = imest__bg_poly_eval(c, n, x);
-  ++st->polish_evals;
-  if (fabs(px) <= 32.0 * (double)(n + 1) * DBL_EPSILON * abs_sum_d(c, n, x)) {
-    *root = x;
-    return 2;
+  for (int order = 0; order < 2; ++order) {
+    double e[2] = {a, b}; /* the bracket */
+    double fe[2] = {eval_v(c, n, order, a), eval_v(c, n, order, b)};
+    st->polish_evals += 2;
+    double w = b - a;
+    if (!(w > 0.0)) w = fabs(b) * 1e-6 + DBL_MIN;
+    int hit = 0;
+    for (int j = 0; !hit && fe[0] != 0.0 && sgn_d(fe[0]) == sgn_d(fe[1]) && j < BG_ROOTS_MAX_EXPAND; ++j) {
+      w *= 4.0;
+      for (int s = 0; s < 2 && !hit; ++s) { /* s = 0: [e0 - w, e0], s = 1: [e1, e1 + w] */
+        const double t = s ? ((e[1] + w < hi) ? e[1] + w : hi) : ((e[0] - w > lo) ? e[0] - w : lo);
+        double ft = fe[s];
+        if (s ? t > e[1] : t < e[0]) {
+          ft = eval_v(c, n, order, t);
+          ++st->polish_evals;
+        }
+        if (sgn_d(ft) != sgn_d(fe[s])) { /* the new bracket is [t, e0] or [e1, t] */
+          e[1 - s] = e[s];
+          fe[1 - s] = fe[s];
+          hit = 1;
+        }
+        e[s] = t;
+        fe[s] = ft;
+      }
+      if (e[0] <= lo && e[1] >= hi) break;
+    }
+    double x;
+    if (fe[0] == 0.0)
+      x = e[0];
+    else if (fe[1] == 0.0)
+      x = e[1];
+    else if (sgn_d(fe[0]) != sgn_d(fe[1]))
+      x = newton_bracketed(c, n, order, e[0], e[1], fe[0], st);
+    else
+      continue; /* no float64 sign change of p^(order) */
+    if (order == 0) {
+      *root = x;
+      return 1;
+    }
+    const double px = imest__bg_poly_eval(c, n, x);
+    ++st->polish_evals;
+    if (fabs(px) <= 32.0 * (double)(n + 1) * DBL_EPSILON * abs_sum_d(c, n, x)) {
+      *root = x;
+      return 2;
+    }
+    return 0;
   }
   return 0;
 }
@@ -368,41 +356,34 @@ BG_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t
   sreal_t a = iv.a, b = iv.b;
   const sreal_t *p0 = CH(ch, 0);
   const int d0 = ch->deg[0];
-  sreal_t fa = horner_s(p0, d0, a), fb = horner_s(p0, d0, b);
-  if (sgn_s(fa) * sgn_s(fb) < 0) {
-    for (int it = 0; it < BG_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
-      const sreal_t m = a + (b - a) * (sreal_t)0.5;
-      if (!(m > a && m < b)) break;
-      ++st->bisect_steps;
-      const sreal_t fm = horner_s(p0, d0, m);
+  sreal_t fa = horner_s(p0, d0, a);
+  const sreal_t fb = horner_s(p0, d0, b);
+  const int by_sign = sgn_s(fa) * sgn_s(fb) < 0; /* else by the Sturm count */
+  int va = iv.va;
+  if (!by_sign && fb == 0) a = b; /* exact zero at b in chain precision */
+  for (int it = 0; it < BG_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
+    const sreal_t m = a + (b - a) * (sreal_t)0.5;
+    if (!(m > a && m < b)) break;
+    ++st->bisect_steps;
+    sreal_t fm = 0;
+    int vm = 0;
+    if (by_sign) {
+      fm = horner_s(p0, d0, m);
       if (fm == 0) {
         a = m;
         b = m;
         break;
       }
-      if (sgn_s(fm) == sgn_s(fa)) {
-        a = m;
-        fa = fm;
-      } else {
-        b = m;
-      }
+    } else {
+      vm = sign_changes(ch, m, st);
     }
-  } else if (fb != 0) {
-    int va = iv.va;
-    for (int it = 0; it < BG_ROOTS_MAX_BISECT && (b - a) > REFINE_REL * b; ++it) {
-      const sreal_t m = a + (b - a) * (sreal_t)0.5;
-      if (!(m > a && m < b)) break;
-      ++st->bisect_steps;
-      const int vm = sign_changes(ch, m, st);
-      if (va - vm >= 1) {
-        b = m;
-      } else {
-        a = m;
-        va = vm;
-      }
+    if (by_sign ? sgn_s(fm) != sgn_s(fa) : va - vm >= 1) {
+      b = m;
+    } else {
+      a = m;
+      fa = fm;
+      va = vm;
     }
-  } else {
-    a = b; /* exact zero at b in chain precision */
   }
   const int kind = polish(pd, n, (double)a, (double)b, lo, hi, root, st);
   if (kind == 0) return 0;
@@ -416,7 +397,7 @@ BG_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t
  * multiplicity roots in (0, TOP] must have the parity of the sign change of p
  * between 0+ and TOP. If not, p is sampled in float64 at a fixed grid
  * (0, 2^-16 .. 2^-1, 0.75, TOP: BG_ROOTS_RESCUE_CELLS cells) and every grid cell with a sign
- * change and no root yet is solved by the bracketed float64 Newton. */
+ * change and no root yet is solved by newton_bracketed. */
 BG_NOINLINE static int parity_rescue(const double *pd, int n, double ylo, double *out, int *odd, int nout,
                                      bg_roots_stats_t *st)
 {
