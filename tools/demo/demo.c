@@ -574,7 +574,7 @@ static int job_open(job_t *j, run_t *x)
     snprintf(tname, sizeof tname, "%s_true_constants.csv", x->name);
     if ((x->csv_true = open_out(j, x->dir, tname)) == NULL) return -1;
     fprintf(x->csv_true, "experiment,seq,t_end_s,T_R_s,R_S_ohm,valid,status,T_R_true_s,R_S_true_ohm,"
-                         "tr_valid,rs_valid\n");
+                         "tr_valid,rs_valid,tr_reason,rs_reason\n");
   }
 
   char fname[256];
@@ -609,7 +609,7 @@ static int job_open(job_t *j, run_t *x)
                   "speed_rad_s,torque_nm,load_nm,torque_ref_nm,torque_err_rms_nm,psi_r_wb,psi_ref_wb,"
                   "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s,"
                   "tr_valid,tr_reason,rs_valid,rs_reason,tr_bound_rel,trk_T_R_s,trk_state,trk_age_s,"
-                  "trk_bound_rel\n");
+                  "trk_bound_rel,rs_bound_rel\n");
 
   j->fs_hz = x->c.fs_hz;
   j->total = (unsigned long long)llround(j->duration_s * x->c.fs_hz);
@@ -643,13 +643,14 @@ static void on_window(void *ctx, const imest_result_t *r)
   (void)imest_tracker_update(&x->trk, r); /* t_end_s only grows: it cannot refuse */
   fprintf(x->csv,
           "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
-          "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s,%.4g,%.9g,%s,%.6g,%.4g\n",
+          "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s,%.4g,%.9g,%s,%.6g,%.4g,%.4g\n",
           x->name, r->seq, r->t_end_s, r->tr_s, r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr,
           t->rs, r->e_i, r->pe_k1_rel, r->pe_k2_rel, r->slip_ratio, r->i_rms_a, r->n_roots, r->n_admissible,
           r->used_samples, r->flags, t->speed, t->te, t->load, t->te_ref, t->te_err_rms, t->psi, t->psi_ref,
           t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr, r->tr_valid, imest_reason_name(r->tr_reason),
           r->rs_valid, imest_reason_name(r->rs_reason), r->tr_bound_rel, (double)x->trk.tr_s,
-          imest_tracker_state_name(x->trk.state), (double)x->trk.age_s, (double)x->trk.tr_bound_rel);
+          imest_tracker_state_name(x->trk.state), (double)x->trk.age_s, (double)x->trk.tr_bound_rel,
+          r->rs_bound_rel);
   /* the controller takes the tracker's T_R (or, with --adaptive-tr raw, every window whose T_R is
      trusted, as it is) */
   if (IS_ADAPTIVE(j->id)) {
@@ -677,8 +678,9 @@ static void on_window_true(void *ctx, const imest_result_t *r)
   static const truth_t nan_t = {D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN,
                                 D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN};
   const truth_t *t = (r->seq < x->nwin && r->seq < x->win) ? &x->truth[r->seq] : &nan_t;
-  fprintf(x->csv_true, "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%d,%d\n", x->name, r->seq, r->t_end_s, r->tr_s,
-          r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr, t->rs, r->tr_valid, r->rs_valid);
+  fprintf(x->csv_true, "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%d,%d,%s,%s\n", x->name, r->seq, r->t_end_s,
+          r->tr_s, r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr, t->rs, r->tr_valid, r->rs_valid,
+          imest_reason_name(r->tr_reason), imest_reason_name(r->rs_reason));
 }
 
 /* The samples: each one's truth into its window, then the drive loop (ISR
