@@ -773,7 +773,10 @@ def fig_duty(path, a, comm):
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
         s_ = err_stats(a[key][v], a[tkey][v])
-        note = (stats_note(*s_) if s_[0] else why_none(a, okkey, rkey) + " (README, When is a window valid)")
+        note = stats_note(*s_) if s_[0] else why_none(a, okkey, rkey)
+        bkey = okkey.replace("valid", "bound_rel")
+        if not s_[0] and bkey in a and np.isfinite(a[bkey]).any():
+            note += f"\n(its error bound {100 * np.nanmedian(a[bkey]):.1f} % > tolerance: README, When is a window valid)"
         ax.legend(loc="best", fontsize=8, framealpha=0.9, title=note, title_fontsize=8)
         err_panel(ae, t, 100.0 * (a[key] / a[tkey] - 1.0), v, a[rkey])
         ae.legend(loc="upper right", fontsize=8, framealpha=0.9)
