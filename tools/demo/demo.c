@@ -110,8 +110,8 @@ enum {
   DUTY4 = 6,
   NEXP = 7
 };
-static const char *const k_exp_name[NEXP] = {"exp1",         "exp2",           "ifoc_fixed", "ifoc_adaptive",
-                                             "ifoc11_fixed", "ifoc11_adaptive", "duty4kw"};
+static const char *const k_exp_name[NEXP] = {
+    "exp1", "exp2", "ifoc_fixed", "ifoc_adaptive", "ifoc11_fixed", "ifoc11_adaptive", "duty4kw"};
 
 /* The 11 kW pair: half load, heating sped up so that a sixth of the heat run's motor time
    covers the same heating (its rotor's thermal time constant is 2100 s). */
@@ -121,9 +121,9 @@ static const char *const k_exp_name[NEXP] = {"exp1",         "exp2",           "
 /* The duty-cycle run: the 4 kW drive (imsim preset 4kw behind commissioning's IGBT inverter) at
    rated speed (V/f 390 V, 50 Hz) and 75 % of rated torque, heating 6x faster over a sixth of the
    duration (like the 11 kW pair). */
-#define DUTY4_LOAD_REL  0.75
-#define DUTY4_THERMAL_X 6.0
-#define SHORT_RUN(id)   (IS_IFOC11(id) || (id) == DUTY4)
+#define DUTY4_LOAD_REL   0.75
+#define DUTY4_THERMAL_X  6.0
+#define SHORT_RUN(id)    (IS_IFOC11(id) || (id) == DUTY4)
 #define IS_ADAPTIVE(id)  ((id) == IFOC_ADAPTIVE || (id) == IFOC11_ADAPTIVE)
 
 /* ------------------------------------------------------------------------- */
@@ -390,11 +390,11 @@ typedef struct {
   tee_port_t *tee;
   FILE *log, *csv, *csv_true;
   truth_t *truth;
-  uint32_t wn;         /* samples per window */
-  size_t nwin;         /* truth slots */
-  size_t win;          /* windows whose truth is complete */
-  int have_id;         /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
-  imest_tracker_t trk; /* every run: what the tracker makes of its results (applied if adaptive) */
+  uint32_t wn;                 /* samples per window */
+  size_t nwin;                 /* truth slots */
+  size_t win;                  /* windows whose truth is complete */
+  int have_id;                 /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
+  imest_tracker_t trk;         /* every run: what the tracker makes of its results (applied if adaptive) */
   float i_off_a[3], i_ginv[3]; /* the duty-cycle run: current correction from commissioning */
 } run_t;
 
@@ -453,9 +453,9 @@ static int write_commission_csv(const char *path, const comm_sim_out_t *out)
           0.5 * (out->sim.v_switch_v + out->sim.v_diode_v), out->inv_err_model_v);
   /* the inverter model as the estimator gets it (imest_inverter_t) */
   fprintf(f, "v_switch,%.6g,%.6g,V\nv_diode,%.6g,%.6g,V\nr_switch,%.6g,%.6g,ohm\nr_diode,%.6g,%.6g,ohm\n",
-          (double)r->inverter.v_switch_v, out->sim.v_switch_v, (double)r->inverter.v_diode_v, out->sim.v_diode_v,
-          (double)r->inverter.r_switch_ohm, out->sim.r_switch_ohm, (double)r->inverter.r_diode_ohm,
-          out->sim.r_diode_ohm);
+          (double)r->inverter.v_switch_v, out->sim.v_switch_v, (double)r->inverter.v_diode_v,
+          out->sim.v_diode_v, (double)r->inverter.r_switch_ohm, out->sim.r_switch_ohm,
+          (double)r->inverter.r_diode_ohm, out->sim.r_diode_ohm);
   fprintf(f, "r_slope_diff,%.6g,%.6g,ohm\ni_band,%.6g,,A\nuncertainty,%.4g,,\ninverter_err_total,%.4f,,V\n",
           (double)r->dr_ohm.value, out->sim.r_switch_ohm - out->sim.r_diode_ohm, (double)r->inverter.i_band_a,
           (double)r->inverter.uncertainty, out->inv_err_total_v);
@@ -710,8 +710,7 @@ static void job_loop(run_t *x)
       /* no voltage sensors: the duties and the bus, and the currents corrected with the offsets and
          gains commissioning measured (as its header asks the firmware to) */
       double i_abc[3];
-      for (int p = 0; p < 3; ++p)
-        i_abc[p] = (x->s.i_abc[p] - (double)x->i_off_a[p]) * (double)x->i_ginv[p];
+      for (int p = 0; p < 3; ++p) i_abc[p] = (x->s.i_abc[p] - (double)x->i_off_a[p]) * (double)x->i_ginv[p];
       drive_sample_duty(&d, x->s.duty, x->s.vdc_v, i_abc, x->s.theta);
       if (x->est_true) drive_sample_duty(&d_true, x->s.duty, x->s.vdc_v, i_abc, x->s.theta);
     } else {
