@@ -787,28 +787,9 @@ def fig_duty(path, a, comm):
     plt.close(fig)
 
 
-def duty_section(raw, a):
-    """The duty-cycle run: what its commissioning reported (constants and the inverter's model)
-    and the estimation error with the identified constants against the true ones."""
-    name = DUTY["exp"]
-    comm = read_commission(raw, f"{name}_commission")
-    md = ["## Without voltage sensors: the duty-cycle input (4 kW drive)\n",
-          "A drive that knows its phase voltages only from its duty cycles: imsim preset 4kw behind an "
-          "8 kHz IGBT inverter (firmware timing, 2 µs dead time, switch 1 V + 20 mΩ, diode 0.8 V + 10 mΩ, "
-          "12-bit sensors with 1 % offsets and ±1 % gain errors, the 4096-count encoder). First the "
-          "commissioning routine (`imest_commission.h`) runs closed loop on it (shaft free, no load); then "
-          "the drive runs V/f at its rated point (390 V, 50 Hz: rated speed) at "
-          f"{100 * DUTY['load_rel']:.0f} % of rated torque ({DUTY['load_rel'] * DUTY['rated']:.1f} N m), the "
-          f"copper heating {DUTY['time_x']:g}x faster over 1/{DUTY['time_x']:g} of the duration. The estimator "
-          "gets the identified constants and inverter model (`imest_comm_apply`), the currents corrected "
-          "with the identified offsets and gains, and is fed the duties and the bus voltage "
-          "(`imest_isr_duty`), never the phase voltages; telemetry over CAN as the other runs (fig14). "
-          "This is where the product is expected to work: rated speed, 50-100 % load, a commissioned "
-          "inverter (README, \"Commission, then estimate\": T_R valid on the 4 kW drive; R_S refused "
-          "wherever the inverter model's stated uncertainty could move it by more than 5 %).\n"]
-    if comm is None:
-        md.append("No commissioning record (raw/duty4kw_commission.csv).\n")
-        return md
+def duty_commission_rows(comm):
+    """The duty-cycle run's commissioning: its state and what it reported (constants, inverter)."""
+    md = []
     state = comm["state"]["identified"]
     ok = comm["valid"]["identified"] == "1"
     md.append(f"Commissioning: state **{state}**"
@@ -841,15 +822,45 @@ def duty_section(raw, a):
         md.append(f"| inverter: i_band (zero-crossing fade) | {fnum(comm['i_band']['identified']):.4g} A | | |")
         md.append(f"| inverter: model vs devices, max per-leg error | {fnum(comm['inverter_err_max']['identified']):.3f} V "
                   f"| | (\\|i\\| ≥ 2 i_band, duty 0.05-0.95) |")
+    return md
+
+
+def duty_section(raw, a):
+    """The duty-cycle run: what its commissioning reported (constants and the inverter's model)
+    and the estimation error with the identified constants against the true ones."""
+    name = DUTY["exp"]
+    comm = read_commission(raw, f"{name}_commission")
+    md = ["## Without voltage sensors: the duty-cycle input (4 kW drive)\n",
+          "A drive that knows its phase voltages only from its duty cycles: imsim preset 4kw behind an "
+          "8 kHz IGBT inverter (firmware timing, 2 µs dead time, switch 1 V + 20 mΩ, diode 0.8 V + 10 mΩ, "
+          "12-bit sensors with 1 % offsets and ±1 % gain errors, the 4096-count encoder). First the "
+          "commissioning routine (`imest_commission.h`) runs closed loop on it (shaft free, no load); then "
+          "the drive runs V/f at its rated point (390 V, 50 Hz: rated speed) at "
+          f"{100 * DUTY['load_rel']:.0f} % of rated torque ({DUTY['load_rel'] * DUTY['rated']:.1f} N m), the "
+          f"copper heating {DUTY['time_x']:g}x faster over 1/{DUTY['time_x']:g} of the duration. The estimator "
+          "gets the identified constants and inverter model (`imest_comm_apply`), the currents corrected "
+          "with the identified offsets and gains, and is fed the duties and the bus voltage "
+          "(`imest_isr_duty`), never the phase voltages; telemetry over CAN as the other runs (fig14). "
+          "This is where the product is expected to work: rated speed, 50-100 % load, a commissioned "
+          "inverter (README, \"Commission, then estimate\": T_R valid on the 4 kW drive; R_S refused "
+          "wherever the inverter model's stated uncertainty could move it by more than 5 %).\n"]
+    if comm is None:
+        md.append("No commissioning record (`--no-commission`): the estimator got the true constants and "
+                  "devices.\n")
+    else:
+        md += duty_commission_rows(comm)
     md.append("")
     n = len(a["t_end_s"])
+    slope = ""
+    if comm is not None and "R_S_winding" in comm:
+        slope = (", so R_S carries the device slope min(r_sw, r_d) that terminal measurements include, here "
+                 f"{100 * fnum(comm['R_S']['true']) / fnum(comm['R_S_winding']['true']) - 100:+.2f} %")
     md.append(f"Estimation on the duty cycles, {n} windows of 1 s (error = estimate / truth - 1 over the valid "
-              "windows; the truth is the simulator's winding R_S, so R_S carries the device slope min(r_sw, r_d) "
-              f"that terminal measurements include, here {100 * fnum(comm['R_S']['true']) / fnum(comm['R_S_winding']['true']) - 100:+.2f} %):\n")
+              f"windows; the truth is the simulator's winding R_S{slope}):\n")
     md.append("| constants | parameter | valid windows | fraction valid | mean err % | max err % | bias % |")
     md.append("|---|---|---:|---:|---:|---:|---:|")
     tpath = os.path.join(raw, f"{name}_true_constants.csv")
-    runs = [("identified constants", a)]
+    runs = [("identified constants" if comm is not None else "true constants (no commissioning)", a)]
     if os.path.exists(tpath):
         tr_rows = read_csv(tpath)
         b = {k: np.array([fnum(r[k]) for r in tr_rows]) for k in ("T_R_s", "T_R_true_s", "R_S_ohm", "R_S_true_ohm")}
