@@ -36,6 +36,13 @@
  *                  the same pair on an 11 kW motor (imsim preset 11kw: 8 kHz
  *                  drive, firmware timing) at half load, heating 6x faster
  *                  over a sixth of the duration (beyond the paper's motor).
+ *   duty4kw        a drive without phase-voltage sensors (imsim preset 4kw): the
+ *                  commissioning routine first identifies its constants, sensor
+ *                  offsets and gains and the IGBT inverter's error model (2 us dead
+ *                  time, 1 V / 0.8 V drops + slopes), then V/f at rated speed and
+ *                  75 % of rated torque, heating 6x faster over a sixth of the
+ *                  duration; the estimator is fed the duties and the bus voltage
+ *                  (imest_isr_duty) with the identified model (imest_comm_apply).
  *
  * Output in --out DIR/raw: <exp>.candump.log, <exp>_direct.csv (one row per
  * window: the result as returned by imest_background, the truth, and the
@@ -100,16 +107,23 @@ enum {
   IFOC_ADAPTIVE = 3,
   IFOC11_FIXED = 4,
   IFOC11_ADAPTIVE = 5,
-  NEXP = 6
+  DUTY4 = 6,
+  NEXP = 7
 };
-static const char *const k_exp_name[NEXP] = {"exp1",          "exp2",         "ifoc_fixed",
-                                             "ifoc_adaptive", "ifoc11_fixed", "ifoc11_adaptive"};
+static const char *const k_exp_name[NEXP] = {
+    "exp1", "exp2", "ifoc_fixed", "ifoc_adaptive", "ifoc11_fixed", "ifoc11_adaptive", "duty4kw"};
 
 /* The 11 kW pair: half load, heating sped up so that a sixth of the heat run's motor time
    covers the same heating (its rotor's thermal time constant is 2100 s). */
 #define IFOC11_LOAD_REL  0.5
 #define IFOC11_THERMAL_X 6.0
 #define IS_IFOC11(id)    ((id) == IFOC11_FIXED || (id) == IFOC11_ADAPTIVE)
+/* The duty-cycle run: the 4 kW drive (imsim preset 4kw behind commissioning's IGBT inverter) at
+   rated speed (V/f 390 V, 50 Hz) and 75 % of rated torque, heating 6x faster over a sixth of the
+   duration (like the 11 kW pair). */
+#define DUTY4_LOAD_REL   0.75
+#define DUTY4_THERMAL_X  6.0
+#define SHORT_RUN(id)    (IS_IFOC11(id) || (id) == DUTY4)
 #define IS_ADAPTIVE(id)  ((id) == IFOC_ADAPTIVE || (id) == IFOC11_ADAPTIVE)
 
 /* ------------------------------------------------------------------------- */
@@ -206,6 +220,8 @@ typedef struct {
   const demo_constants_t *k;
   double duration_s;
   double fs_hz;
+  /* the duty-cycle run's own commissioning (of the 4 kW drive) */
+  imest_comm_result_t duty_comm;
   /* exp1 hands its estimate to the identified-parameter simulation */
   double id_tr, id_rs;
   int id_seq, id_status;
@@ -374,11 +390,12 @@ typedef struct {
   tee_port_t *tee;
   FILE *log, *csv, *csv_true;
   truth_t *truth;
-  uint32_t wn;         /* samples per window */
-  size_t nwin;         /* truth slots */
-  size_t win;          /* windows whose truth is complete */
-  int have_id;         /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
-  imest_tracker_t trk; /* every run: what the tracker makes of its results (applied if adaptive) */
+  uint32_t wn;                 /* samples per window */
+  size_t nwin;                 /* truth slots */
+  size_t win;                  /* windows whose truth is complete */
+  int have_id;                 /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
+  imest_tracker_t trk;         /* every run: what the tracker makes of its results (applied if adaptive) */
+  float i_off_a[3], i_ginv[3]; /* the duty-cycle run: current correction from commissioning */
 } run_t;
 
 static void run_release(run_t *x)
@@ -413,6 +430,104 @@ static void open_live(job_t *j, tee_port_t *tee)
 #endif
 }
 
+/* raw/commission.csv, raw/duty4kw_commission.csv: what a commissioning run identified against the
+   simulator's truth. 0, or -1 if the file cannot be written (errno set). */
+static int write_commission_csv(const char *path, const comm_sim_out_t *out)
+{
+  const imest_comm_result_t *r = &out->r;
+  FILE *f = fopen(path, "w");
+  if (f == NULL) return -1;
+  fprintf(f, "quantity,identified,true,unit\n");
+  fprintf(f, "state,%s,,\nreason,%s,,\nvalid,%d,,\n", imest_comm_state_name(r->state),
+          imest_comm_reason_name(r->reason), r->valid);
+  fprintf(f, "time_s,%.3f,,s\ni_peak_a,%.4f,%.4f,A\n", (double)r->time_s, out->i_peak_true_a,
+          (double)out->cc.i_max_a);
+  fprintf(f, "R_S,%.6g,%.6g,ohm\nR_S_winding,%.6g,%.6g,ohm\n", (double)r->rs_ohm.value,
+          out->rs_identifiable_ohm, (double)r->rs_ohm.value, out->rs_ohm);
+  fprintf(f, "L_S,%.6g,%.6g,H\nsigma,%.6g,%.6g,\nsigma_L_S,%.6g,%.6g,H\nT_R,%.6g,%.6g,s\n",
+          (double)r->ls_h.value, out->ls_h, (double)r->sigma.value, out->sigma, (double)r->sigma_ls_h.value,
+          out->sigma_ls_h, (double)r->tr_s.value, out->tr_s);
+  fprintf(f, "pole_pairs,%u,%u,\nencoder_dir,%d,1,\n", r->pole_pairs, out->pole_pairs, r->encoder_dir);
+  fprintf(f, "dead_time,%.6g,%.6g,s\nv_threshold,%.6g,%.6g,V\ninverter_err_max,%.4f,,V\n",
+          (double)r->inverter.dead_time_s, out->sim.dead_time_s, (double)r->v_threshold_v.value,
+          0.5 * (out->sim.v_switch_v + out->sim.v_diode_v), out->inv_err_model_v);
+  /* the inverter model as the estimator gets it (imest_inverter_t) */
+  fprintf(f, "v_switch,%.6g,%.6g,V\nv_diode,%.6g,%.6g,V\nr_switch,%.6g,%.6g,ohm\nr_diode,%.6g,%.6g,ohm\n",
+          (double)r->inverter.v_switch_v, out->sim.v_switch_v, (double)r->inverter.v_diode_v,
+          out->sim.v_diode_v, (double)r->inverter.r_switch_ohm, out->sim.r_switch_ohm,
+          (double)r->inverter.r_diode_ohm, out->sim.r_diode_ohm);
+  fprintf(f, "r_slope_diff,%.6g,%.6g,ohm\ni_band,%.6g,,A\nuncertainty,%.4g,,\ninverter_err_total,%.4f,,V\n",
+          (double)r->dr_ohm.value, out->sim.r_switch_ohm - out->sim.r_diode_ohm, (double)r->inverter.i_band_a,
+          (double)r->inverter.uncertainty, out->inv_err_total_v);
+  for (int p = 0; p < 3; ++p)
+    fprintf(f, "i_gain_rel_%c,%.6g,,\ni_offset_%c,%.6g,,A\n", 'a' + p, (double)r->i_gain_rel[p], 'a' + p,
+            (double)r->i_offset_a[p]);
+  return fclose(f) == 0 ? 0 : -1;
+}
+
+/* The duty-cycle run: commissioning closed loop on the 4 kW drive (its IGBT inverter: 2 us dead
+   time, 1 V + r_sw / 0.8 V + r_d; 12-bit sensors with offsets and gain errors; the shaft free to
+   turn, the nameplate's rated speed), raw/duty4kw_commission.csv; then the same drive in operation
+   (comm_sim_operating: V/f at its rated point, DUTY4_LOAD_REL of rated torque, steady state) with
+   its copper heating on; the estimator gets the identified constants and inverter model
+   (imest_comm_apply), the second one the truth (constants and devices). 0, or -1 (j->err). */
+static int duty_setup(job_t *j, const char *dir, imsim_config_t *c, imest_config_t *cfg,
+                      imest_config_t *cfg_true)
+{
+  comm_sim_opts_t co;
+  static _Thread_local comm_sim_out_t out;
+  if (comm_sim_defaults(&co, "4kw") != 0) return -1;
+  co.seed = j->opt->seed + (unsigned long)j->id;
+  memset(&j->duty_comm, 0, sizeof j->duty_comm);
+  if (j->opt->no_commission) { /* the true constants and devices, no record */
+    if (comm_sim_operating(&co, DUTY4_LOAD_REL, c) != 0) return -1;
+  } else if (comm_sim_run(&co, &out) != 0) {
+    snprintf(j->err, sizeof j->err, "duty4kw: commissioning could not run");
+    return -1;
+  }
+  if (!j->opt->no_commission) {
+    j->duty_comm = out.r;
+    char path[1100];
+    snprintf(path, sizeof path, "%s/duty4kw_commission.csv", dir);
+    if (write_commission_csv(path, &out) != 0) {
+      snprintf(j->err, sizeof j->err, "%s: %s", path, strerror(errno));
+      return -1;
+    }
+  }
+  if (comm_sim_operating(&co, DUTY4_LOAD_REL, c) != 0) return -1;
+  c->thermal = true; /* from cold, 6x faster */
+  c->thermal_speedup = DUTY4_THERMAL_X;
+  c->seed = j->opt->seed + (unsigned long)j->id;
+  for (int t = 0; t < 2; ++t) {
+    imest_config_t *e = t == 0 ? cfg : cfg_true;
+    imest_config_default(e);
+    e->fs_hz = (float)c->fs_hz;
+    e->pwm_hz = (float)c->carrier_hz;
+    e->i_limit_a = (float)(c->i_range_a * (1.0 - ldexp(1.0, 1 - c->adc_bits)));
+  }
+  if (j->opt->no_commission) {
+    /* nothing identified: the truth below */
+  } else if (!out.r.valid || imest_comm_apply(&out.r, cfg) < 0) {
+    /* the routine failed: the truth, and the summary says so */
+    fprintf(stderr, "imest-demo: duty4kw: commissioning failed (%s): the run uses the true constants\n",
+            imest_comm_reason_name(out.r.reason));
+    j->duty_comm.valid = 0;
+  }
+  cfg_true->pole_pairs = (unsigned int)c->pole_pairs;
+  cfg_true->ls_h = (float)c->ls_h;
+  cfg_true->sigma = (float)c->sigma;
+  cfg_true->tr_nominal_s = (float)c->tr_s;
+  cfg_true->rs_nominal_ohm = (float)c->rs_ohm;
+  cfg_true->inverter.dead_time_s = (float)c->dead_time_s;
+  cfg_true->inverter.v_switch_v = (float)c->v_switch_v;
+  cfg_true->inverter.r_switch_ohm = (float)c->r_switch_ohm;
+  cfg_true->inverter.v_diode_v = (float)c->v_diode_v;
+  cfg_true->inverter.r_diode_ohm = (float)c->r_diode_ohm;
+  cfg_true->inverter.uncertainty = 0.05f; /* as imest-commission --online's reference */
+  if (!j->duty_comm.valid) *cfg = *cfg_true;
+  return 0;
+}
+
 /* Simulator, estimator, CAN port (candump log, live interface), output files. */
 static int job_open(job_t *j, run_t *x)
 {
@@ -426,17 +541,31 @@ static int job_open(job_t *j, run_t *x)
   x->est = &est;
   x->tee = &tee;
   snprintf(x->dir, sizeof x->dir, "%.900s/raw", j->opt->out);
+  for (int p = 0; p < 3; ++p) {
+    x->i_off_a[p] = 0.0f;
+    x->i_ginv[p] = 1.0f;
+  }
 
-  sim_config(j->id, j->opt->seed, &x->c);
+  imest_config_t cfg, cfg_true;
+  /* the commissioned constants are the paper motor's: the 11 kW pair gets its true ones; the
+     duty-cycle run commissions its own drive */
+  const demo_constants_t *k = SHORT_RUN(j->id) ? NULL : j->k;
+  if (j->id == DUTY4) {
+    if (duty_setup(j, x->dir, &x->c, &cfg, &cfg_true) != 0) return -1;
+    if (j->duty_comm.valid)
+      for (int p = 0; p < 3; ++p) {
+        x->i_off_a[p] = j->duty_comm.i_offset_a[p];
+        x->i_ginv[p] = j->duty_comm.i_gain_rel[p] > 0.0f ? 1.0f / j->duty_comm.i_gain_rel[p] : 1.0f;
+      }
+  } else {
+    sim_config(j->id, j->opt->seed, &x->c);
+    est_config(&x->c, k, &cfg);
+    est_config(&x->c, NULL, &cfg_true);
+  }
   if (imsim_init(&sim, &x->c, &x->s) != 0) {
     snprintf(j->err, sizeof j->err, "%s: simulator: %s", x->name, imsim_error(&sim));
     return -1;
   }
-  imest_config_t cfg, cfg_true;
-  /* the commissioned constants are the paper motor's: the 11 kW pair gets its true ones */
-  const demo_constants_t *k = IS_IFOC11(j->id) ? NULL : j->k;
-  est_config(&x->c, k, &cfg);
-  est_config(&x->c, NULL, &cfg_true);
   const char *field = NULL;
   if (imest_config_check(&cfg, &field) != IMEST_OK) {
     snprintf(j->err, sizeof j->err, "%s: estimator config: bad %s", x->name, field);
@@ -446,13 +575,13 @@ static int job_open(job_t *j, run_t *x)
     snprintf(j->err, sizeof j->err, "%s: imest_init failed", x->name);
     return -1;
   }
-  if (k != NULL && k->commissioned) {
+  if ((k != NULL && k->commissioned) || (j->id == DUTY4 && j->duty_comm.valid)) {
     x->est_true = &est_true;
     char tname[256];
     snprintf(tname, sizeof tname, "%s_true_constants.csv", x->name);
     if ((x->csv_true = open_out(j, x->dir, tname)) == NULL) return -1;
     fprintf(x->csv_true, "experiment,seq,t_end_s,T_R_s,R_S_ohm,valid,status,T_R_true_s,R_S_true_ohm,"
-                         "tr_valid,rs_valid\n");
+                         "tr_valid,rs_valid,tr_reason,rs_reason\n");
   }
 
   char fname[256];
@@ -487,7 +616,7 @@ static int job_open(job_t *j, run_t *x)
                   "speed_rad_s,torque_nm,load_nm,torque_ref_nm,torque_err_rms_nm,psi_r_wb,psi_ref_wb,"
                   "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s,"
                   "tr_valid,tr_reason,rs_valid,rs_reason,tr_bound_rel,trk_T_R_s,trk_state,trk_age_s,"
-                  "trk_bound_rel\n");
+                  "trk_bound_rel,rs_bound_rel\n");
 
   j->fs_hz = x->c.fs_hz;
   j->total = (unsigned long long)llround(j->duration_s * x->c.fs_hz);
@@ -521,13 +650,14 @@ static void on_window(void *ctx, const imest_result_t *r)
   (void)imest_tracker_update(&x->trk, r); /* t_end_s only grows: it cannot refuse */
   fprintf(x->csv,
           "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
-          "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s,%.4g,%.9g,%s,%.6g,%.4g\n",
+          "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s,%.4g,%.9g,%s,%.6g,%.4g,%.4g\n",
           x->name, r->seq, r->t_end_s, r->tr_s, r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr,
           t->rs, r->e_i, r->pe_k1_rel, r->pe_k2_rel, r->slip_ratio, r->i_rms_a, r->n_roots, r->n_admissible,
           r->used_samples, r->flags, t->speed, t->te, t->load, t->te_ref, t->te_err_rms, t->psi, t->psi_ref,
           t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr, r->tr_valid, imest_reason_name(r->tr_reason),
           r->rs_valid, imest_reason_name(r->rs_reason), r->tr_bound_rel, (double)x->trk.tr_s,
-          imest_tracker_state_name(x->trk.state), (double)x->trk.age_s, (double)x->trk.tr_bound_rel);
+          imest_tracker_state_name(x->trk.state), (double)x->trk.age_s, (double)x->trk.tr_bound_rel,
+          r->rs_bound_rel);
   /* the controller takes the tracker's T_R (or, with --adaptive-tr raw, every window whose T_R is
      trusted, as it is) */
   if (IS_ADAPTIVE(j->id)) {
@@ -555,8 +685,9 @@ static void on_window_true(void *ctx, const imest_result_t *r)
   static const truth_t nan_t = {D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN,
                                 D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN};
   const truth_t *t = (r->seq < x->nwin && r->seq < x->win) ? &x->truth[r->seq] : &nan_t;
-  fprintf(x->csv_true, "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%d,%d\n", x->name, r->seq, r->t_end_s, r->tr_s,
-          r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr, t->rs, r->tr_valid, r->rs_valid);
+  fprintf(x->csv_true, "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%d,%d,%s,%s\n", x->name, r->seq, r->t_end_s,
+          r->tr_s, r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr, t->rs, r->tr_valid, r->rs_valid,
+          imest_reason_name(r->tr_reason), imest_reason_name(r->rs_reason));
 }
 
 /* The samples: each one's truth into its window, then the drive loop (ISR
@@ -582,8 +713,17 @@ static void job_loop(run_t *x)
       memset(&acc, 0, sizeof acc);
     }
     imest_candump_port_set_time(&x->tee->log, x->s.t); /* frames carry their window's end */
-    drive_sample(&d, x->s.u_abc, x->s.i_abc, x->s.theta);
-    if (x->est_true) drive_sample(&d_true, x->s.u_abc, x->s.i_abc, x->s.theta);
+    if (j->id == DUTY4) {
+      /* no voltage sensors: the duties and the bus, and the currents corrected with the offsets and
+         gains commissioning measured (as its header asks the firmware to) */
+      double i_abc[3];
+      for (int p = 0; p < 3; ++p) i_abc[p] = (x->s.i_abc[p] - (double)x->i_off_a[p]) * (double)x->i_ginv[p];
+      drive_sample_duty(&d, x->s.duty, x->s.vdc_v, i_abc, x->s.theta);
+      if (x->est_true) drive_sample_duty(&d_true, x->s.duty, x->s.vdc_v, i_abc, x->s.theta);
+    } else {
+      drive_sample(&d, x->s.u_abc, x->s.i_abc, x->s.theta);
+      if (x->est_true) drive_sample(&d_true, x->s.u_abc, x->s.i_abc, x->s.theta);
+    }
     if ((k & 1023u) == 0) atomic_store(&j->done, k);
   }
   atomic_store(&j->done, total);
@@ -671,26 +811,10 @@ static int commission(const options_t *o, const char *raw, demo_constants_t *k)
   k->commissioned = r->valid;
   char path[1100];
   snprintf(path, sizeof path, "%s/commission.csv", raw);
-  FILE *f = fopen(path, "w");
-  if (f == NULL) {
+  if (write_commission_csv(path, &out) != 0) {
     fprintf(stderr, "imest-demo: %s: %s\n", path, strerror(errno));
     return -1;
   }
-  fprintf(f, "quantity,identified,true,unit\n");
-  fprintf(f, "state,%s,,\nreason,%s,,\nvalid,%d,,\n", imest_comm_state_name(r->state),
-          imest_comm_reason_name(r->reason), r->valid);
-  fprintf(f, "time_s,%.3f,,s\ni_peak_a,%.4f,%.4f,A\n", (double)r->time_s, out.i_peak_true_a,
-          (double)out.cc.i_max_a);
-  fprintf(f, "R_S,%.6g,%.6g,ohm\nR_S_winding,%.6g,%.6g,ohm\n", (double)r->rs_ohm.value,
-          out.rs_identifiable_ohm, (double)r->rs_ohm.value, out.rs_ohm);
-  fprintf(f, "L_S,%.6g,%.6g,H\nsigma,%.6g,%.6g,\nsigma_L_S,%.6g,%.6g,H\nT_R,%.6g,%.6g,s\n",
-          (double)r->ls_h.value, out.ls_h, (double)r->sigma.value, out.sigma, (double)r->sigma_ls_h.value,
-          out.sigma_ls_h, (double)r->tr_s.value, out.tr_s);
-  fprintf(f, "pole_pairs,%u,%u,\nencoder_dir,%d,1,\n", r->pole_pairs, out.pole_pairs, r->encoder_dir);
-  fprintf(f, "dead_time,%.6g,%.6g,s\nv_threshold,%.6g,%.6g,V\ninverter_err_max,%.4f,,V\n",
-          (double)r->inverter.dead_time_s, out.sim.dead_time_s, (double)r->v_threshold_v.value,
-          0.5 * (out.sim.v_switch_v + out.sim.v_diode_v), out.inv_err_model_v);
-  if (fclose(f) != 0) return -1;
   printf("commission state=%s reason=%s time_s=%.2f i_peak_a=%.3f R_S_ohm=%.5g L_S_h=%.5g sigma=%.5g "
          "T_R_s=%.5g pole_pairs=%u\n",
          imest_comm_state_name(r->state), imest_comm_reason_name(r->reason), (double)r->time_s,
@@ -719,14 +843,16 @@ static void usage(FILE *f)
              "Experiments run in parallel threads: exp1 (run-up), exp2 (30 Hz V/f heat run),\n"
              "ifoc_fixed and ifoc_adaptive (the heat run under IFOC, controller T_R fixed at\n"
              "the cold value / taken from the estimator), ifoc11_fixed and ifoc11_adaptive\n"
-             "(the same on an 11 kW drive at half load, heating 6x faster for duration / 6).\n"
+             "(the same on an 11 kW drive at half load, heating 6x faster for duration / 6),\n"
+             "duty4kw (a 4 kW drive without voltage sensors: its own commissioning, then V/f at\n"
+             "rated speed and 75 %% load with the duty-cycle input, imest_isr_duty; duration / 6).\n"
              "Options take a value as '--opt VALUE' or '--opt=VALUE'.\n"
              "\n"
              "  --out DIR           output folder (default results)\n"
              "  --duration S        motor time of exp2 and the IFOC runs (default 3600)\n"
              "  --exp1-duration S   motor time of exp1 (default 2)\n"
              "  --only LIST         comma-separated subset of exp1,exp2,ifoc_fixed,ifoc_adaptive,\n"
-             "                      ifoc11_fixed,ifoc11_adaptive\n"
+             "                      ifoc11_fixed,ifoc11_adaptive,duty4kw\n"
              "  --can-iface NAME    also send exp2's frames on this SocketCAN interface\n"
              "  --seed N            sensor noise seed (default 1)\n"
              "  --no-commission     the estimators get the true constants (no commissioning)\n"
@@ -772,7 +898,7 @@ static int parse_only(const char *v, unsigned int *only)
     if (!found) {
       fprintf(stderr,
               "imest-demo: --only: unknown experiment '%s' (exp1, exp2, ifoc_fixed, "
-              "ifoc_adaptive, ifoc11_fixed, ifoc11_adaptive)\n",
+              "ifoc_adaptive, ifoc11_fixed, ifoc11_adaptive, duty4kw)\n",
               tok);
       return -1;
     }
@@ -852,9 +978,9 @@ static int start_jobs(const options_t *o, const demo_constants_t *k, job_t jobs[
     jobs[e].opt = o;
     jobs[e].k = k;
     jobs[e].duration_s = e == EXP1      ? o->exp1_duration_s
-                         : IS_IFOC11(e) ? fmax(o->duration_s / IFOC11_THERMAL_X, 10.0)
+                         : SHORT_RUN(e) ? fmax(o->duration_s / IFOC11_THERMAL_X, 10.0)
                                         : o->duration_s;
-    jobs[e].fs_hz = IS_IFOC11(e) ? 8000.0 : 4000.0; /* progress only; job_open sets total */
+    jobs[e].fs_hz = SHORT_RUN(e) ? 8000.0 : 4000.0; /* progress only; job_open sets total */
     jobs[e].total = (unsigned long long)llround(jobs[e].duration_s * jobs[e].fs_hz);
     atomic_store(&jobs[e].done, 0);
     started[e] = 0;
@@ -921,6 +1047,10 @@ static int report(const job_t jobs[NEXP], const int started[NEXP], double t0)
            "wall_s=%.2f realtime_x=%.0f",
            k_exp_name[e], j->duration_s, j->windows, j->valid, j->can_lines, j->can_failed, j->wall_s,
            j->duration_s / j->wall_s);
+    if (e == DUTY4)
+      printf(" commissioned=%d dead_time_s=%.4g v_threshold_v=%.4g uncertainty=%.3g", j->duty_comm.valid,
+             (double)j->duty_comm.inverter.dead_time_s, (double)j->duty_comm.v_threshold_v.value,
+             (double)j->duty_comm.inverter.uncertainty);
     if (e == EXP1)
       printf(" identified_T_R_s=%.6g identified_R_S_ohm=%.6g identified_window=%d", j->id_tr, j->id_rs,
              j->id_seq);

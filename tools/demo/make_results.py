@@ -11,7 +11,7 @@ Reads OUT_DIR/raw/ (written by imest-demo and imest-monitor, see tools/demo/READ
   exp1_wave.csv           exp1 waveforms, measured and simulated with the identified parameters
   exp1_identified.csv     which exp1 window gave the identified parameters
 Writes OUT_DIR/{windows.csv, exp1_windows.csv, ifoc_fixed_windows.csv,
-ifoc_adaptive_windows.csv, ifoc11_*_windows.csv, exp2_avg30.csv, exp2_avg120.csv, fig*.png, summary.md}.
+ifoc_adaptive_windows.csv, ifoc11_*_windows.csv, duty4kw_windows.csv, exp2_avg30.csv, exp2_avg120.csv, fig*.png, summary.md}.
 Plots with matplotlib's Agg backend (Debian python3-matplotlib).
 """
 import csv
@@ -27,10 +27,14 @@ import matplotlib.patches  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-EXPS = ["exp1", "exp2", "ifoc_fixed", "ifoc_adaptive", "ifoc11_fixed", "ifoc11_adaptive"]
+EXPS = ["exp1", "exp2", "ifoc_fixed", "ifoc_adaptive", "ifoc11_fixed", "ifoc11_adaptive", "duty4kw"]
 WIN_FILE = {"exp2": "windows.csv", "exp1": "exp1_windows.csv",
             "ifoc_fixed": "ifoc_fixed_windows.csv", "ifoc_adaptive": "ifoc_adaptive_windows.csv",
-            "ifoc11_fixed": "ifoc11_fixed_windows.csv", "ifoc11_adaptive": "ifoc11_adaptive_windows.csv"}
+            "ifoc11_fixed": "ifoc11_fixed_windows.csv", "ifoc11_adaptive": "ifoc11_adaptive_windows.csv",
+            "duty4kw": "duty4kw_windows.csv"}
+# The duty-cycle run (tools/demo/demo.c, duty4kw): imsim preset 4kw, V/f at its rated point
+# (390 V, 50 Hz), 75 % of rated torque, heating 6x faster over a sixth of the duration.
+DUTY = dict(exp="duty4kw", fig="fig14_duty_4kw.png", rated=26.5, load_rel=0.75, time_x=6.0)
 RATED_TORQUE = 2.064
 GREY = "0.55"
 # The demo's set-up (tools/demo/demo.c, imsim's defaults and the paper's motor): the
@@ -158,7 +162,7 @@ def build_windows(raw, exp):
             row[key] = d[key]
         # the T_R tracker's output after this window (imest_tracker.h; the adaptive runs' controller
         # uses it from the next window on), when the demo wrote it
-        for key in ("tr_bound_rel", "trk_T_R_s", "trk_state", "trk_age_s", "trk_bound_rel"):
+        for key in ("tr_bound_rel", "trk_T_R_s", "trk_state", "trk_age_s", "trk_bound_rel", "rs_bound_rel"):
             if key in d:
                 row[key] = d[key]
         rows.append(row)
@@ -246,6 +250,24 @@ def block_avg(a, period):
             row[tkey] = float(np.mean(a[tkey][v if n_v else sel]))
         out.append(row)
     return out
+
+
+def why_none(a, okkey, rkey, top=2):
+    """What a summary cell says when a run has no valid window for a parameter: its most common
+    reason(s), e.g. 'no valid window: 599/600 rs_uncertain, 1/600 warmup'."""
+    n = len(a[okkey])
+    rc = reason_counts(a[rkey], a[okkey])
+    if not rc:
+        return "no window"
+    return "no valid window: " + ", ".join(f"{c}/{n} {r}" for r, c in rc[:top])
+
+
+def stat_cells(s, why, fmt=("{:.2f}", "{:.2f}", "{:+.2f}"), idx=(1, 3, 4)):
+    """Cells of err_stats s (n first, then the statistics at idx); with no valid value the first
+    statistic's cell gives the reason (why) and the others a dash, never 'nan'."""
+    if s[0] == 0:
+        return [str(0), why] + ["–"] * (len(idx) - 1)
+    return [str(s[0])] + [f.format(s[i]) for f, i in zip(fmt, idx)]
 
 
 def err_stats(est, true):
@@ -714,6 +736,159 @@ def fig_closed_loop(path, fx, ad, pair=IFOC_PAIRS[0]):
     plt.close(fig)
 
 
+def read_commission(raw, name):
+    """raw/<name>.csv of imest-demo's commissioning runs: {quantity: row}, or None."""
+    path = os.path.join(raw, f"{name}.csv")
+    if not os.path.exists(path):
+        return None
+    return {r["quantity"]: r for r in read_csv(path)}
+
+
+def fig_duty(path, a, comm):
+    """The duty-cycle run: T_R and R_S against the truth over time, each with its error panel
+    (valid windows only, like fig05 / fig08)."""
+    t = a["t_end_s"] / 60.0
+    fig, axs = plt.subplots(4, 1, figsize=(10, 12.0), sharex=True,
+                            gridspec_kw={"height_ratios": [3, 2, 3, 2]})
+    inv = ""
+    if comm is not None and comm.get("valid", {}).get("identified") == "1":
+        inv = (f"commissioned inverter: dead time {1e6 * fnum(comm['dead_time']['identified']):.3f} µs, "
+               f"drops {fnum(comm['v_switch']['identified']):.3f} V / {fnum(comm['v_diode']['identified']):.3f} V "
+               f"+ {1e3 * fnum(comm['r_switch']['identified']):.1f} / {1e3 * fnum(comm['r_diode']['identified']):.1f} mΩ, "
+               f"stated uncertainty {100 * fnum(comm['uncertainty']['identified']):.0f} %")
+    title = (f"No voltage sensors: the estimator on the duty cycles and V_dc (imest_isr_duty), 4 kW drive\n"
+             f"V/f 390 V 50 Hz (rated speed), {100 * DUTY['load_rel']:.0f} % of rated torque, heating "
+             f"{DUTY['time_x']:g}x faster (time axis: motor time)\n{inv}")
+    for row, (key, tkey, okkey, rkey, label) in enumerate((
+            ("T_R_s", "T_R_true_s", "tr_valid", "tr_reason", "$T_R$ [s]"),
+            ("R_S_ohm", "R_S_true_ohm", "rs_valid", "rs_reason", "$R_S$ [Ω]"))):
+        ax, ae = axs[2 * row], axs[2 * row + 1]
+        v = a[okkey]
+        ax.plot(t[v], a[key][v], ".", ms=2.5, color="tab:blue",
+                label=f"estimate, valid 1-s window ({int(v.sum())} of {len(v)})")
+        ax.plot(t, a[tkey], "-", color="k", lw=1.4, label="truth (window mean of the simulator)")
+        lo, hi = robust_ylim(ax, a[key][v], a[tkey])
+        mark_clipped(ax, t[v], a[key][v], lo, hi)
+        mark_invalid(ax, t, v)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        s_ = err_stats(a[key][v], a[tkey][v])
+        note = stats_note(*s_) if s_[0] else why_none(a, okkey, rkey)
+        bkey = okkey.replace("valid", "bound_rel")
+        if not s_[0] and bkey in a and np.isfinite(a[bkey]).any():
+            note += f"\n(its error bound {100 * np.nanmedian(a[bkey]):.1f} % > tolerance: README, When is a window valid)"
+        ax.legend(loc="best", fontsize=8, framealpha=0.9, title=note, title_fontsize=8)
+        err_panel(ae, t, 100.0 * (a[key] / a[tkey] - 1.0), v, a[rkey])
+        ae.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    axs[0].set_title(title, fontsize=9)
+    axs[-1].set_xlabel("time [min]")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def duty_commission_rows(comm):
+    """The duty-cycle run's commissioning: its state and what it reported (constants, inverter)."""
+    md = []
+    state = comm["state"]["identified"]
+    ok = comm["valid"]["identified"] == "1"
+    md.append(f"Commissioning: state **{state}**"
+              + (f" ({comm['reason']['identified']})" if comm["reason"]["identified"] != "none" else "")
+              + f", {fnum(comm['time_s']['identified']):.1f} s."
+              + ("" if ok else " **It did not complete: the run used the true constants and devices.**") + "\n")
+    md.append("| what commissioning reported | identified | true | error |")
+    md.append("|---|---:|---:|---:|")
+    for key, label, scale, unit in (("R_S", "R_S (winding + min(r_sw, r_d))", 1.0, "Ω"),
+                                    ("L_S", "L_S", 1e3, "mH"), ("sigma", "σ", 1.0, ""),
+                                    ("T_R", "T_R (nominal)", 1e3, "ms"),
+                                    ("dead_time", "inverter: dead time", 1e6, "µs"),
+                                    ("v_threshold", "inverter: device drops (V_sw0 + V_d0) / 2", 1.0, "V"),
+                                    ("r_slope_diff", "inverter: slopes r_sw - r_d", 1e3, "mΩ")):
+        if key not in comm:
+            continue
+        i, t = fnum(comm[key]["identified"]), fnum(comm[key]["true"])
+        md.append(f"| {label} | {i * scale:.5g} {unit} | {t * scale:.5g} {unit} | "
+                  + (f"{100 * (i / t - 1):+.2f} % |" if t else "|"))
+    if "v_switch" in comm:
+        g = {k: fnum(comm[k]["identified"]) for k in ("v_switch", "v_diode", "r_switch", "r_diode")}
+        t = {k: fnum(comm[k]["true"]) for k in ("v_switch", "v_diode", "r_switch", "r_diode")}
+        md.append(f"| inverter: the model applied, V_sw0 / V_d0, r_sw / r_d | {g['v_switch']:.3f} / {g['v_diode']:.3f} V, "
+                  f"{1e3 * g['r_switch']:.1f} / {1e3 * g['r_diode']:.1f} mΩ | {t['v_switch']:.3g} / {t['v_diode']:.3g} V, "
+                  f"{1e3 * t['r_switch']:.3g} / {1e3 * t['r_diode']:.3g} mΩ | drops split evenly (not separable "
+                  "at standstill); the common slope min(r_sw, r_d) is in R_S |")
+    if "uncertainty" in comm:
+        md.append(f"| inverter: the model's stated uncertainty | {100 * fnum(comm['uncertainty']['identified']):.1f} % "
+                  f"| | |")
+        md.append(f"| inverter: i_band (zero-crossing fade) | {fnum(comm['i_band']['identified']):.4g} A | | |")
+        md.append(f"| inverter: model vs devices, max per-leg error | {fnum(comm['inverter_err_max']['identified']):.3f} V "
+                  f"| | (\\|i\\| ≥ 2 i_band, duty 0.05-0.95) |")
+    return md
+
+
+def duty_section(raw, a):
+    """The duty-cycle run: what its commissioning reported (constants and the inverter's model)
+    and the estimation error with the identified constants against the true ones."""
+    name = DUTY["exp"]
+    comm = read_commission(raw, f"{name}_commission")
+    md = ["## Without voltage sensors: the duty-cycle input (4 kW drive)\n",
+          "A drive that knows its phase voltages only from its duty cycles: imsim preset 4kw behind an "
+          "8 kHz IGBT inverter (firmware timing, 2 µs dead time, switch 1 V + 20 mΩ, diode 0.8 V + 10 mΩ, "
+          "12-bit sensors with 1 % offsets and ±1 % gain errors, the 4096-count encoder). First the "
+          "commissioning routine (`imest_commission.h`) runs closed loop on it (shaft free, no load); then "
+          "the drive runs V/f at its rated point (390 V, 50 Hz: rated speed) at "
+          f"{100 * DUTY['load_rel']:.0f} % of rated torque ({DUTY['load_rel'] * DUTY['rated']:.1f} N m), the "
+          f"copper heating {DUTY['time_x']:g}x faster over 1/{DUTY['time_x']:g} of the duration. The estimator "
+          "gets the identified constants and inverter model (`imest_comm_apply`), the currents corrected "
+          "with the identified offsets and gains, and is fed the duties and the bus voltage "
+          "(`imest_isr_duty`), never the phase voltages; telemetry over CAN as the other runs (fig14). "
+          "This is where the product is expected to work: rated speed, 50-100 % load, a commissioned "
+          "inverter (README, \"Commission, then estimate\": T_R valid on the 4 kW drive; R_S refused "
+          "wherever the inverter model's stated uncertainty could move it by more than 5 %).\n"]
+    if comm is None:
+        md.append("No commissioning record (`--no-commission`): the estimator got the true constants and "
+                  "devices.\n")
+    else:
+        md += duty_commission_rows(comm)
+    md.append("")
+    n = len(a["t_end_s"])
+    slope = ""
+    if comm is not None and "R_S_winding" in comm:
+        slope = (", so R_S carries the device slope min(r_sw, r_d) that terminal measurements include, here "
+                 f"{100 * fnum(comm['R_S']['true']) / fnum(comm['R_S_winding']['true']) - 100:+.2f} %")
+    md.append(f"Estimation on the duty cycles, {n} windows of 1 s (error = estimate / truth - 1 over the valid "
+              f"windows; the truth is the simulator's winding R_S{slope}):\n")
+    md.append("| constants | parameter | valid windows | fraction valid | mean err % | max err % | bias % |")
+    md.append("|---|---|---:|---:|---:|---:|---:|")
+    tpath = os.path.join(raw, f"{name}_true_constants.csv")
+    runs = [("identified constants" if comm is not None else "true constants (no commissioning)", a)]
+    if os.path.exists(tpath):
+        tr_rows = read_csv(tpath)
+        b = {k: np.array([fnum(r[k]) for r in tr_rows]) for k in ("T_R_s", "T_R_true_s", "R_S_ohm", "R_S_true_ohm")}
+        for k in ("tr_valid", "rs_valid"):
+            b[k] = np.array([r[k] == "1" for r in tr_rows])
+        for k in ("tr_reason", "rs_reason"):
+            b[k] = np.array([r.get(k, r["status"]) for r in tr_rows])
+        runs.append(("true constants and devices", b))
+    for label, x in runs:
+        for par, key, tkey, okkey, rkey in (("T_R", "T_R_s", "T_R_true_s", "tr_valid", "tr_reason"),
+                                            ("R_S", "R_S_ohm", "R_S_true_ohm", "rs_valid", "rs_reason")):
+            v = x[okkey]
+            s_ = err_stats(x[key][v], x[tkey][v])
+            cells = stat_cells(s_, why_none(x, okkey, rkey))
+            md.append(f"| {label} | {par} | {cells[0]} / {len(v)} | {100 * v.sum() / max(len(v), 1):.1f} % "
+                      f"| {cells[1]} | {cells[2]} | {cells[3]} |")
+    if "rs_bound_rel" in a:
+        b = a["rs_bound_rel"][np.isfinite(a["rs_bound_rel"])]
+        if len(b):
+            md.append("")
+            md.append(f"R_S's error bound (`rs_bound_rel`: the inverter model's stated uncertainty, the timing, the "
+                      f"PWM staircase) is {100 * np.median(b):.1f} % (median over the windows; {100 * np.min(b):.1f}-"
+                      f"{100 * np.max(b):.1f} %) against `rs_tolerance` 5 %: where it is above, the window's R_S is "
+                      "`rs_uncertain` and the drive must not use it (README, \"When is a window valid\").")
+    md.append("")
+    return md
+
+
 def encoder_section(res):
     """R_S inside / outside the spans where the encoder pattern aliases into the band."""
     rows = []
@@ -892,18 +1067,30 @@ def commission_section(raw, res):
     md.append("|---|---|---:|---:|---:|---:|---:|---:|")
     for exp in EXPS:
         tpath = os.path.join(raw, f"{exp}_true_constants.csv")
-        if exp not in res or not os.path.exists(tpath):
-            continue
-        a = res[exp]["a"]
-        tr_rows = read_csv(tpath)
-        b = {k: np.array([fnum(r[k]) for r in tr_rows]) for k in ("T_R_s", "T_R_true_s", "R_S_ohm", "R_S_true_ohm")}
-        for k in ("tr_valid", "rs_valid"):
-            b[k] = np.array([r[k] == "1" for r in tr_rows])
-        for name, x in (("identified", a), ("true", b)):
-            s1 = err_stats(x["T_R_s"][x["tr_valid"]], x["T_R_true_s"][x["tr_valid"]])
-            s2 = err_stats(x["R_S_ohm"][x["rs_valid"]], x["R_S_true_ohm"][x["rs_valid"]])
-            md.append(f"| {exp} | {name} | {s1[0]} | {s1[1]:.2f} | {s1[4]:+.2f} | {s2[0]} | {s2[1]:.2f} | {s2[4]:+.2f} |")
+        if exp not in res or not os.path.exists(tpath) or exp == DUTY["exp"]:
+            continue  # the duty-cycle run has its own commissioning (duty_section)
+        md += true_constants_rows(exp, res[exp]["a"], tpath)
     md.append("")
+    return md
+
+
+def true_constants_rows(exp, a, tpath):
+    """Rows 'identified' (the run, a) and 'true' (the second estimator on the same samples,
+    raw/<exp>_true_constants.csv): n valid, mean error, bias of T_R and R_S."""
+    tr_rows = read_csv(tpath)
+    b = {k: np.array([fnum(r[k]) for r in tr_rows]) for k in ("T_R_s", "T_R_true_s", "R_S_ohm", "R_S_true_ohm")}
+    b["status"] = np.array([r["status"] for r in tr_rows])
+    for k in ("tr_valid", "rs_valid"):
+        b[k] = np.array([r[k] == "1" for r in tr_rows])
+    for k in ("tr_reason", "rs_reason"):  # an older demo wrote the window's status only
+        b[k] = np.array([r.get(k, r["status"]) for r in tr_rows])
+    md = []
+    for name, x in (("identified", a), ("true", b)):
+        s1 = err_stats(x["T_R_s"][x["tr_valid"]], x["T_R_true_s"][x["tr_valid"]])
+        s2 = err_stats(x["R_S_ohm"][x["rs_valid"]], x["R_S_true_ohm"][x["rs_valid"]])
+        cells = (stat_cells(s1, why_none(x, "tr_valid", "tr_reason"), ("{:.2f}", "{:+.2f}"), (1, 4))
+                 + stat_cells(s2, why_none(x, "rs_valid", "rs_reason"), ("{:.2f}", "{:+.2f}"), (1, 4)))
+        md.append(f"| {exp} | {name} | " + " | ".join(cells) + " |")
     return md
 
 
@@ -981,6 +1168,9 @@ def main(argv):
         if pair["fixed"] in res and pair["adaptive"] in res:
             figs.append(os.path.join(out, pair["fig"]))
             fig_closed_loop(figs[-1], res[pair["fixed"]]["a"], res[pair["adaptive"]]["a"], pair)
+    if DUTY["exp"] in res:
+        figs.append(os.path.join(out, DUTY["fig"]))
+        fig_duty(figs[-1], res[DUTY["exp"]]["a"], read_commission(raw, f"{DUTY['exp']}_commission"))
     if res:
         figs.append(os.path.join(out, "fig13_verdicts.png"))
         fig_verdicts(figs[-1], res)
@@ -1015,10 +1205,10 @@ def main(argv):
                 levels.append((f"{per} s avg",
                                np.array([x["T_R_s"] for x in b]), np.array([x["T_R_true_s"] for x in b]),
                                np.array([x["R_S_ohm"] for x in b]), np.array([x["R_S_true_ohm"] for x in b])))
+        why_tr, why_rs = why_none(a, "tr_valid", "tr_reason"), why_none(a, "rs_valid", "rs_reason")
         for name, tr, trt, rs, rst in levels:
-            s1, s2 = err_stats(tr, trt), err_stats(rs, rst)
-            md.append(f"| {exp} | {name} | {s1[0]} | {s1[1]:.2f} | {s1[3]:.2f} | {s1[4]:+.2f} "
-                      f"| {s2[0]} | {s2[1]:.2f} | {s2[3]:.2f} | {s2[4]:+.2f} |")
+            cells = stat_cells(err_stats(tr, trt), why_tr) + stat_cells(err_stats(rs, rst), why_rs)
+            md.append(f"| {exp} | {name} | " + " | ".join(cells) + " |")
     md.append("")
     md.append("## Windows: valid / not valid by reason, telemetry\n")
     md.append("| experiment | windows | valid | T_R not valid (reason count) | R_S not valid (reason count) "
@@ -1081,10 +1271,13 @@ def main(argv):
     p11 = IFOC_PAIRS[1]
     if p11["fixed"] in res and p11["adaptive"] in res:
         md += ifoc11_section(res[p11["fixed"]]["a"], res[p11["adaptive"]]["a"], p11)
+    if DUTY["exp"] in res:
+        md += duty_section(raw, res[DUTY["exp"]]["a"])
     md.append("## Files\n")
     md.append("- `windows.csv`: exp. 2, one row per 1-s window (values as decoded from the CAN log; "
               "`via_can` = 1), truth, drive state; `exp1_windows.csv`, `ifoc_fixed_windows.csv`, "
-              "`ifoc_adaptive_windows.csv`, `ifoc11_fixed_windows.csv`, `ifoc11_adaptive_windows.csv`: "
+              "`ifoc_adaptive_windows.csv`, `ifoc11_fixed_windows.csv`, `ifoc11_adaptive_windows.csv`, "
+              "`duty4kw_windows.csv`: "
               "the same for the other runs")
     md.append("- `exp2_avg30.csv`, `exp2_avg120.csv`: 30-s / 120-s averages of the valid 1-s estimates")
     md.append("- figures: " + ", ".join(f"`{os.path.basename(f)}`" for f in figs))

@@ -20,6 +20,7 @@ for f in windows.csv exp1_windows.csv ifoc_fixed_windows.csv ifoc_adaptive_windo
          fig05_tr_1s.png fig06_tr_30s.png fig07_tr_120s.png \
          fig08_rs_1s.png fig09_rs_30s.png fig10_rs_120s.png fig11_ifoc_closed_loop.png \
          fig12_ifoc_11kw.png fig13_verdicts.png ifoc11_fixed_windows.csv ifoc11_adaptive_windows.csv \
+         fig14_duty_4kw.png duty4kw_windows.csv raw/duty4kw_commission.csv raw/duty4kw_true_constants.csv \
          raw/exp2.candump.log raw/exp2_monitor.csv; do
   [ -s "$out/$f" ] || fail "missing or empty: $f"
 done
@@ -39,14 +40,44 @@ for r in rows:
     assert abs(float(r["T_R_true_s"]) - 0.12) < 0.01, r
 md = open(f"{out}/summary.md").read()
 # error table: one row per experiment and averaging level, numbers in every cell
-rows = re.findall(r"^\| (exp1|exp2|ifoc_fixed|ifoc_adaptive) \| (1 s|30 s avg|120 s avg) \|(.*)\|$", md, re.M)
-assert ("exp2", "1 s") in [(a, b) for a, b, _ in rows], "summary: no exp2 1-s row"
+# (a statistic without a valid window names the most common reasons instead, the rest of its cells "–")
+runs = "exp1|exp2|ifoc_fixed|ifoc_adaptive|ifoc11_fixed|ifoc11_adaptive|duty4kw"
+rows = re.findall(r"^\| (" + runs + r") \| (1 s|30 s avg|120 s avg) \|(.*)\|$", md, re.M)
+for need_run in ("exp2", "ifoc11_fixed", "duty4kw"):
+    assert (need_run, "1 s") in [(a, b) for a, b, _ in rows], f"summary: no {need_run} 1-s row"
 for a, b, rest in rows:
     cells = [c.strip() for c in rest.split("|")]
     assert len(cells) == 8, f"summary: error row {a} {b}: {len(cells)} cells"
-    int(cells[0]), int(cells[4])  # n for T_R, n for R_S
-    for c in cells[1:]:
-        float(c)
+    for n_at in (0, 4):  # n for T_R, n for R_S, then mean, max, bias
+        n, stats = int(cells[n_at]), cells[n_at + 1:n_at + 4]
+        if n == 0:
+            assert re.match(r"no valid window: \d+/\d+ [a-z_]+", stats[0]), f"summary: {a} {b}: {stats[0]!r}"
+            assert stats[1:] == ["–", "–"], f"summary: {a} {b}: {stats}"
+        else:
+            for c in stats:
+                float(c)
+# no cell of any table (and no word of the text) is "nan"
+for line in md.splitlines():
+    if line.startswith("|"):
+        for c in line.strip("|").split("|"):
+            assert not re.search(r"\bnan\b", c, re.I), f"summary: a cell is nan: {line}"
+assert not re.search(r"\bnan\b", md, re.I), "summary: 'nan' in the text"
+# the duty-cycle run: commissioning's inverter model and the estimation rows
+assert "## Without voltage sensors: the duty-cycle input (4 kW drive)" in md, "summary: no duty-cycle section"
+for label in ("inverter: dead time", "inverter: device drops (V_sw0 + V_d0) / 2", "inverter: slopes r_sw - r_d",
+              "inverter: the model's stated uncertainty"):
+    assert re.search(r"^\| " + re.escape(label) + r" \| [0-9.]+ ", md, re.M), f"summary: no row '{label}'"
+for par in ("T_R", "R_S"):
+    m = re.search(r"^\| identified constants \| " + par + r" \| (\d+) / (\d+) \| ([0-9.]+) % \| ([^|]*) \|", md, re.M)
+    assert m, f"summary: no duty-cycle row for {par}"
+    assert int(m.group(2)) == 10, f"duty4kw: {m.group(2)} windows, expected 10 (60 s / 6)"
+    assert abs(100 * int(m.group(1)) / int(m.group(2)) - float(m.group(3))) < 0.06, m.group(0)
+duty = list(csv.DictReader(open(f"{out}/duty4kw_windows.csv")))
+assert all(r["via_can"] == "1" for r in duty), "duty4kw: a window did not come through the CAN log"
+# the operating point was chosen where the product works: T_R valid after the warm-up, within 1 %
+tr_ok = [r for r in duty if r["tr_valid"] == "1"]
+assert len(tr_ok) >= 8, f"duty4kw: only {len(tr_ok)} of 10 windows have a valid T_R"
+assert all(abs(float(r["T_R_err_pct"])) < 1.0 for r in tr_ok), "duty4kw: a valid T_R is more than 1 % off"
 tel = re.search(r"^\| exp2 \| (\d+) \| (\d+) \| [^|]* \| [^|]* \| (\d+) \| (\d+) \|", md, re.M)
 assert tel, "summary: no exp2 telemetry row"
 assert int(tel.group(1)) == 60 and int(tel.group(3)) == 60, tel.group(0)
