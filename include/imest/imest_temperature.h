@@ -18,15 +18,17 @@
  *       if (tmp.stator_valid) derate_on_winding(tmp.stator_c);
  *     }
  *
- * The resistance method (IEC 60034-1, "Determination of winding temperature", resistance
- * method; the same relation in IEEE Std 112 and IEEE Std 118). A metal conductor's resistance is
- * linear in temperature over the motor's range and extrapolates to zero at -k degC, so
+ * The resistance method (IEC 60034-1, determination of winding temperature by the resistance
+ * method; the same relation in IEEE Std 112). A metal conductor's resistance is linear in
+ * temperature over the motor's range and extrapolates to zero at -k degC, so
  *     T = (R / R_ref) (k + T_ref) - k,
- * with R_ref measured at T_ref. k = 234.5 for annealed copper (IEEE Std 118, from copper's
- * 100 % IACS conductivity; IEC 60034-1 rounds it to 235: 0.2 K at a 100 K rise) and 225 for
- * aluminium (IEC 60034-1). So R_S up 39.3 % from 20 degC is (1.393 x 254.5) - 234.5 = 120 degC, a
- * rise of 100 K. This is the form the standard uses for a winding's mean temperature (the
- * hottest spot is hotter: IEC 60034-1's thermal classes allow 10 K between the two for class F).
+ * with R_ref measured at T_ref. k = 234.5 for copper of 100 % IACS conductivity (IEEE Std 112;
+ * IEC 60034-1 rounds it to 235: 0.2 K at a 100 K rise) and 225 for aluminium (both standards).
+ * So R_S up 39.3 % from 20 degC is (1.393 x 254.5) - 234.5 = 120 degC, a rise of 100 K. The
+ * linear-alpha form R = R_ref (1 + alpha (T - T_ref)) is the same relation with
+ * alpha = 1 / (k + T_ref) (0.00393 /K for copper at 20 degC). The figure is the winding's mean
+ * temperature; its hottest spot is hotter (class F: 155 degC for a 105 K rise by resistance over
+ * 40 degC coolant, 10 K left for the difference).
  *
  * The stator: R = R_S of the window, R_ref = rs_ref_ohm, k = stator_k_c (default 234.5, copper).
  * R_S is the phase resistance the estimator sees: the winding plus what is in series with it
@@ -47,9 +49,10 @@
  *     deep-bar or double-cage rotor's current fills the bar: its AC resistance at slip frequency
  *     is the DC value to within a fraction of a percent; at starting (slip 1) it is not.
  *   - The cage is one temperature (bars and end rings together); a die-cast cage's alloy has a
- *     k of its own (225 is pure aluminium's; an alloy of lower conductivity has a larger k):
+ *     k of its own (225 is for aluminium of about 62 % IACS; an alloy of lower conductivity has a
+ *     larger k):
  *     use the rotor maker's figure if known. An error dk in k reads as dk (R/R_ref - 1): 10 in k
- *     is 3 K at a 100 K rise.
+ *     is 4 K at a 100 K rise.
  *
  * Uncertainty, first order in the relative bounds and summed as bounds (the estimator's
  * tr_bound_rel and rs_bound_rel are bounds, the references' uncertainties too):
@@ -67,20 +70,20 @@
  *   - tr_ref_bound_rel 0.005: the mean of the estimator's valid T_R over commissioning's cold
  *     minutes; 1.6 K of the rotor's 5 K at 100 degC (0.005 x 325).
  * The tolerances (the verdicts, below):
- *   - stator_tol_k 3 K: insulation life halves per 8-10 K (Montsinger's rule; IEC 60034-18), so
- *     a 3 K error is a 20-25 % error in the life consumed, about what a winding's own
- *     spread between coils is. 3 K is 0.9 % of R_S at 100 degC: stricter than the estimator's
- *     rs_tolerance (5 %), so a window whose R_S is valid but whose bound exceeds about 0.6 %
- *     gives a stator temperature that is not. The estimator's R_S bound is conservative: in the
- *     simulated heat run (tools/demo, exp2) rs_bound_rel is 1.3-1.5 %, a stated 5.5-6 K, while
- *     the stator temperature's actual error stays within 1.2 K; no stator temperature there is
- *     valid at 3 K. Where the drive's R_S bound is known to be that conservative, a stator_tol_k
- *     of 6-7 K passes those windows (the figure is then as good as its actual error, not its
- *     stated one).
- *   - rotor_tol_k 5 K: the rotor carries no insulation; its temperature serves T_R's
- *     correction and thermal protection, whose trip margins are 10 K or more. 5 K is 1.5 % of
- *     T_R at 100 degC: stricter than tr_tolerance (2 %, imest.h), so a window whose T_R bound
- *     exceeds about 1 % gives a rotor temperature that is not valid.
+ *   - stator_tol_k 3 K: insulation life halves per 8-10 K (Montsinger's rule), so a 3 K error
+ *     is a 20-30 % error in the life consumed; and 3 K is the resistance method's own
+ *     accuracy, a 1 % error of R_S at 40-60 degC. With the references' defaults it leaves
+ *     (3 K - 1 K x R/R_ref) / (T + k) - 0.003 for the window's R_S bound: 0.5 % at 20 degC,
+ *     0.2 % at 100 degC, much stricter than rs_tolerance (5 %). The estimator's R_S bound is
+ *     conservative: in the simulated heat run (tools/demo, exp2) rs_bound_rel is 1.3-1.5 %, a
+ *     stated 5.5-6 K, while the stator temperature's actual error stays within 1.2 K, so no
+ *     stator temperature there is valid at 3 K. Where the drive's R_S bound is known to be that
+ *     conservative, a stator_tol_k of 6-7 K passes those windows (the figure is then as good as
+ *     its actual error, not as its stated one).
+ *   - rotor_tol_k 5 K: the rotor carries no insulation; its temperature serves T_R's correction
+ *     and thermal protection, whose trip margins are 10 K or more. It leaves 1.1 % for the
+ *     window's T_R bound at 20 degC, 0.6 % at 100 degC (tr_tolerance is 2 %, imest.h); in the
+ *     heat run the bound is 0.06 % and the stated uncertainty 2.4-3.2 K, mostly the references'.
  *
  * Verdicts: stator_valid iff rs_valid, R_S and rs_bound_rel finite with R_S > 0 and the bound
  * >= 0, and stator_uncert_k <= stator_tol_k; rotor_valid the same with tr_valid, T_R,
