@@ -45,14 +45,19 @@
  *     relative change d of L_R reads as a rotor temperature error of d (T + k): 1 % of L_R is
  *     3.2 K at 100 degC in aluminium. Take tr_ref_s at the flux the motor runs at; the figure is
  *     for steady flux, not for field weakening.
- *   - R_R is the cage's DC resistance. T_R is identified at slip frequency (a few Hz), where a
- *     deep-bar or double-cage rotor's current fills the bar: its AC resistance at slip frequency
- *     is the DC value to within a fraction of a percent; at starting (slip 1) it is not.
- *   - The cage is one temperature (bars and end rings together); a die-cast cage's alloy has a
- *     k of its own (225 is for aluminium of about 62 % IACS; an alloy of lower conductivity has a
- *     larger k):
- *     use the rotor maker's figure if known. An error dk in k reads as dk (R/R_ref - 1): 10 in k
- *     is 4 K at a 100 K rise.
+ *   - R_R is the cage's DC resistance, times a skin-effect factor that is taken as constant.
+ *     T_R is identified at slip frequency (1-5 Hz at load). For a bar of depth h and skin depth
+ *     d (die-cast aluminium: 65 mm at 2 Hz, 41 mm at 5 Hz) the AC resistance exceeds the DC one
+ *     by about 4 (h/d)^4 / 45: a 20-mm bar (small motors) 0.1 % at 2 Hz, 0.5 % at 5 Hz, so
+ *     R_R at slip frequency is the DC value; a 40-mm deep bar 1.3 % at 2 Hz, 8 % at 5 Hz, which
+ *     is not. The factor at the reference's slip is in tr_ref_s; its change with the slip reads
+ *     as temperature: d (T + k), 4 K per 1 % (a 40-mm bar referenced at 2 Hz and run at 5 Hz:
+ *     +6.5 %, 21 K too warm). Take tr_ref_s at the working slip. At starting (slip 1) none of
+ *     this holds.
+ *   - The cage is one temperature (bars and end rings together). A die-cast cage's alloy has a
+ *     k of its own: 225 is for aluminium of about 62 % IACS, and an alloy of lower conductivity
+ *     has a larger k (use the rotor maker's figure if known). An error dk in k reads as
+ *     dk (R/R_ref - 1): 10 in k is 4 K at a 100 K rise.
  *
  * Uncertainty, first order in the relative bounds and summed as bounds (the estimator's
  * tr_bound_rel and rs_bound_rel are bounds, the references' uncertainties too):
