@@ -51,9 +51,9 @@
  *     by about 4 (h/d)^4 / 45: a 20-mm bar (small motors) 0.1 % at 2 Hz, 0.5 % at 5 Hz, so
  *     R_R at slip frequency is the DC value; a 40-mm deep bar 1.3 % at 2 Hz, 8 % at 5 Hz, which
  *     is not. The factor at the reference's slip is in tr_ref_s; its change with the slip reads
- *     as temperature: d (T + k), 4 K per 1 % (a 40-mm bar referenced at 2 Hz and run at 5 Hz:
- *     +6.5 %, 21 K too warm). Take tr_ref_s at the working slip. At starting (slip 1) none of
- *     this holds.
+ *     as temperature: d (T + k), 3.3 K per 1 % at 100 degC (a 40-mm bar referenced at 2 Hz and
+ *     run at 5 Hz: +6.5 %, 21 K too warm). Take tr_ref_s at the working slip. At starting
+ *     (slip 1) none of this holds.
  *   - The cage is one temperature (bars and end rings together). A die-cast cage's alloy has a
  *     k of its own: 225 is for aluminium of about 62 % IACS, and an alloy of lower conductivity
  *     has a larger k (use the rotor maker's figure if known). An error dk in k reads as
