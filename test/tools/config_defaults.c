@@ -4,11 +4,13 @@
  * N" for this host. test_documented_defaults.py compares it with the
  * defaults the header's comments and imest-replay --help state, and checks
  * that every field the header declares is listed here; likewise the T_R
- * tracker's imest_tracker_config_default() (tracker.NAME). */
+ * tracker's imest_tracker_config_default() (tracker.NAME) and the temperature module's
+ * imest_temperature_config_default() (temperature.NAME). */
 #include <stddef.h>
 #include <stdio.h>
 
 #include "imest/imest.h"
+#include "imest/imest_temperature.h"
 #include "imest/imest_tracker.h"
 
 #define F(name)                                                                                              \
@@ -84,6 +86,17 @@ int main(void)
   printf("tracker.gate_min_rel %.9g\n", (double)t.gate_min_rel);
   printf("tracker.confirm_windows %u\n", t.confirm_windows);
   printf("tracker.acquire_jump %d\n", t.acquire_jump);
+  /* the temperature module's defaults (imest_temperature.h), as temperature.NAME; the references
+     and L_R are the caller's */
+  imest_temperature_config_t m;
+  imest_temperature_config_default(&m, 20.0f, 1.0f, 0.1f, 0.2f);
+  printf("temperature.t_ref_uncert_k %.9g\n", (double)m.t_ref_uncert_k);
+  printf("temperature.rs_ref_bound_rel %.9g\n", (double)m.rs_ref_bound_rel);
+  printf("temperature.tr_ref_bound_rel %.9g\n", (double)m.tr_ref_bound_rel);
+  printf("temperature.stator_k_c %.9g\n", (double)m.stator_k_c);
+  printf("temperature.rotor_k_c %.9g\n", (double)m.rotor_k_c);
+  printf("temperature.stator_tol_k %.9g\n", (double)m.stator_tol_k);
+  printf("temperature.rotor_tol_k %.9g\n", (double)m.rotor_tol_k);
   printf("sizeof imest_t %zu\n", sizeof(imest_t));
   return 0;
 }

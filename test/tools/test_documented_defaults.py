@@ -10,6 +10,8 @@ against
     (the option table k_numeric of tools/replay/replay_options.c maps options to fields);
   * the comments of imest_tracker_config_t in include/imest/imest_tracker.h against
     imest_tracker_config_default() (every field but the caller's nominal T_R must state one);
+  * the comments of imest_temperature_config_t in include/imest/imest_temperature.h against
+    imest_temperature_config_default() (every field but the caller's references and L_R);
   * README.md: "`field` (default X)" and "(default X %)";
   * the instance size: README.md, fw/README.md and include/imest/imest_instance.h state
     sizeof(imest_t) measured on the Cortex-M4F/M7; it is checked against this host's
@@ -171,7 +173,7 @@ def main():
     with open(os.path.join(src, "include/imest/imest.h")) as f:
         fields = header_fields(f.read())
     declared = [f for f, _ in fields]
-    probed = [n for n in code if n != "sizeof imest_t" and not n.startswith("tracker.")]
+    probed = [n for n in code if n != "sizeof imest_t" and not n.startswith(("tracker.", "temperature."))]
     for f in declared:
         if f not in code:
             fails.append("include/imest/imest.h declares %s: add it to test/tools/config_defaults.c" % f)
@@ -197,6 +199,23 @@ def main():
                          "test/tools/config_defaults.c" % f)
     for f, doc in tclaims.items():
         compare("include/imest/imest_tracker.h", f, doc)
+
+    # 1c. the temperature module's header (imest_temperature.h): every field but the caller's
+    with open(os.path.join(src, "include/imest/imest_temperature.h")) as f:
+        mfields = [("temperature." + n, d) for n, d in header_fields(f.read(), "imest_temperature_config_t")]
+    callers = {"temperature." + n for n in ("t_ref_c", "rs_ref_ohm", "tr_ref_s", "lr_h")}
+    mclaims = header_claims(mfields)
+    if len(mfields) != 11:
+        fails.append("include/imest/imest_temperature.h: %d config fields parsed, expected 11" % len(mfields))
+    for f, _ in mfields:
+        if f not in callers and f not in mclaims:
+            fails.append("include/imest/imest_temperature.h: %s states no default" % f)
+        if f not in callers and f not in code:
+            fails.append("include/imest/imest_temperature.h declares %s: add it to "
+                         "test/tools/config_defaults.c" % f)
+    for f, doc in mclaims.items():
+        if f not in callers:
+            compare("include/imest/imest_temperature.h", f, doc)
 
     # 2. imest-replay --help, through replay's option table
     with open(os.path.join(src, "tools/replay/replay_options.c")) as f:

@@ -127,3 +127,24 @@ TEST(ReplayOptions, PhaseInputKeepsTheLibraryDefaults)
   EXPECT_EQ(parse({"--voltage", "duty", "--u-limit", "auto"}).rc, -1); // the default: nothing to refuse
   EXPECT_EQ(parse({"--voltage", "duty", "--u-limit", "400"}).rc, TOOL_EXIT_USAGE);
 }
+
+// --temperatures: three references into the temperature module's config, L_R from --ls; a
+// malformed or out-of-range value is a usage error; without it no temperature columns.
+TEST(ReplayOptions, TemperaturesReferences)
+{
+  const Parsed none = parse({});
+  ASSERT_EQ(none.rc, -1);
+  EXPECT_EQ(none.o.temperatures, 0);
+  const Parsed p = parse({"--temperatures", "21.5,3.2,0.121"});
+  ASSERT_EQ(p.rc, -1);
+  EXPECT_EQ(p.o.temperatures, 1);
+  EXPECT_FLOAT_EQ(p.o.temp_cfg.t_ref_c, 21.5f);
+  EXPECT_FLOAT_EQ(p.o.temp_cfg.rs_ref_ohm, 3.2f);
+  EXPECT_FLOAT_EQ(p.o.temp_cfg.tr_ref_s, 0.121f);
+  EXPECT_FLOAT_EQ(p.o.temp_cfg.lr_h, 0.2f);
+  EXPECT_EQ(p.o.temp_cfg.stator_k_c, 234.5f);
+  EXPECT_EQ(parse({"--temperatures=20,3,0.1"}).rc, -1);
+  for (const char *bad :
+       {"20,3", "20,3,0.1,4", "20,x,0.1", "20,0,0.1", "20,3,-0.1", "300,3,0.1", "20,3,0.1x"})
+    EXPECT_EQ(parse({"--temperatures", bad}).rc, 2) << bad;
+}

@@ -67,6 +67,7 @@
 #include "drive_loop.h"
 #include "imest/imest.h"
 #include "imest/imest_can.h"
+#include "imest/imest_temperature.h"
 #include "imest/imest_tracker.h"
 #include "imest_candump.h"
 #include "imsim/imsim.h"
@@ -396,6 +397,8 @@ typedef struct {
   int have_id;                 /* exp1: 0 none yet, 1 the run-up window (not valid), 2 the first valid one */
   imest_tracker_t trk;         /* every run: what the tracker makes of its results (applied if adaptive) */
   float i_off_a[3], i_ginv[3]; /* the duty-cycle run: current correction from commissioning */
+  /* every run: the temperatures from its results (imest_temperature.h) */
+  imest_temperature_t temp;
 } run_t;
 
 static void run_release(run_t *x)
@@ -608,6 +611,17 @@ static int job_open(job_t *j, run_t *x)
     snprintf(j->err, sizeof j->err, "%s: imest_tracker_init failed", x->name);
     return -1;
   }
+  /* the temperatures' references: the motor's cold R_S and T_R at ambient, as commissioning
+     measures them; imsim heats both bodies with copper's linear alpha from t_amb_c, which is the
+     resistance method with k = 1/alpha - t_amb_c (234.5 at 20 degC): the rotor's k is set to it */
+  imest_temperature_config_t mc;
+  imest_temperature_config_default(&mc, (float)x->c.t_amb_c, (float)x->c.rs_ohm, (float)x->c.tr_s,
+                                   (float)x->c.lr_h);
+  if (x->c.alpha_per_k > 0.0) mc.rotor_k_c = mc.stator_k_c = (float)(1.0 / x->c.alpha_per_k - x->c.t_amb_c);
+  if (imest_temperature_init(&x->temp, &mc) != IMEST_OK) {
+    snprintf(j->err, sizeof j->err, "%s: imest_temperature_init failed", x->name);
+    return -1;
+  }
 
   snprintf(fname, sizeof fname, "%s_direct.csv", x->name);
   if ((x->csv = open_out(j, x->dir, fname)) == NULL) return -1;
@@ -616,7 +630,8 @@ static int job_open(job_t *j, run_t *x)
                   "speed_rad_s,torque_nm,load_nm,torque_ref_nm,torque_err_rms_nm,psi_r_wb,psi_ref_wb,"
                   "i_phase_rms_a,temp_stator_c,temp_rotor_c,ifoc_T_R_s,"
                   "tr_valid,tr_reason,rs_valid,rs_reason,tr_bound_rel,trk_T_R_s,trk_state,trk_age_s,"
-                  "trk_bound_rel,rs_bound_rel\n");
+                  "trk_bound_rel,rs_bound_rel,est_stator_c,est_stator_uncert_k,est_stator_valid,est_rotor_c,"
+                  "est_rotor_uncert_k,est_rotor_valid\n");
 
   j->fs_hz = x->c.fs_hz;
   j->total = (unsigned long long)llround(j->duration_s * x->c.fs_hz);
@@ -648,16 +663,19 @@ static void on_window(void *ctx, const imest_result_t *r)
                                 D_NAN, D_NAN, D_NAN, D_NAN, D_NAN, D_NAN};
   const truth_t *t = (r->seq < x->nwin && r->seq < x->win) ? &x->truth[r->seq] : &nan_t;
   (void)imest_tracker_update(&x->trk, r); /* t_end_s only grows: it cannot refuse */
+  (void)imest_temperature_update(&x->temp, r);
   fprintf(x->csv,
           "%s,%u,%.6f,%.9g,%.9g,%d,%s,%.9g,%.9g,%.6g,%.6g,%.6g,%.5g,%.6g,%u,%u,%u,%u,"
-          "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s,%.4g,%.9g,%s,%.6g,%.4g,%.4g\n",
+          "%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.5g,%.5g,%.6g,%d,%s,%d,%s,%.4g,%.9g,%s,%.6g,%.4g,%.4g,"
+          "%.6g,%.4g,%d,%.6g,%.4g,%d\n",
           x->name, r->seq, r->t_end_s, r->tr_s, r->rs_ohm, r->valid, imest_reason_name(r->status), t->tr,
           t->rs, r->e_i, r->pe_k1_rel, r->pe_k2_rel, r->slip_ratio, r->i_rms_a, r->n_roots, r->n_admissible,
           r->used_samples, r->flags, t->speed, t->te, t->load, t->te_ref, t->te_err_rms, t->psi, t->psi_ref,
           t->i_rms, t->temp_s, t->temp_r, t->ifoc_tr, r->tr_valid, imest_reason_name(r->tr_reason),
           r->rs_valid, imest_reason_name(r->rs_reason), r->tr_bound_rel, (double)x->trk.tr_s,
           imest_tracker_state_name(x->trk.state), (double)x->trk.age_s, (double)x->trk.tr_bound_rel,
-          r->rs_bound_rel);
+          r->rs_bound_rel, (double)x->temp.stator_c, (double)x->temp.stator_uncert_k, x->temp.stator_valid,
+          (double)x->temp.rotor_c, (double)x->temp.rotor_uncert_k, x->temp.rotor_valid);
   /* the controller takes the tracker's T_R (or, with --adaptive-tr raw, every window whose T_R is
      trusted, as it is) */
   if (IS_ADAPTIVE(j->id)) {

@@ -165,8 +165,99 @@ def build_windows(raw, exp):
         for key in ("tr_bound_rel", "trk_T_R_s", "trk_state", "trk_age_s", "trk_bound_rel", "rs_bound_rel"):
             if key in d:
                 row[key] = d[key]
+        # the temperatures from this window's R_S and T_R (imest_temperature.h), when written
+        for key in TEMP_KEYS:
+            if key in d:
+                row[key] = d[key]
         rows.append(row)
     return rows, mismatches, missing, len(mon)
+
+
+TEMP_KEYS = ("est_stator_c", "est_stator_uncert_k", "est_stator_valid", "est_rotor_c",
+             "est_rotor_uncert_k", "est_rotor_valid")
+
+
+TEMP_SOURCE = {"stator": "rs_valid", "rotor": "tr_valid"}
+
+
+def temp_stats(a, by_estimate=False):
+    """Per body: (valid windows, windows, mean |err| K, max |err| K, mean signed err K, mean
+    uncertainty K) of the estimated temperature against the simulator's, over the windows whose
+    temperature is valid (by_estimate: whose R_S or T_R is valid, the tolerance aside)."""
+    out = {}
+    for body in ("stator", "rotor"):
+        ok = a[TEMP_SOURCE[body]] if by_estimate else a[f"est_{body}_valid"] == 1
+        ok = ok & np.isfinite(a[f"est_{body}_c"])
+        err = a[f"est_{body}_c"][ok] - a[f"temp_{body}_c"][ok]
+        if len(err) == 0:
+            out[body] = (0, len(ok), math.nan, math.nan, math.nan, math.nan)
+        else:
+            out[body] = (len(err), len(ok), float(np.mean(np.abs(err))), float(np.max(np.abs(err))),
+                         float(np.mean(err)), float(np.mean(a[f"est_{body}_uncert_k"][ok])))
+    return out
+
+
+def fig_temperatures(path, a, sub):
+    """The heat run's stator and rotor temperatures from the estimates (valid windows) against
+    the simulator's thermal truth, and their errors with the stated uncertainty."""
+    fig, axs = plt.subplots(2, 2, figsize=(12, 7), sharex=True)
+    t = a["t_end_s"] / 60.0
+    for col, (body, tol) in enumerate((("stator", 3.0), ("rotor", 5.0))):
+        ok = a[f"est_{body}_valid"] == 1
+        est_ok = a[TEMP_SOURCE[body]] & ~ok  # the estimate valid, its temperature's uncertainty too large
+        ax = axs[0][col]
+        ax.plot(t, a[f"temp_{body}_c"], "k-", lw=1.2, label="simulator (truth)")
+        ax.plot(t[ok], a[f"est_{body}_c"][ok], ".", ms=2, label="estimated, valid windows")
+        if est_ok.any():
+            ax.plot(t[est_ok], a[f"est_{body}_c"][est_ok], ".", ms=2, color="tab:orange",
+                    label=f"estimated, {TEMP_SOURCE[body]} but uncertainty > {tol:g} K")
+        ax.set_ylabel(f"{body} temperature [°C]")
+        ax.set_title(f"{body}: resistance method from {'R_S' if body == 'stator' else 'T_R'}")
+        ax.legend(loc="lower right", fontsize=8)
+        ax = axs[1][col]
+        err = a[f"est_{body}_c"] - a[f"temp_{body}_c"]
+        ax.plot(t[ok], err[ok], ".", ms=2, label="error (valid windows)")
+        if est_ok.any():
+            ax.plot(t[est_ok], err[est_ok], ".", ms=2, color="tab:orange", label=f"error ({TEMP_SOURCE[body]} only)")
+        u = a[f"est_{body}_uncert_k"]
+        sel = ok | est_ok
+        ax.plot(t[sel], u[sel], "-", color="0.6", lw=0.8, label="± stated uncertainty")
+        ax.plot(t[sel], -u[sel], "-", color="0.6", lw=0.8)
+        ax.axhline(tol, color="r", ls=":", lw=0.8, label=f"goal ±{tol:g} K")
+        ax.axhline(-tol, color="r", ls=":", lw=0.8)
+        ax.set_ylabel("estimated − true [K]")
+        ax.set_xlabel("time [min]")
+        ax.legend(loc="lower right", fontsize=8)
+    fig.suptitle(f"Motor temperatures from the estimates (imest_temperature.h)\n{sub}", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def temperature_section(a):
+    st = temp_stats(a)
+    md = ["## Stator and rotor temperatures (exp. 2, imest_temperature.h)\n",
+          "Each window's R_S and T_R turned into temperatures by the resistance method, referenced "
+          "to the motor's cold R_S and T_R at the simulator's ambient (k = 1/alpha - t_amb for both "
+          "bodies: the simulator heats the rotor with copper's coefficient too). Error = estimated "
+          "- simulator, over the windows whose temperature is valid (estimate valid and stated "
+          "uncertainty within 3 K stator, 5 K rotor).\n",
+          "| body | valid / windows | mean abs error [K] | max abs error [K] | mean signed [K] | "
+          "mean stated uncertainty [K] | goal | met |",
+          "|---|---:|---:|---:|---:|---:|---:|---|"]
+    se = temp_stats(a, by_estimate=True)
+    for body, goal in (("stator", 3.0), ("rotor", 5.0)):
+        for label, s in ((body, st[body]), (f"{body}, every window with {TEMP_SOURCE[body]}", se[body])):
+            n, tot, mean, mx, bias, unc = s
+            met = "yes" if n > 0 and mx <= goal else ("no valid window" if n == 0 else "no")
+            md.append(f"| {label} | {n} / {tot} | {mean:.2f} | {mx:.2f} | {bias:+.2f} | {unc:.2f} | "
+                      f"±{goal:g} K | {met} |")
+    md.append("")
+    md.append("A temperature is valid only where its stated uncertainty is within the tolerance: the "
+              "second row of each body shows the error where the estimate is valid whatever the "
+              "uncertainty (the stator's is mostly rs_bound_rel, which the estimator states "
+              "conservatively).\n")
+    return md
 
 
 def write_rows(path, rows):
@@ -1174,6 +1265,9 @@ def main(argv):
     if res:
         figs.append(os.path.join(out, "fig13_verdicts.png"))
         fig_verdicts(figs[-1], res)
+    if "exp2" in res and "est_stator_c" in res["exp2"]["a"]:
+        figs.append(os.path.join(out, "fig15_temperatures.png"))
+        fig_temperatures(figs[-1], res["exp2"]["a"], sub)
 
     # ---------------- summary
     md.append("# imest demo: results\n")
@@ -1273,6 +1367,8 @@ def main(argv):
         md += ifoc11_section(res[p11["fixed"]]["a"], res[p11["adaptive"]]["a"], p11)
     if DUTY["exp"] in res:
         md += duty_section(raw, res[DUTY["exp"]]["a"])
+    if "exp2" in res and "est_stator_c" in res["exp2"]["a"]:
+        md += temperature_section(res["exp2"]["a"])
     md.append("## Files\n")
     md.append("- `windows.csv`: exp. 2, one row per 1-s window (values as decoded from the CAN log; "
               "`via_can` = 1), truth, drive state; `exp1_windows.csv`, `ifoc_fixed_windows.csv`, "

@@ -19,7 +19,7 @@ for f in windows.csv exp1_windows.csv ifoc_fixed_windows.csv ifoc_adaptive_windo
          fig02_exp1_voltages.png fig03_exp1_current.png fig04_exp1_speed.png \
          fig05_tr_1s.png fig06_tr_30s.png fig07_tr_120s.png \
          fig08_rs_1s.png fig09_rs_30s.png fig10_rs_120s.png fig11_ifoc_closed_loop.png \
-         fig12_ifoc_11kw.png fig13_verdicts.png ifoc11_fixed_windows.csv ifoc11_adaptive_windows.csv \
+         fig12_ifoc_11kw.png fig13_verdicts.png fig15_temperatures.png ifoc11_fixed_windows.csv ifoc11_adaptive_windows.csv \
          fig14_duty_4kw.png duty4kw_windows.csv raw/duty4kw_commission.csv raw/duty4kw_true_constants.csv \
          raw/exp2.candump.log raw/exp2_monitor.csv; do
   [ -s "$out/$f" ] || fail "missing or empty: $f"
@@ -103,5 +103,14 @@ for name in ("ifoc_adaptive_windows.csv", "ifoc11_adaptive_windows.csv"):
         assert abs(used / trk - 1) < 1e-5, f"{name} window {b['seq']}: controller T_R {used}, tracker {trk}"
 for sec in ("## R_S and the encoder", "Why the fixed-T_R torque error changes sign"):
     assert sec in md, f"summary: no '{sec}'"
+# the heat run's temperatures (imest_temperature.h): columns, figure, and the summary's table
+rows = list(csv.DictReader(open(f"{out}/windows.csv")))
+for k in ("est_stator_c", "est_stator_uncert_k", "est_stator_valid", "est_rotor_c", "est_rotor_uncert_k",
+          "est_rotor_valid"):
+    assert k in rows[0], f"windows.csv: no column {k}"
+trows = dict(re.findall(r"^\| (stator|rotor) \| (\d+) / 60 \|", md, re.M))
+assert set(trows) == {"stator", "rotor"}, "summary: no temperature rows"
+rot = re.search(r"^\| rotor \| (\d+) / 60 \| ([0-9.]+) \| ([0-9.]+) \|", md, re.M)
+assert rot and int(rot.group(1)) > 0 and float(rot.group(3)) <= 5.0, f"summary: rotor temperature {rot}"
 print("demo smoke test: ok")
 EOF

@@ -151,11 +151,13 @@ static int can_log_close(can_log_t *c)
 
 /* The columns up to flags keep their places (tools/studies/accuracy reads them by
  * position); the per-parameter verdicts and bounds came later and follow. */
-static void print_header(void)
+static void print_header(int temperatures)
 {
   printf("t_end_s,T_R_s,R_S_ohm,E_I,valid,status,seq,K1,K2,pe_k1_rel,pe_k2_rel,"
          "H11,H12,H22,hessian_pd,n_roots,n_admissible,slip_ratio,i_rms_a,used_samples,flags,"
-         "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel\n");
+         "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel%s\n",
+         temperatures ? ",stator_c,stator_uncert_k,stator_valid,rr_ohm,rotor_c,rotor_uncert_k,rotor_valid"
+                      : "");
 }
 
 /* A bound that was not computed is NaN: printed as "nan" whatever its sign bit. */
@@ -170,6 +172,7 @@ static void print_bound(double x)
 typedef struct {
   double t0_s; /* the record's first t [s] */
   can_log_t *can;
+  imest_temperature_t *temp; /* --temperatures: its columns follow the others (NULL: none) */
 } row_ctx_t;
 
 /* drive_window_fn: the window's frames to the CAN log, one output row. */
@@ -187,6 +190,17 @@ static void print_row(void *ctx, const imest_result_t *r)
          imest_reason_name(r->rs_reason), r->span_s, r->windows);
   print_bound(r->tr_bound_rel);
   print_bound(r->rs_bound_rel);
+  if (x->temp != NULL) {
+    (void)imest_temperature_update(x->temp, r); /* r and x->temp are not NULL */
+    const imest_temperature_t *t = x->temp;
+    print_bound((double)t->stator_c);
+    print_bound((double)t->stator_uncert_k);
+    printf(",%d", t->stator_valid);
+    print_bound((double)t->rr_ohm);
+    print_bound((double)t->rotor_c);
+    print_bound((double)t->rotor_uncert_k);
+    printf(",%d", t->rotor_valid);
+  }
   printf("\n");
 }
 
@@ -230,7 +244,7 @@ static int run(csv_reader_t *r, const replay_opts_t *o, const replay_scan_t *s, 
     fprintf(stderr, "%s: %s: cannot read the file a second time\n", k_prog, r->name);
     return TOOL_EXIT_DATA;
   }
-  print_header();
+  print_header(o->temperatures);
   double v[CSV_MAX_NEED], tprev = 0, qprev = 0;
   replay_sample_t x;
   long k = 0;
@@ -371,7 +385,12 @@ int main(int argc, char **argv)
   static imest_t est;
   can_log_t can;
   drive_t d;
-  row_ctx_t row = {0, &can};
+  static imest_temperature_t temp;
+  row_ctx_t row = {0, &can, NULL};
+  if (o.temperatures) {
+    (void)imest_temperature_init(&temp, &o.temp_cfg); /* checked by replay_parse() */
+    row.temp = &temp;
+  }
   if ((rc = replay_scan(&r, &o, &s)) >= 0 || (rc = configure(&o, &s, &cfg)) >= 0) goto done;
   imest_init(&est, &cfg);
   FILE *to_stdout = stdout;

@@ -109,6 +109,13 @@ static void usage(FILE *o)
              "                      auto = current ~0 and rotor still at the first samples\n"
              "output:\n"
              "  -o, --output FILE   the windows' CSV into FILE (default: stdout; \"-\" = stdout)\n"
+             "  --temperatures T_REF_C,RS_REF_OHM,TR_REF_S\n"
+             "                      append the stator's and the rotor's temperatures\n"
+             "                      (imest_temperature.h, the resistance method: copper stator,\n"
+             "                      aluminium cage) from R_S and T_R measured at T_REF_C [degC]\n"
+             "                      (ambient at commissioning): columns stator_c,\n"
+             "                      stator_uncert_k, stator_valid, rr_ohm, rotor_c,\n"
+             "                      rotor_uncert_k, rotor_valid after the others (L_R = --ls)\n"
              "CAN telemetry:\n"
              "  --candump FILE      also write the published CAN frames (candump -L format;\n"
              "                      \"-\" = stdout, with the windows' CSV in -o FILE)\n"
@@ -276,6 +283,27 @@ static int limit_value(tool_args_t *a, double *out)
   return 0;
 }
 
+/* --temperatures T_REF_C,RS_REF_OHM,TR_REF_S: three numbers into the temperature module's config
+   (its other fields default; the ranges are checked once --ls is known). 0, or -1 after a message. */
+static int parse_temperatures(const char *v, replay_opts_t *o)
+{
+  double x[3];
+  const char *p = v;
+  for (int k = 0; k < 3; k++) {
+    char *end = NULL;
+    x[k] = strtod(p, &end);
+    if (end == p || !isfinite(x[k]) || *end != (k < 2 ? ',' : '\0')) {
+      fprintf(stderr, "%s: --temperatures takes T_REF_C,RS_REF_OHM,TR_REF_S (three numbers), not '%s'\n",
+              k_prog, v);
+      return -1;
+    }
+    p = end + 1;
+  }
+  imest_temperature_config_default(&o->temp_cfg, (float)x[0], (float)x[1], (float)x[2], 1.0f);
+  o->temperatures = 1;
+  return 0;
+}
+
 int replay_parse(int argc, char **argv, replay_opts_t *o)
 {
   memset(o, 0, sizeof *o);
@@ -382,6 +410,10 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
       }
     } else if (tool_args_is(&a, "-o") || tool_args_is(&a, "--output")) {
       if ((o->output_path = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--temperatures")) {
+      const char *v = tool_args_value(&a);
+      if (v == NULL) return TOOL_EXIT_USAGE;
+      if (parse_temperatures(v, o) != 0) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--candump")) {
       if ((o->candump_path = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--candump-iface")) {
@@ -415,6 +447,15 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
   if (!have_np || !given(o, "--ls") || !given(o, "--sigma")) {
     fprintf(stderr, "%s: --pole-pairs, --ls and --sigma are required (see --help)\n", k_prog);
     return TOOL_EXIT_USAGE;
+  }
+  if (o->temperatures) {
+    o->temp_cfg.lr_h = o->cfg.ls_h; /* equal leakages */
+    const char *field = NULL;
+    if (imest_temperature_config_check(&o->temp_cfg, &field) != IMEST_OK) {
+      fprintf(stderr, "%s: --temperatures: %s is out of range (imest_temperature.h)\n", k_prog,
+              field ? field : "a reference");
+      return TOOL_EXIT_USAGE;
+    }
   }
   if (o->path == NULL) {
     fprintf(stderr, "%s: no input file (\"-\" reads stdin; see --help)\n", k_prog);

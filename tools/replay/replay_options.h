@@ -6,6 +6,7 @@
 #define IMEST_REPLAY_OPTIONS_H
 
 #include "imest/imest.h"
+#include "imest/imest_temperature.h"
 
 /* Where the phase voltage comes from (--voltage). */
 typedef enum {
@@ -28,8 +29,10 @@ typedef struct {
   int from_rest;            /* -1 = auto, 0 no, 1 yes */
   int gaps_restart;         /* --gaps restart: missing samples restart the estimator (0: refused) */
   int quiet;
-  int align_check; /* 0 after --no-align-check */
-  int require;     /* --require-valid: a tool_require_t */
+  int align_check;  /* 0 after --no-align-check */
+  int require;      /* --require-valid: a tool_require_t */
+  int temperatures; /* --temperatures given: temp_cfg holds its references */
+  imest_temperature_config_t temp_cfg;
 } replay_opts_t;
 
 /* Parses argv into *o. Returns -1 to go on, or the exit code to end with
