@@ -249,7 +249,12 @@ def temperature_section(a):
     for body, goal in (("stator", 3.0), ("rotor", 5.0)):
         for label, s in ((body, st[body]), (f"{body}, every window with {TEMP_SOURCE[body]}", se[body])):
             n, tot, mean, mx, bias, unc = s
-            met = "yes" if n > 0 and mx <= goal else ("no valid window" if n == 0 else "no")
+            if n == 0:  # no number to show: say why, as the other tables do
+                why = ("no valid window: the stated uncertainty is above the tolerance"
+                       if label == body else "no valid window")
+                md.append(f"| {label} | 0 / {tot} | – | – | – | – | ±{goal:g} K | {why} |")
+                continue
+            met = "yes" if mx <= goal else "no"
             md.append(f"| {label} | {n} / {tot} | {mean:.2f} | {mx:.2f} | {bias:+.2f} | {unc:.2f} | "
                       f"±{goal:g} K | {met} |")
     md.append("")
