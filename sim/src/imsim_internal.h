@@ -126,6 +126,11 @@ void ims_rm_piece(imsim_t *s, double len, cpx u_pwm, const step_input_t *in, dou
 void ims_rm_sync(imsim_t *s, double tl);
 double ims_rm_p_rotor(const imsim_t *s);
 void ims_rm_fill(imsim_t *s, imsim_sample_t *o);
+/* The steady speed in (0, wsync]: where the torque surplus (motor torque - load - friction)
+   changes sign, by a scan down from synchronous speed in steps of wsync/4000 and 200 bisections.
+   Returns 0 and *w (wsync if the surplus there is >= 0), or -1 if the motor cannot carry the
+   load at any speed. Shared by the linear and the real-motor phasor solutions. */
+int ims_speed_root(double (*surplus)(const void *ctx, double w), const void *ctx, double wsync, double *w);
 int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double freq_hz,
                   double load_nm, imsim_steady_t *out, cpx fl[4]);
 

@@ -402,6 +402,21 @@ static void phasor_at(const imsim_config_t *c, const imsim_real_t *rm, double vl
   o->te = (double)c->pole_pairs * (ir.re * o->psim.im - ir.im * o->psim.re);
 }
 
+/* The real machine's torque surplus at speed w (ims_speed_root). */
+typedef struct {
+  const imsim_config_t *c;
+  const imsim_real_t *rm;
+  double vll_v, we, load_nm;
+} rm_ctx_t;
+
+static double rm_torque_surplus(const void *ctx, double w)
+{
+  const rm_ctx_t *x = (const rm_ctx_t *)ctx;
+  rm_phasor_t ph;
+  phasor_at(x->c, x->rm, x->vll_v, x->we, w, &ph);
+  return ph.te - x->load_nm - x->c->b_nms * w;
+}
+
 int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double freq_hz,
                   double load_nm, imsim_steady_t *out, cpx fl[4])
 {
@@ -409,26 +424,9 @@ int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v,
   const double we = 2.0 * PI * freq_hz;
   const double wsync = we / (double)c->pole_pairs;
   rm_phasor_t ph;
-#define F_OF(wv) (phasor_at(c, rm, vll_v, we, (wv), &ph), ph.te - load_nm - c->b_nms * (wv))
-  double hi = wsync, lo = wsync;
-  if (F_OF(hi) < 0.0) {
-    int k = 0;
-    for (k = 1; k <= 4000; ++k) {
-      lo = wsync * (1.0 - (double)k / 4000.0);
-      if (F_OF(lo) > 0.0) break;
-      hi = lo;
-    }
-    if (k > 4000) return -1;
-    for (int it = 0; it < 200; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      if (F_OF(mid) > 0.0)
-        lo = mid;
-      else
-        hi = mid;
-    }
-  }
-#undef F_OF
-  const double w = 0.5 * (lo + hi);
+  const rm_ctx_t x = {c, rm, vll_v, we, load_nm};
+  double w;
+  if (ims_speed_root(rm_torque_surplus, &x, wsync, &w) != 0) return -1;
   phasor_at(c, rm, vll_v, we, w, &ph);
   const cpx ir = cadd(ph.i1, ph.i2);
   const cpx psir = cadd(ph.psim, cscale(ir, rm->llr_h));

@@ -24,6 +24,45 @@ static void steady_at(const imsim_config_t *c, double m, double tr, double w, do
   *te = (double)c->pole_pairs * m / c->lr_h * (i->im * psi->re - i->re * psi->im);
 }
 
+int ims_speed_root(double (*surplus)(const void *ctx, double w), const void *ctx, double wsync, double *w)
+{
+  double hi = wsync, lo = wsync;
+  if (surplus(ctx, hi) < 0.0) {
+    int k = 0;
+    for (k = 1; k <= 4000; ++k) {
+      lo = wsync * (1.0 - (double)k / 4000.0);
+      if (surplus(ctx, lo) > 0.0) break;
+      hi = lo;
+    }
+    if (k > 4000) return -1;
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      if (surplus(ctx, mid) > 0.0)
+        lo = mid;
+      else
+        hi = mid;
+    }
+  }
+  /* no load and no friction: synchronous speed */
+  *w = 0.5 * (lo + hi);
+  return 0;
+}
+
+/* The linear machine's torque surplus at speed w (ims_speed_root). */
+typedef struct {
+  const imsim_config_t *c;
+  double m, vll_v, we, load_nm;
+} lin_ctx_t;
+
+static double lin_torque_surplus(const void *ctx, double w)
+{
+  const lin_ctx_t *x = (const lin_ctx_t *)ctx;
+  cpx i, psi;
+  double te;
+  steady_at(x->c, x->m, x->c->tr_s, w, x->vll_v, x->we, &i, &psi, &te);
+  return te - x->load_nm - x->c->b_nms * w;
+}
+
 int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, double load_nm,
                        imsim_steady_t *out)
 {
@@ -38,30 +77,9 @@ int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, do
   const double wsync = we / (double)c->pole_pairs;
   cpx i, psi;
   double te;
-#define F_OF(wv) (steady_at(c, m, c->tr_s, (wv), vll_v, we, &i, &psi, &te), te - load_nm - c->b_nms * (wv))
-  double hi = wsync, lo = wsync;
-  double fhi = F_OF(hi);
-  if (fhi >= 0.0) {
-    /* no load and no friction: synchronous speed */
-    lo = hi;
-  } else {
-    int k = 0;
-    for (k = 1; k <= 4000; ++k) {
-      lo = wsync * (1.0 - (double)k / 4000.0);
-      if (F_OF(lo) > 0.0) break;
-      hi = lo;
-    }
-    if (k > 4000) return -1;
-    for (int it = 0; it < 200; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      if (F_OF(mid) > 0.0)
-        lo = mid;
-      else
-        hi = mid;
-    }
-  }
-#undef F_OF
-  const double w = 0.5 * (lo + hi);
+  const lin_ctx_t x = {c, m, vll_v, we, load_nm};
+  double w;
+  if (ims_speed_root(lin_torque_surplus, &x, wsync, &w) != 0) return -1;
   steady_at(c, m, c->tr_s, w, vll_v, we, &i, &psi, &te);
   out->speed_rad_s = w;
   out->speed_rpm = w * 60.0 / (2.0 * PI);
