@@ -123,7 +123,7 @@ typedef struct {
 } imest_combo_t;
 
 /** Estimator instance. All fields are private; sizes are what the ISR needs.
- *  sizeof(imest_t) is 1928 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
+ *  sizeof(imest_t) is 1936 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
  *  fw/README.md) and on an x86-64 host too (every member is 32-bit: no pointers, no padding that
  *  differs); the test tools_documented_defaults checks this figure against the host's sizeof. */
 typedef struct {
@@ -181,6 +181,7 @@ typedef struct {
   uint32_t ls_check;         /* L_S measured at no load: 0 not yet, 1 agrees, 2 differs (latched) */
   imest_inverter_t inverter; /* as configured: the R_S verdict weighs its uncertainty */
   float pwm_hz;
+  float t_stair_s;    /* the phase input's staircase period [s]: 1 / pwm_hz, 0 for a smooth source */
   float noise_g[6];   /* the front end's noise gains (bg_noise.h) */
   float w_prev_rad_s; /* the previous processed window's mean speed (noise model) */
   uint32_t w_prev_valid;

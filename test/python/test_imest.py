@@ -281,6 +281,13 @@ class BadInput(unittest.TestCase):
             self.imest.Config(pole_pairs=2.5)
         with self.assertRaises(ValueError):
             self.imest.Config(pwm_timing="middle")
+        self.assertEqual(self.imest.Config(voltage_kind="smooth").voltage_kind, 1)
+        self.assertEqual(self.imest.Config().voltage_kind, 0)
+        with self.assertRaises(ValueError):
+            self.imest.Config(voltage_kind="sine")
+        with self.assertRaises(ValueError) as cm:
+            self.imest.Config(voltage_kind=2, **MOTOR_CFG).check()
+        self.assertIn("voltage_kind", str(cm.exception))
         cfg = self.imest.Config(filter_hz=5000, **MOTOR_CFG)
         with self.assertRaises(ValueError) as cm:
             self.imest.run(cfg, t=self.t, u=self.u, i=self.i, theta=self.theta)
