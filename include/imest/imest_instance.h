@@ -140,6 +140,10 @@ typedef struct {
   imest_real_t dly_u;      /* voltage leads: voltage delayed by this fraction of a sample */
   imest_real_t dcb_a;      /* offset high-pass: mean-tracking gain per sample */
   imest_duty_model_t duty; /* duty-cycle input */
+  /* the voltage's staircase period [s] by input, indexed by a window's duty_input (the error
+     bounds): [0] phase voltages, 1 / pwm_hz or 0 for a smooth source (voltage_kind); [1] duties,
+     1 / pwm_hz */
+  float t_stair_s[2];
   /* ISR: written and read only by the ISR calls. The filter of each channel: */
   imest_chan_t f_ux, f_uy, f_ix, f_iy, f_w;
   imest_real_t aa_s1, aa_s2;     /* anti-alias model state (speed) */
@@ -181,7 +185,6 @@ typedef struct {
   uint32_t ls_check;         /* L_S measured at no load: 0 not yet, 1 agrees, 2 differs (latched) */
   imest_inverter_t inverter; /* as configured: the R_S verdict weighs its uncertainty */
   float pwm_hz;
-  float t_stair_s;    /* the phase input's staircase period [s]: 1 / pwm_hz, 0 for a smooth source */
   float noise_g[6];   /* the front end's noise gains (bg_noise.h) */
   float w_prev_rad_s; /* the previous processed window's mean speed (noise model) */
   uint32_t w_prev_valid;

@@ -163,7 +163,7 @@ static void systematic_bounds(const imest_t *s, const imest_window_t *w, const o
   const float k = we * ls * slip_rate * (1.0f - sg) / (den * den);
   const float dr = k * (1.0f - a * a), di = k * (-2.0f * a);
   const float tau = 2.0f * s->timing_uncertainty_s;
-  const float t_pwm = w->duty_input ? 1.0f / s->pwm_hz : s->t_stair_s; /* 0: a smooth source */
+  const float t_pwm = s->t_stair_s[w->duty_input]; /* duty_input is 0 or 1; 0: a smooth source */
   const float share = (w->duty_input && s->duty.zoh > 0.0f) ? 0.3f : 1.0f;
   const float eps = share * fabsf(we) * t_pwm * t_pwm / (12.0f * sg * ls);
   const float dzr = fabsf(we) * tau * fabsf(zi) + eps * 2.0f * fabsf(zr * zi);
