@@ -183,6 +183,25 @@ typedef enum {
   IMEST_PWM_LAST_PERIOD = 2 /**< applied during [t_k - T, t_k): the period that just ended */
 } imest_pwm_timing_t;
 
+/** What the phase voltages passed to imest_isr_abc() / imest_isr_ab() look like between samples:
+ *  it sets the PWM staircase's share of R_S's (and T_R's) error bound, docs/METHOD.md §17.2.
+ *  Configured, not detected from the data. The duty-cycle input (imest_isr_duty) is a staircase
+ *  at pwm_hz by construction, whatever this says. */
+typedef enum {
+  /** a PWM staircase at pwm_hz (an inverter's phase voltages sampled unfiltered; default): the bound
+   *  takes the staircase's aliased images in full (the source may be smooth, so they are not
+   *  corrected) */
+  IMEST_VOLTAGE_STAIRCASE = 0,
+  /** sinusoidal or filtered (a line-fed motor, a voltage channel behind a filter well below the
+   *  carrier): no staircase images, their share of the bound is 0. Set on a PWM staircase, the
+   *  bound misses the staircase's error and R_S reads as valid while low by what it is
+   *  uncorrected (docs/METHOD.md §17.2: 4 kW at 4 kHz, rated speed, -10 %; 11 kW -21 %). The
+   *  default on a smooth source is the opposite mistake, only conservative: R_S is rs_uncertain
+   *  wherever the staircase's share lifts its bound above rs_tolerance (high speed, large
+   *  motors, slow sampling; 4 kW at 4 kHz: every window) */
+  IMEST_VOLTAGE_SMOOTH = 1
+} imest_voltage_kind_t;
+
 /** The inverter's voltage error per leg, for the duty-cycle input: how much less a
  *  leg delivers than its commanded d * V_dc, for the phase current i (into the motor):
  *
@@ -254,10 +273,14 @@ typedef struct {
   /* Duty-cycle input (imest_isr_duty). */
   /** carrier frequency [Hz] (default 0: fs_hz, one sample per period). Both inputs: the PWM
    *  staircase's share of the T_R and R_S error bounds scales with its period squared (a fast carrier:
-   *  its rate; a sine source: a rate far above fs_hz) */
+   *  its rate; a sine source or filtered voltages: voltage_kind) */
   float pwm_hz;
   imest_pwm_timing_t pwm_timing; /**< when the duties passed with a sample apply (default NEXT_PERIOD) */
-  imest_inverter_t inverter;     /**< the inverter's voltage error (default: unknown) */
+  /** phase-voltage input (imest_isr_abc, imest_isr_ab): a PWM staircase or a smooth source, for
+   *  the error bounds (default IMEST_VOLTAGE_STAIRCASE); the duty input is a staircase whatever
+   *  this says */
+  imest_voltage_kind_t voltage_kind;
+  imest_inverter_t inverter; /**< the inverter's voltage error (default: unknown) */
 
   /* Solve and selection. */
   /** nominal T_R, used for scaling and the first centring (default 0.1 s) */

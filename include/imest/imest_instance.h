@@ -123,7 +123,7 @@ typedef struct {
 } imest_combo_t;
 
 /** Estimator instance. All fields are private; sizes are what the ISR needs.
- *  sizeof(imest_t) is 1928 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
+ *  sizeof(imest_t) is 1936 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
  *  fw/README.md) and on an x86-64 host too (every member is 32-bit: no pointers, no padding that
  *  differs); the test tools_documented_defaults checks this figure against the host's sizeof. */
 typedef struct {
@@ -140,6 +140,10 @@ typedef struct {
   imest_real_t dly_u;      /* voltage leads: voltage delayed by this fraction of a sample */
   imest_real_t dcb_a;      /* offset high-pass: mean-tracking gain per sample */
   imest_duty_model_t duty; /* duty-cycle input */
+  /* the voltage's staircase period [s] by input, indexed by a window's duty_input (the error
+     bounds): [0] phase voltages, 1 / pwm_hz or 0 for a smooth source (voltage_kind); [1] duties,
+     1 / pwm_hz */
+  float t_stair_s[2];
   /* ISR: written and read only by the ISR calls. The filter of each channel: */
   imest_chan_t f_ux, f_uy, f_ix, f_iy, f_w;
   imest_real_t aa_s1, aa_s2;     /* anti-alias model state (speed) */

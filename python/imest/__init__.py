@@ -86,7 +86,8 @@ class Config:
     """An estimator config: every imest_config_t field, with imest_config_default()'s values
     (read from the library, so they cannot drift). Set fields as keywords or attributes; a nested
     field takes an underscore for its dot (inverter_dead_time_s) or its C name as a key
-    (cfg["inverter.dead_time_s"]). pwm_timing takes "next", "centred" or "last".
+    (cfg["inverter.dead_time_s"]). pwm_timing takes "next", "centred" or "last"; voltage_kind
+    "staircase" or "smooth" (or IMEST_VOLTAGE_STAIRCASE's 0, IMEST_VOLTAGE_SMOOTH's 1).
 
     Fields you set are "given": run() keeps them as they are. For the others it applies
     imest-replay's rules (the sample rate, the ADC limits, the speed limit, the at-rest start, the
@@ -156,6 +157,10 @@ class Config:
         _check(self._values)
 
 
+# imest_voltage_kind_t by imest-replay's --voltage-kind words
+_VOLTAGE_KINDS = {"staircase": 0, "smooth": 1}
+
+
 def _coerce(c, value):
     kind = _KIND[c]
     if kind == KIND_PWM_TIMING and isinstance(value, str):
@@ -163,6 +168,10 @@ def _coerce(c, value):
         if code < 0:
             raise ValueError("imest.Config: pwm_timing takes 'next', 'centred' or 'last', not %r" % value)
         return code
+    if c == "voltage_kind" and isinstance(value, str):
+        if value not in _VOLTAGE_KINDS:
+            raise ValueError("imest.Config: voltage_kind takes 'staircase' or 'smooth', not %r" % value)
+        return _VOLTAGE_KINDS[value]
     if isinstance(value, (bool, np.bool_)) and kind != KIND_INT:
         raise TypeError("imest.Config: %s takes a number, not %r" % (c, value))
     try:
@@ -380,6 +389,9 @@ def _replay_config(cfg, fs, duty, u, i, theta):
     elif "u_limit_v" in given:
         raise ValueError("imest.run: u_limit_v applies to measured phase voltages; with duty= the voltage "
                          "comes from the duty cycles and has no ADC to clip")
+    elif values["voltage_kind"] == _VOLTAGE_KINDS["smooth"]:
+        raise ValueError("imest.run: voltage_kind smooth applies to measured phase voltages; the voltage "
+                         "formed from the duty cycles is a PWM staircase by construction")
     values["fs_hz"] = fs
     if "speed_limit_rad_s" not in given:
         values["speed_limit_rad_s"] = float(min(np.float32(values["speed_limit_rad_s"]), np.float32(2.0 * fs)))

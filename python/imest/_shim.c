@@ -43,6 +43,7 @@ enum { KIND_FLOAT = 0, KIND_INT = 1, KIND_UINT = 2, KIND_PWM_TIMING = 3, KIND_RE
   X(start_at_rest, KIND_INT)                                                                                 \
   X(pwm_hz, KIND_FLOAT)                                                                                      \
   X(pwm_timing, KIND_PWM_TIMING)                                                                             \
+  X(voltage_kind, KIND_INT)                                                                                  \
   X(inverter.dead_time_s, KIND_FLOAT)                                                                        \
   X(inverter.v_switch_v, KIND_FLOAT)                                                                         \
   X(inverter.r_switch_ohm, KIND_FLOAT)                                                                       \

@@ -43,6 +43,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->speed_limit_rad_s = 3000.0f;
   cfg->pwm_hz = 0.0f;
   cfg->pwm_timing = IMEST_PWM_NEXT_PERIOD;
+  cfg->voltage_kind = IMEST_VOLTAGE_STAIRCASE;
   cfg->inverter.dead_time_s = 0.0f;
   cfg->inverter.v_switch_v = 0.0f;
   cfg->inverter.r_switch_ohm = 0.0f;
@@ -156,6 +157,8 @@ int imest_config_check(const imest_config_t *cfg, const char **field)
   else if (!(cfg->pwm_timing == IMEST_PWM_NEXT_PERIOD || cfg->pwm_timing == IMEST_PWM_CENTRED ||
              cfg->pwm_timing == IMEST_PWM_LAST_PERIOD))
     bad = "pwm_timing";
+  else if ((unsigned int)cfg->voltage_kind > (unsigned int)IMEST_VOLTAGE_SMOOTH)
+    bad = "voltage_kind";
   else if (!(cfg->inverter.dead_time_s * pwm < 0.5f))
     bad = "inverter.dead_time_s";
   else if (!(cfg->timing_uncertainty_s * fs < 1.0f))
@@ -353,6 +356,8 @@ static void init_background_constants(imest_t *s, const imest_config_t *cfg)
   s->tr_nominal_known = cfg->tr_nominal_known != 0;
   s->inverter = cfg->inverter;
   s->pwm_hz = cfg->pwm_hz > 0.0f ? cfg->pwm_hz : cfg->fs_hz;
+  s->t_stair_s[1] = 1.0f / s->pwm_hz;
+  s->t_stair_s[0] = cfg->voltage_kind == IMEST_VOLTAGE_SMOOTH ? 0.0f : s->t_stair_s[1];
 }
 
 int imest_init(imest_t *s, const imest_config_t *cfg)

@@ -55,6 +55,16 @@ TEST(Handoff, InitRejectsBadConfigNamingTheField)
   cfg.filter_hz = 3000;
   EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_ERR_CONFIG);
   EXPECT_STREQ(field, "filter_hz");
+  cfg = small_config();
+  EXPECT_EQ(cfg.voltage_kind, IMEST_VOLTAGE_STAIRCASE);
+  cfg.voltage_kind = IMEST_VOLTAGE_SMOOTH;
+  EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_OK);
+  cfg.voltage_kind = (imest_voltage_kind_t)2;
+  EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(field, "voltage_kind");
+  cfg.voltage_kind = (imest_voltage_kind_t)-1;
+  EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(field, "voltage_kind");
 }
 
 TEST(Handoff, IsrSignalsExactlyAtWindowEnds)

@@ -8,7 +8,7 @@
 
 #include "imest/imest.h"
 
-_Static_assert(sizeof(imest_config_t) == 41 * sizeof(float),
+_Static_assert(sizeof(imest_config_t) == 42 * sizeof(float),
                "imest_config_t changed: list the new field below");
 
 #define F(name) printf(#name " %a\n", (double)cfg.name)
@@ -32,6 +32,7 @@ int main(void)
   I(start_at_rest);
   F(pwm_hz);
   I(pwm_timing);
+  I(voltage_kind);
   F(inverter.dead_time_s);
   F(inverter.v_switch_v);
   F(inverter.r_switch_ohm);

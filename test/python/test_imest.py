@@ -114,6 +114,18 @@ class Replay(unittest.TestCase):
         self.same(self.ideal, replay(self.ideal), w, "phase input")
         self.assertTrue(w["valid"][1:].all(), "the rated-load windows after the first are valid")
 
+    def test_smooth_voltage_kind(self):
+        # the setting reaches the library as replay's option does (the bounds shrink: rs_bound_rel
+        # differs), and the duty input refuses it
+        d = read_csv(self.ideal)
+        w = self.imest.run(self.imest.Config(voltage_kind="smooth", **MOTOR_CFG), **self.arrays(d, False))
+        self.same(self.ideal, replay(self.ideal, "--voltage-kind", "smooth"), w, "smooth phase input")
+        stair = self.imest.run(self.imest.Config(**MOTOR_CFG), **self.arrays(d, False))
+        self.assertTrue((w["rs_bound_rel"][1:] < stair["rs_bound_rel"][1:]).all())
+        with self.assertRaises(ValueError) as cm:
+            self.imest.run(self.imest.Config(voltage_kind="smooth", **MOTOR_CFG), **self.arrays(read_csv(self.dt), True))
+        self.assertIn("voltage_kind", str(cm.exception))
+
     def test_duty_cycles_with_the_inverter_model(self):
         # the dead time given without its uncertainty: replay takes 0.2, and so must the module
         d = read_csv(self.dt)
@@ -281,6 +293,13 @@ class BadInput(unittest.TestCase):
             self.imest.Config(pole_pairs=2.5)
         with self.assertRaises(ValueError):
             self.imest.Config(pwm_timing="middle")
+        self.assertEqual(self.imest.Config(voltage_kind="smooth").voltage_kind, 1)
+        self.assertEqual(self.imest.Config().voltage_kind, 0)
+        with self.assertRaises(ValueError):
+            self.imest.Config(voltage_kind="sine")
+        with self.assertRaises(ValueError) as cm:
+            self.imest.Config(voltage_kind=2, **MOTOR_CFG).check()
+        self.assertIn("voltage_kind", str(cm.exception))
         cfg = self.imest.Config(filter_hz=5000, **MOTOR_CFG)
         with self.assertRaises(ValueError) as cm:
             self.imest.run(cfg, t=self.t, u=self.u, i=self.i, theta=self.theta)

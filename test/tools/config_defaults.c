@@ -75,6 +75,9 @@ int main(void)
   printf("pwm_timing %s\n", c.pwm_timing == IMEST_PWM_NEXT_PERIOD ? "NEXT_PERIOD"
                             : c.pwm_timing == IMEST_PWM_CENTRED   ? "CENTRED"
                                                                   : "LAST_PERIOD");
+  printf("voltage_kind %s\n", c.voltage_kind == IMEST_VOLTAGE_STAIRCASE ? "IMEST_VOLTAGE_STAIRCASE"
+                              : c.voltage_kind == IMEST_VOLTAGE_SMOOTH  ? "IMEST_VOLTAGE_SMOOTH"
+                                                                        : "?");
   /* the T_R tracker's defaults (imest_tracker.h), as tracker.NAME; the nominal T_R is the
      caller's argument, not a default */
   imest_tracker_config_t t;

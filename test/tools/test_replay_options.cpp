@@ -123,6 +123,12 @@ TEST(ReplayOptions, PhaseInputKeepsTheLibraryDefaults)
   EXPECT_FLOAT_EQ(p.o.cfg.timing_uncertainty_s, lib.timing_uncertainty_s);
   EXPECT_FLOAT_EQ(p.o.cfg.rs_nominal_ohm, lib.rs_nominal_ohm);
   EXPECT_EQ(parse({"--pwm-timing", "next"}).rc, TOOL_EXIT_USAGE);
+  EXPECT_EQ(p.o.cfg.voltage_kind, lib.voltage_kind);
+  EXPECT_EQ(parse({"--voltage-kind", "smooth"}).o.cfg.voltage_kind, IMEST_VOLTAGE_SMOOTH);
+  EXPECT_EQ(parse({"--voltage-kind=staircase"}).o.cfg.voltage_kind, IMEST_VOLTAGE_STAIRCASE);
+  EXPECT_EQ(parse({"--voltage-kind", "sine"}).rc, TOOL_EXIT_USAGE);
+  EXPECT_EQ(parse({"--voltage", "duty", "--voltage-kind", "smooth"}).rc, TOOL_EXIT_USAGE);
+  EXPECT_EQ(parse({"--voltage", "duty", "--voltage-kind", "staircase"}).rc, -1);
   EXPECT_EQ(parse({"--inverter-uncertainty", "0.1"}).rc, TOOL_EXIT_USAGE);
   EXPECT_EQ(parse({"--voltage", "duty", "--u-limit", "auto"}).rc, -1); // the default: nothing to refuse
   EXPECT_EQ(parse({"--voltage", "duty", "--u-limit", "400"}).rc, TOOL_EXIT_USAGE);

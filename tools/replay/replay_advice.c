@@ -135,7 +135,8 @@ const char *replay_remedy(int status)
     return "R_S's error bound exceeds --rs-tolerance (T_R may still be valid: see the tr_valid "
            "column). With --voltage duty give the inverter's numbers (--dead-time, --v-switch, "
            "--v-diode ...) and how well they are known (--inverter-uncertainty); check "
-           "--pwm-timing and --u-delay";
+           "--pwm-timing and --u-delay. Measured voltages from a sine source or a filtered "
+           "channel (no PWM staircase): --voltage-kind smooth";
   case IMEST_REASON_TR_UNCERTAIN:
     return "T_R's error bound exceeds --tr-tolerance: light load at high speed, where the "
            "PWM staircase's aliased current (or the timing) moves T_R; a load of 25 % or more, "
@@ -143,7 +144,7 @@ const char *replay_remedy(int status)
            "error bounds T_R too (its harmonics, at least 20 % of the modelled error): more "
            "load, or a smaller error (shorter dead time, lower drops), gives valid windows. "
            "With measured voltages from a PWM faster than the samples give its rate with "
-           "--pwm-hz";
+           "--pwm-hz; from a sine source or a filtered channel, --voltage-kind smooth";
   case IMEST_REASON_GAIN_MISMATCH:
     return "the three current sensors' gains differ by more than R_S tolerates: calibrate them";
   default: return NULL;

@@ -58,6 +58,12 @@ static void usage(FILE *o)
              "                      the PWM period that just ended at 10 kHz)\n"
              "  --pwm-hz HZ         carrier frequency when it is faster than the sample rate\n"
              "                      (default: the sample rate, one sample per period)\n"
+             "  --voltage-kind staircase|smooth  what the measured phase voltages look like:\n"
+             "                      staircase = a PWM inverter's, sampled unfiltered (default);\n"
+             "                      smooth = a sine source (line-fed motor) or a voltage channel\n"
+             "                      filtered well below the carrier: no PWM staircase share in\n"
+             "                      the R_S and T_R error bounds (smooth on a staircase: R_S\n"
+             "                      reads valid but up to 10 %% low). Not with --voltage duty\n"
              "duty cycles and the inverter (--voltage duty only):\n"
              "  --pwm-timing next|centred|last  when row k's duties apply: next = during\n"
              "                      [t_k, t_k+1) (default: computed one ISR earlier, loaded at\n"
@@ -222,6 +228,10 @@ const char *replay_option_of(const replay_opts_t *o, const char *field, int *is_
     *is_given = 1;
     return "--pwm-timing";
   }
+  if (strcmp(field, "voltage_kind") == 0) {
+    *is_given = 1;
+    return "--voltage-kind";
+  }
   *is_given = 0;
   return NULL;
 }
@@ -235,6 +245,13 @@ static int check_input_options(const replay_opts_t *o, int pwm_timing_given)
       fprintf(stderr,
               "%s: --u-limit applies to measured phase voltages; with --voltage duty the voltage "
               "comes from the duty cycles and has no ADC to clip\n",
+              k_prog);
+      return TOOL_EXIT_USAGE;
+    }
+    if (o->cfg.voltage_kind == IMEST_VOLTAGE_SMOOTH) {
+      fprintf(stderr,
+              "%s: --voltage-kind smooth applies to measured phase voltages; the voltage formed "
+              "from the duty cycles is a PWM staircase by construction\n",
               k_prog);
       return TOOL_EXIT_USAGE;
     }
@@ -370,6 +387,17 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
         return TOOL_EXIT_USAGE;
       }
       pwm_timing_given = 1;
+    } else if (tool_args_is(&a, "--voltage-kind")) {
+      const char *v = tool_args_value(&a);
+      if (v == NULL) return TOOL_EXIT_USAGE;
+      if (!strcmp(v, "staircase"))
+        o->cfg.voltage_kind = IMEST_VOLTAGE_STAIRCASE;
+      else if (!strcmp(v, "smooth"))
+        o->cfg.voltage_kind = IMEST_VOLTAGE_SMOOTH;
+      else {
+        fprintf(stderr, "%s: --voltage-kind takes staircase or smooth, not '%s'\n", k_prog, v);
+        return TOOL_EXIT_USAGE;
+      }
     } else if (tool_args_is(&a, "--fs")) {
       if (tool_args_number(&a, &o->fs_hz)) return TOOL_EXIT_USAGE;
       if (!(o->fs_hz > 0.0) || o->fs_hz > 1e6) {

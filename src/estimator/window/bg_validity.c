@@ -134,8 +134,10 @@ static float voltage_uncertainty(const imest_t *s, const imest_window_t *w, cons
  *   -(T^2 / 12 sigma L_S) du/dt to the sampled current: the admittance gains
  *   -j eps, eps = we T^2 / (12 sigma L_S), so Z gains j eps Z^2 and Re Z
  *   -2 eps Re Z Im Z, all of it R_S. With measured phase voltages (not
- *   corrected: the source may be smooth) the whole effect is uncertain; the
- *   duty input corrects it to within about 20 % (measured), 30 % is kept.
+ *   corrected: the source may be smooth) the whole effect is uncertain, unless
+ *   the config says the source is smooth (voltage_kind: t_stair_s 0, no
+ *   images); the duty input corrects it to within about 20 % (measured),
+ *   30 % is kept.
  *   Measured on 11 kW at rated speed, half load, 8 kHz: R_S -8.3 %; this
  *   term says 9 %. It scales with (we T)^2 and |Z|^2 / R_S: high speed,
  *   large motors, light load.
@@ -161,7 +163,7 @@ static void systematic_bounds(const imest_t *s, const imest_window_t *w, const o
   const float k = we * ls * slip_rate * (1.0f - sg) / (den * den);
   const float dr = k * (1.0f - a * a), di = k * (-2.0f * a);
   const float tau = 2.0f * s->timing_uncertainty_s;
-  const float t_pwm = 1.0f / s->pwm_hz;
+  const float t_pwm = s->t_stair_s[w->duty_input]; /* duty_input is 0 or 1; 0: a smooth source */
   const float share = (w->duty_input && s->duty.zoh > 0.0f) ? 0.3f : 1.0f;
   const float eps = share * fabsf(we) * t_pwm * t_pwm / (12.0f * sg * ls);
   const float dzr = fabsf(we) * tau * fabsf(zi) + eps * 2.0f * fabsf(zr * zi);
