@@ -157,3 +157,36 @@ def write_csv(path, rows, cols=None):
         wr.writeheader()
         for r in rows:
             wr.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+
+
+REAL_TR, REAL_RS = 0.02, 0.05  # the product promise: a valid T_R within 2 %, a valid R_S within 5 %
+
+
+def real_stats(ws):
+    """Counts of the real-motor table for the windows ws: valid, valid and within the promise,
+    valid and outside it (the confident wrong numbers; a valid non-number counts), the worst
+    valid error (relative, signed) and the median error of all windows."""
+    def one(key, e, lim):
+        v = [w for w in ws if w[key]]
+        errs = [w[e] if math.isfinite(w[e]) else math.inf for w in v]
+        worst = max(errs, key=abs) if errs else math.nan
+        return {f"{key[:2]}_valid": len(v),
+                f"{key[:2]}_within": sum(abs(x) <= lim for x in errs),
+                f"{key[:2]}_wrong": sum(abs(x) > lim for x in errs),
+                f"{key[:2]}_worst": worst,
+                f"{key[:2]}_median_all": median([w[e] for w in ws])}
+    s = dict(windows=len(ws))
+    s.update(one("tr_valid", "e_tr", REAL_TR))
+    s.update(one("rs_valid", "e_rs", REAL_RS))
+    return s
+
+
+def real_summary(rows):
+    """family -> real_stats, in the order of points.REAL_FAMILIES."""
+    import points
+    out = {}
+    for fam, _, _ in points.REAL_FAMILIES:
+        ws = [w for w in rows if w["family"] == fam]
+        if ws:
+            out[fam] = real_stats(ws)
+    return out

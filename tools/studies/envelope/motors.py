@@ -126,3 +126,41 @@ def operating_point(m, f_pct, load_pct, inv=None, vdc=560.0, f_carrier=8000.0):
 
 def rated_current(m):
     return operating_point(m, 100.0, 100.0)[3]
+
+
+def commissioning(m, effects, sim):
+    """The constants a user's commissioning gives for motor m (a preset of MOTORS) with the
+    imest-sim real-motor flags `effects`: n_p, L_S, sigma, R_S, T_R (dict as constants()).
+
+    A standstill test gives R_S at ambient (the preset's R_S; the runs are at ambient) and the
+    leakages; a no-load test at the drive's rated voltage and frequency gives L_S = L_ls + L_m
+    with L_m the static magnetising inductance at the no-load flux. L_m is read from the
+    simulator itself: its `lm_h` column (the static L_m(|psi_m|)) in the steady state on an
+    ideal sine at m's V_ll and f, no load, ideal sensors. L_R = L_lr + L_m with the preset's
+    (DC) leakage L_lr = L_ls, sigma = 1 - L_m^2 / (L_S L_R). T_R nominal is the linear model's
+    (the preset's L_R / R_R with its M). Without effects: constants(m)."""
+    import os
+    import subprocess
+    import tempfile
+    c = constants(m)
+    if not effects.split() or m["flags"]:
+        return c
+    lls = _PRESET[m["preset"]][2]
+    fd, path = tempfile.mkstemp(suffix=".csv")
+    os.close(fd)
+    try:
+        subprocess.run([sim, "--preset", m["preset"]] + effects.split() +
+                       ["--supply", "sine", "--timing", "ideal", "--start", "steady", "--vll", f"{m['vll']:g}",
+                        "--freq", f"{m['f']:g}", "--load-nm", "0", "--ideal-sensors", "--no-thermal",
+                        "--duration", "0.02", "--no-progress", "--out", path],
+                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        with open(path) as f:
+            head = f.readline().strip().split(",")
+            k = head.index("lm_h")
+            lm = [float(line.split(",")[k]) for line in f if line.strip()]
+    finally:
+        os.remove(path)
+    lm = sum(lm) / len(lm)
+    ls = lls + lm
+    return dict(np=c["np"], ls=ls, lr=ls, sigma=1.0 - lm * lm / (ls * ls), rs=c["rs"], tr=c["tr"],
+                b=c["b"], lm=lm)

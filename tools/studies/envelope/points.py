@@ -13,6 +13,13 @@ about 7000 recordings; the design keeps what the goals need:
   that reaches the envelope's corners (5 % frequency, 10 % load).
 
 The reduced form (CTest) is a handful of points from both.
+
+The real-motor design (`real_design`, `run --real`) is a separate measurement, outside the goal
+region and the gate: the 4, 11 and 37 kW motors with the simulator's real-motor effects
+(main-flux saturation, iron loss, double cage; each alone, all three, and all three on the
+duty-cycle input with dead time), and the same points on the linear motor as the control, at
+25-100 % of rated frequency x 25-100 % of rated torque, with the goal sensors. The estimator gets
+what a standstill + no-load commissioning gives (`motors.commissioning`).
 """
 import motors
 
@@ -37,6 +44,21 @@ SWEEPS = [
 INVERTER = dict(dead_time=2e-6, v_switch=1.0, r_switch=0.02, v_diode=0.8, r_diode=0.01)
 
 
+# Real-motor families: (family, imest-sim flags, input). --real-motor sizes the three effects per
+# preset (sim/README.md, Real-motor effects); the flags after it switch the others off.
+REAL_FAMILIES = [
+    ("real_linear", "", "phase"),
+    ("real_sat", "--real-motor --iron-loss 0 --rotor single", "phase"),
+    ("real_ironloss", "--real-motor --saturation 0 --rotor single", "phase"),
+    ("real_deepbar", "--real-motor --saturation 0 --iron-loss 0", "phase"),
+    ("real_all", "--real-motor", "phase"),
+    ("real_all_duty", "--real-motor", "duty_inv"),
+]
+REAL_MOTORS = ["4kw", "11kw", "37kw"]  # presets: --real-motor needs the preset's nameplate
+REAL_FREQS = [25, 50, 75, 100]
+REAL_LOADS = [25, 50, 75, 100]
+
+
 def in_goal(p):
     return (p["sensors"] == GOAL["sensors"] and p["encoder"] == GOAL["encoder"] and
             p["input"] == GOAL["input"] and p["load_pct"] >= 25 and p["f_pct"] >= 15)
@@ -47,6 +69,49 @@ def _point(family, m, f_pct, load_pct, **kw):
     p.update(GOAL)
     p.update(kw)
     return p
+
+
+def _finish(pts, seed0=1000, family_in_name=False):
+    """Drop points the motor cannot run at, name the rest, one recording per name, seeds."""
+    out = []
+    for p in pts:
+        m = next(x for x in motors.MOTORS if x["name"] == p["motor"])
+        inv = INVERTER if p["input"] == "duty_inv" else None  # the drive makes up its error
+        f_hz, vll, load, i_ab, wm = motors.operating_point(m, p["f_pct"], p["load_pct"], inv, m["vdc"])
+        if wm <= 0.0:
+            continue
+        p.update(f_hz=f_hz, vll=vll, load_nm=load, speed_rad_s=wm, goal=in_goal(p))
+        p["name"] = ("{family}_" if family_in_name else "").format(**p) + \
+            "{motor}_f{f_pct}_l{load_pct}_{sensors}_e{encoder}_{input}".format(**p)
+        out.append(p)
+    seen, uniq = set(), []
+    for p in out:
+        if p["name"] not in seen:
+            seen.add(p["name"])
+            uniq.append(p)
+    for k, p in enumerate(uniq):
+        p["seed"] = seed0 + k
+    return uniq
+
+
+def real_design():
+    """The real-motor points (dicts with `effects`, the imest-sim flags); never in the goal
+    region (goal False), so never in the envelope's summary lines or its gate."""
+    pts = []
+    mm = {m["name"]: m for m in motors.MOTORS}
+    for fam, effects, inp in REAL_FAMILIES:
+        for name in REAL_MOTORS:
+            for f in REAL_FREQS:
+                for ld in REAL_LOADS:
+                    p = _point(fam, mm[name], f, ld, input=inp)
+                    p["effects"] = effects
+                    pts.append(p)
+    out = _finish(pts, seed0=5000, family_in_name=True)
+    keys = sorted({(p["motor"], p["f_pct"], p["load_pct"]) for p in out})
+    for p in out:  # the same noise at the same operating point in every family
+        p["goal"] = False
+        p["seed"] = 5000 + keys.index((p["motor"], p["f_pct"], p["load_pct"]))
+    return out
 
 
 def design(full=True):

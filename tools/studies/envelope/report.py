@@ -287,3 +287,119 @@ def render(summary, rows, table, meta):
             f"{c['tr']:.4g} | {m['vll']:g} V, {m['f']:g} Hz, {m['t_nm']:g} N m | {m['source']} |")
     add("")
     return "\n".join(L)
+
+
+def _w(x):
+    return f"{100.0 * x:+.2f} %" if math.isfinite(x) else ("–" if x != x else "not a number")
+
+
+def _real_row(label, s):
+    return (f"| {label} | {s['windows']} | {s['tr_valid']} | {s['tr_within']} | **{s['tr_wrong']}** | "
+            f"{_w(s['tr_worst'])} | {s['rs_valid']} | {s['rs_within']} | **{s['rs_wrong']}** | "
+            f"{_w(s['rs_worst'])} |")
+
+
+REAL_HEAD = ["| family | windows | T_R valid | T_R valid, within 2 % | T_R valid, > 2 % off | worst valid "
+             "e_TR | R_S valid | R_S valid, within 5 % | R_S valid, > 5 % off | worst valid e_RS |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+
+
+def render_real(fam, rows, table, meta):
+    """real-motor.md: the real-motor families against the product promise (a valid T_R within
+    2 % of what the IFOC needs, a valid R_S within 5 %)."""
+    L = ["# Operating envelope of imest: real-motor effects\n"]
+    L.append(f"Run: real-motor design on `{meta['source']}`, {meta['points']} recordings of "
+             f"{meta['duration']:g} s, {len(rows)} steady-state windows (the first {meta['skip']} "
+             f"window(s) of each recording dropped), {meta['wall_s']:.0f} s wall on {meta['jobs']} "
+             "jobs." + (f" Extra imest-replay options: `{meta['replay_args']}`." if meta["replay_args"] else "")
+             + "\n")
+    if meta["not_held"]:
+        L.append("Left out, the motor did not hold its operating point: " + ", ".join(meta["not_held"]) + ".\n")
+    L.append("Motors " + ", ".join(points.REAL_MOTORS) + "; frequency " +
+             ", ".join(map(str, points.REAL_FREQS)) + " % of rated; load " +
+             ", ".join(map(str, points.REAL_LOADS)) + " % of rated torque; goal sensors (12-bit ADCs, "
+             "1 LSB noise, 16384 counts). Truth: the simulator's `T_R_true_s` (the effective "
+             "L_R/R_R an IFOC's slip relation needs) and `R_S_true_ohm`, averaged per window. "
+             "Constants given to the estimator: those of a standstill + no-load commissioning "
+             "(tools/studies/envelope/README.md, Real-motor effects).\n")
+    L.append("| family | imest-sim flags | input |")
+    L.append("|---|---|---|")
+    for f, eff, inp in points.REAL_FAMILIES:
+        if f in fam:
+            L.append(f"| {f} | `{eff or '(linear motor)'}` | "
+                     f"{'duty cycle, 2 µs dead time + drops, model given' if inp == 'duty_inv' else 'phase voltage'} |")
+    L.append("\n## Against the promise (no valid T_R more than 2 % off, no valid R_S more than 5 % off)\n")
+    L += REAL_HEAD
+    for f, s in fam.items():
+        L.append(_real_row(f, s))
+    L.append("\nThe bold columns are the confident wrong numbers: windows the estimator marked valid "
+             "whose estimate is outside the promise.\n")
+
+    L.append("## Per motor\n")
+    L += REAL_HEAD
+    for f in fam:
+        for n in points.REAL_MOTORS:
+            ws = _sel(rows, family=f, motor=n)
+            if ws:
+                L.append(_real_row(f"{f}, {n}", analyse.real_stats(ws)))
+    L.append("")
+
+    L.append("## Median error of all windows (valid or not), e_TR / e_RS in %, by frequency x load\n")
+    L.append("In brackets: windows with T_R valid / R_S valid, of the point's windows.\n")
+    fl = sorted({(w["f_pct"], w["load_pct"]) for w in rows})
+    for n in points.REAL_MOTORS:
+        if not _sel(rows, motor=n):
+            continue
+        L.append(f"**{n}**\n")
+        L.append("| f %, load % | " + " | ".join(fam) + " |")
+        L.append("|---" * (len(fam) + 1) + "|")
+        for fp, ld in fl:
+            cells = []
+            for f in fam:
+                ws = _sel(rows, family=f, motor=n, f_pct=fp, load_pct=ld)
+                if not ws:
+                    cells.append("–")
+                    continue
+                cells.append(f"{_e(100 * analyse.median([w['e_tr'] for w in ws]), 1)} / "
+                             f"{_e(100 * analyse.median([w['e_rs'] for w in ws]), 1)}"
+                             f" ({sum(w['tr_valid'] for w in ws)}/{sum(w['rs_valid'] for w in ws)} of {len(ws)})")
+            L.append(f"| {fp}, {ld} | " + " | ".join(cells) + " |")
+        L.append("")
+
+    wrong = [r for r in rows if (r["tr_valid"] and not abs(r["e_tr"]) <= analyse.REAL_TR)
+             or (r["rs_valid"] and not abs(r["e_rs"]) <= analyse.REAL_RS)]
+    L.append(f"## Valid and outside the promise: {len(wrong)} windows\n")
+    if wrong:
+        byp = defaultdict(list)
+        for w in wrong:
+            byp[w["name"]].append(w)
+        L.append("| recording | windows | valid T_R > 2 % off | e_TR (median of those) | valid R_S > 5 % off "
+                 "| e_RS (median of those) |")
+        L.append("|---|---|---|---|---|---|")
+        for name, ws in sorted(byp.items()):
+            t = [w["e_tr"] for w in ws if w["tr_valid"] and not abs(w["e_tr"]) <= analyse.REAL_TR]
+            r = [w["e_rs"] for w in ws if w["rs_valid"] and not abs(w["e_rs"]) <= analyse.REAL_RS]
+            L.append(f"| {name} | {len(ws)} | {len(t)} | {_w(analyse.median(t)) if t else '–'} | {len(r)} | "
+                     f"{_w(analyse.median(r)) if r else '–'} |")
+        L.append("")
+
+    L.append("## Refusals\n")
+    L.append("| family | T_R refused (reasons) | R_S refused (reasons) |")
+    L.append("|---|---|---|")
+    for f in fam:
+        ws = _sel(rows, family=f)
+        tr = Counter(w["tr_reason"] for w in ws if not w["tr_valid"])
+        rs = Counter(w["rs_reason"] for w in ws if not w["rs_valid"])
+        L.append(f"| {f} | " + ", ".join(f"`{k}` {v}" for k, v in tr.most_common()) + " | " +
+                 ", ".join(f"`{k}` {v}" for k, v in rs.most_common()) + " |")
+    L.append("")
+
+    L.append("## Constants given to the estimator\n")
+    L.append("| motor, family | L_S [H] | sigma | R_S [ohm] | T_R nominal [s] | L_m at no load [H] |")
+    L.append("|---|---|---|---|---|---|")
+    for k, c in meta["constants"].items():
+        L.append(f"| {k} | {c['ls']:.6g} | {c['sigma']:.5g} | {c['rs']:.5g} | {c['tr']:.5g} | "
+                 f"{c['lm']:.6g} |" if "lm" in c else
+                 f"| {k} | {c['ls']:.6g} | {c['sigma']:.5g} | {c['rs']:.5g} | {c['tr']:.5g} | (linear) |")
+    L.append("")
+    return "\n".join(L)

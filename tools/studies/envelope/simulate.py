@@ -35,7 +35,7 @@ def sim_args(p, duration_s):
     # the bus: the motor's, raised where the point needs more than the linear range (0.97 of
     # V_dc / sqrt 2 with space-vector modulation): 150 % load at rated frequency
     vdc = max(m["vdc"], p["vll"] * 2 ** 0.5 / 0.97)
-    a = ["--preset", m["preset"]] + m["flags"].split()
+    a = ["--preset", m["preset"]] + m["flags"].split() + p.get("effects", "").split()
     a += ["--no-thermal", "--start", "steady", "--vdc", f"{vdc:.1f}",
           "--freq", f"{p['f_hz']:.6g}", "--vll", f"{p['vll']:.6g}", "--load-nm", f"{p['load_nm']:.6g}",
           "--duration", f"{duration_s:g}", "--seed", str(p["seed"]),
@@ -58,9 +58,13 @@ def inverter_flags(inv):
 
 
 def replay_args(p, extra=()):
-    c = motors.constants(motor_of(p))
+    """The estimator's options: the motor's constants (with `consts` in the point, the
+    commissioned ones of motors.commissioning, with R_S and T_R nominal), the input."""
+    c = p.get("consts") or motors.constants(motor_of(p))
     a = ["--pole-pairs", str(c["np"]), "--ls", f"{c['ls']:.7g}", "--sigma", f"{c['sigma']:.7g}",
          "--from-rest", "no", "--quiet"]
+    if p.get("consts"):
+        a += ["--rs", f"{c['rs']:.7g}", "--tr-nominal", f"{c['tr']:.7g}"]
     if p["input"] == "phase":
         # the phase voltage of the simulated drive is the volt-seconds of the sample period
         # that just ended: half a sample behind the currents
