@@ -59,6 +59,19 @@ REAL_FREQS = [25, 50, 75, 100]
 REAL_LOADS = [25, 50, 75, 100]
 
 
+
+def unique_seeded(points, seed0):
+    """One recording per name (a sweep point equal to a grid point is simulated once), seeded
+    seed0, seed0 + 1, ... in order."""
+    seen, uniq = set(), []
+    for p in points:
+        if p["name"] not in seen:
+            seen.add(p["name"])
+            uniq.append(p)
+    for k, p in enumerate(uniq):
+        p["seed"] = seed0 + k
+    return uniq
+
 def in_goal(p):
     return (p["sensors"] == GOAL["sensors"] and p["encoder"] == GOAL["encoder"] and
             p["input"] == GOAL["input"] and p["load_pct"] >= 25 and p["f_pct"] >= 15)
@@ -84,14 +97,7 @@ def _finish(pts, seed0=1000, family_in_name=False):
         p["name"] = ("{family}_" if family_in_name else "").format(**p) + \
             "{motor}_f{f_pct}_l{load_pct}_{sensors}_e{encoder}_{input}".format(**p)
         out.append(p)
-    seen, uniq = set(), []
-    for p in out:
-        if p["name"] not in seen:
-            seen.add(p["name"])
-            uniq.append(p)
-    for k, p in enumerate(uniq):
-        p["seed"] = seed0 + k
-    return uniq
+    return unique_seeded(out, seed0)
 
 
 def real_design():
@@ -149,12 +155,4 @@ def design(full=True):
         p.update(f_hz=f_hz, vll=vll, load_nm=load, speed_rad_s=wm, goal=in_goal(p))
         p["name"] = "{motor}_f{f_pct}_l{load_pct}_{sensors}_e{encoder}_{input}".format(**p)
         out.append(p)
-    # one recording per name (a sweep point equal to a grid point is simulated once)
-    seen, uniq = set(), []
-    for p in out:
-        if p["name"] not in seen:
-            seen.add(p["name"])
-            uniq.append(p)
-    for k, p in enumerate(uniq):
-        p["seed"] = 1000 + k
-    return uniq
+    return unique_seeded(out, 1000)
