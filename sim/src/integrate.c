@@ -65,6 +65,45 @@ static void piece_currents(const imsim_config_t *c, cpx i, double i_abc[3])
   imsim_ab_to_abc(iab, i_abc);
 }
 
+/* One constant-input piece of an integrator that is not the fast path (ctx: its state). */
+typedef void (*piece_fn_t)(imsim_t *s, void *ctx, double len, cpx u, const step_input_t *in, double tl);
+
+static void rm_piece(imsim_t *s, void *ctx, double len, cpx u, const step_input_t *in, double tl)
+{
+  (void)ctx;
+  ims_rm_piece(s, len, u, in, tl);
+}
+
+static void rk4_piece(imsim_t *s, void *ctx, double len, cpx u, const step_input_t *in, double tl)
+{
+  ims_rk4_piece(s, (ims_full_state_t *)ctx, len, u, in, tl);
+}
+
+/* The half period split at its switching instants, each piece integrated with the inverter's
+   voltage for the stator current at its start (*i_s, which the piece advances); the volt-seconds
+   applied go to ph->act_avg unless the inverter is ideal. */
+static void split_at_switching(imsim_t *s, pwm_half_t *ph, const cpx *i_s, piece_fn_t piece_fn, void *ctx,
+                               const step_input_t *in, double tl)
+{
+  const double h = s->h_s;
+  double b[8], vs[2] = {0.0, 0.0};
+  const int nb = ims_pwm_breaks(ph, h, b);
+  for (int piece = 0; piece < nb - 1; ++piece) {
+    const double t0 = b[piece], t1 = b[piece + 1];
+    if (t1 <= t0) continue;
+    double iabc[3];
+    piece_currents(&s->c, *i_s, iabc);
+    const cpx u = ims_pwm_piece_voltage(s, ph, 0.5 * (t0 + t1), iabc);
+    vs[0] += u.re * (t1 - t0);
+    vs[1] += u.im * (t1 - t0);
+    piece_fn(s, ctx, t1 - t0, u, in, tl);
+  }
+  if (!ims_inverter_is_ideal(&s->c)) {
+    ph->act_avg[0] = vs[0] / h;
+    ph->act_avg[1] = vs[1] / h;
+  }
+}
+
 void ims_advance(imsim_t *s, const step_input_t *in, pwm_half_t *ph, double tl)
 {
   const imsim_config_t *c = &s->c;
@@ -75,22 +114,7 @@ void ims_advance(imsim_t *s, const step_input_t *in, pwm_half_t *ph, double tl)
       ims_rm_piece(s, h, cx(0.0, 0.0), in, tl);
       return;
     }
-    double b[8], vs[2] = {0.0, 0.0};
-    const int nb = ims_pwm_breaks(ph, h, b);
-    for (int piece = 0; piece < nb - 1; ++piece) {
-      const double t0 = b[piece], t1 = b[piece + 1];
-      if (t1 <= t0) continue;
-      double iabc[3];
-      piece_currents(c, s->x[0], iabc);
-      const cpx u = ims_pwm_piece_voltage(s, ph, 0.5 * (t0 + t1), iabc);
-      vs[0] += u.re * (t1 - t0);
-      vs[1] += u.im * (t1 - t0);
-      ims_rm_piece(s, t1 - t0, u, in, tl);
-    }
-    if (!ims_inverter_is_ideal(c)) {
-      ph->act_avg[0] = vs[0] / h;
-      ph->act_avg[1] = vs[1] / h;
-    }
+    split_at_switching(s, ph, &s->x[0], rm_piece, NULL, in, tl);
     return;
   }
   if (c->integrator == IMSIM_INTEGRATOR_FAST) {
@@ -152,22 +176,7 @@ void ims_advance(imsim_t *s, const step_input_t *in, pwm_half_t *ph, double tl)
   if (!in->pwm) {
     ims_rk4_piece(s, &X, h, cx(0.0, 0.0), in, tl);
   } else {
-    double b[8], vs[2] = {0.0, 0.0};
-    const int nb = ims_pwm_breaks(ph, h, b);
-    for (int piece = 0; piece < nb - 1; ++piece) {
-      const double t0 = b[piece], t1 = b[piece + 1];
-      if (t1 <= t0) continue;
-      double iabc[3];
-      piece_currents(c, X.x[0], iabc);
-      const cpx u = ims_pwm_piece_voltage(s, ph, 0.5 * (t0 + t1), iabc);
-      vs[0] += u.re * (t1 - t0);
-      vs[1] += u.im * (t1 - t0);
-      ims_rk4_piece(s, &X, t1 - t0, u, in, tl);
-    }
-    if (!ims_inverter_is_ideal(c)) {
-      ph->act_avg[0] = vs[0] / h;
-      ph->act_avg[1] = vs[1] / h;
-    }
+    split_at_switching(s, ph, &X.x[0], rk4_piece, &X, in, tl);
   }
   for (int q = 0; q < 7; ++q) s->x[q] = X.x[q];
   s->w = X.w;
