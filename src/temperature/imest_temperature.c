@@ -8,6 +8,8 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "common/imest_range.h"
+
 void imest_temperature_config_default(imest_temperature_config_t *cfg, float t_ref_c, float rs_ref_ohm,
                                       float tr_ref_s, float ls_h)
 {
@@ -25,13 +27,6 @@ void imest_temperature_config_default(imest_temperature_config_t *cfg, float t_r
   cfg->rotor_tol_k = 5.0f;
 }
 
-/* x finite and lo <= x <= hi (lo_open: lo < x). */
-static int in_range(float x, float lo, int lo_open, float hi)
-{
-  if (!isfinite(x) || x > hi) return 0;
-  return lo_open ? x > lo : x >= lo;
-}
-
 int imest_temperature_config_check(const imest_temperature_config_t *cfg, const char **field)
 {
   const char *bad = NULL;
@@ -39,27 +34,27 @@ int imest_temperature_config_check(const imest_temperature_config_t *cfg, const 
     if (field) *field = "cfg";
     return IMEST_ERR_NULL;
   }
-  if (!in_range(cfg->t_ref_c, -60.0f, 0, 200.0f))
+  if (!imest__in_range(cfg->t_ref_c, -60.0f, 0, 200.0f))
     bad = "t_ref_c";
-  else if (!in_range(cfg->t_ref_uncert_k, 0.0f, 0, 50.0f))
+  else if (!imest__in_range(cfg->t_ref_uncert_k, 0.0f, 0, 50.0f))
     bad = "t_ref_uncert_k";
-  else if (!in_range(cfg->rs_ref_ohm, 0.0f, 1, 3.0e38f))
+  else if (!imest__in_range(cfg->rs_ref_ohm, 0.0f, 1, 3.0e38f))
     bad = "rs_ref_ohm";
-  else if (!in_range(cfg->rs_ref_bound_rel, 0.0f, 0, 0.5f))
+  else if (!imest__in_range(cfg->rs_ref_bound_rel, 0.0f, 0, 0.5f))
     bad = "rs_ref_bound_rel";
-  else if (!in_range(cfg->tr_ref_s, 0.0f, 1, 3.0e38f))
+  else if (!imest__in_range(cfg->tr_ref_s, 0.0f, 1, 3.0e38f))
     bad = "tr_ref_s";
-  else if (!in_range(cfg->tr_ref_bound_rel, 0.0f, 0, 0.5f))
+  else if (!imest__in_range(cfg->tr_ref_bound_rel, 0.0f, 0, 0.5f))
     bad = "tr_ref_bound_rel";
-  else if (!in_range(cfg->lr_h, 0.0f, 1, 3.0e38f))
+  else if (!imest__in_range(cfg->lr_h, 0.0f, 1, 3.0e38f))
     bad = "lr_h";
-  else if (!in_range(cfg->stator_k_c, 100.0f, 0, 1000.0f))
+  else if (!imest__in_range(cfg->stator_k_c, 100.0f, 0, 1000.0f))
     bad = "stator_k_c";
-  else if (!in_range(cfg->rotor_k_c, 100.0f, 0, 1000.0f))
+  else if (!imest__in_range(cfg->rotor_k_c, 100.0f, 0, 1000.0f))
     bad = "rotor_k_c";
-  else if (!in_range(cfg->stator_tol_k, 0.0f, 1, 1000.0f))
+  else if (!imest__in_range(cfg->stator_tol_k, 0.0f, 1, 1000.0f))
     bad = "stator_tol_k";
-  else if (!in_range(cfg->rotor_tol_k, 0.0f, 1, 1000.0f))
+  else if (!imest__in_range(cfg->rotor_tol_k, 0.0f, 1, 1000.0f))
     bad = "rotor_tol_k";
   if (field) *field = bad;
   return bad == NULL ? IMEST_OK : IMEST_ERR_CONFIG;

@@ -7,6 +7,8 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "common/imest_range.h"
+
 /* |y - x| <= (max(bx + by, floor) + rate |dt|) x: the two values differ by no more than their
    bounds plus the drift the rate limit allows between them (imest_tracker_update()). */
 static int agree(const imest_tracker_config_t *c, float x, float bx, float y, float by, float dt_s)
@@ -49,13 +51,6 @@ void imest_tracker_config_default(imest_tracker_config_t *cfg, float tr_nominal_
   cfg->acquire_jump = 1;
 }
 
-/* x finite and lo <= x <= hi (lo_open: lo < x). */
-static int in_range(float x, float lo, int lo_open, float hi)
-{
-  if (!isfinite(x) || x > hi) return 0;
-  return lo_open ? x > lo : x >= lo;
-}
-
 int imest_tracker_config_check(const imest_tracker_config_t *cfg, const char **field)
 {
   const char *bad = NULL;
@@ -63,17 +58,17 @@ int imest_tracker_config_check(const imest_tracker_config_t *cfg, const char **f
     if (field) *field = "cfg";
     return IMEST_ERR_NULL;
   }
-  if (!in_range(cfg->tr_nominal_s, 0.0f, 1, 3.0e38f))
+  if (!imest__in_range(cfg->tr_nominal_s, 0.0f, 1, 3.0e38f))
     bad = "tr_nominal_s";
-  else if (!in_range(cfg->nominal_bound_rel, 0.0f, 0, 10.0f))
+  else if (!imest__in_range(cfg->nominal_bound_rel, 0.0f, 0, 10.0f))
     bad = "nominal_bound_rel";
-  else if (!in_range(cfg->rate_rel_per_s, 0.0f, 1, 1.0f))
+  else if (!imest__in_range(cfg->rate_rel_per_s, 0.0f, 1, 1.0f))
     bad = "rate_rel_per_s";
-  else if (!in_range(cfg->stale_after_s, 0.0f, 1, 3.0e38f))
+  else if (!imest__in_range(cfg->stale_after_s, 0.0f, 1, 3.0e38f))
     bad = "stale_after_s";
-  else if (!in_range(cfg->fallback_rel_per_s, 0.0f, 0, 1.0f))
+  else if (!imest__in_range(cfg->fallback_rel_per_s, 0.0f, 0, 1.0f))
     bad = "fallback_rel_per_s";
-  else if (!in_range(cfg->gate_min_rel, 0.0f, 0, 1.0f) || cfg->gate_min_rel >= 1.0f)
+  else if (!imest__in_range(cfg->gate_min_rel, 0.0f, 0, 1.0f) || cfg->gate_min_rel >= 1.0f)
     bad = "gate_min_rel";
   else if (cfg->confirm_windows < 1u || cfg->confirm_windows > 16u)
     bad = "confirm_windows";
