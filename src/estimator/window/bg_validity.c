@@ -10,6 +10,7 @@
  * Every evidence is dimensionless: the same rule holds for any motor size. */
 #include <math.h>
 
+#include "bg_impedance.h"
 #include "bg_validity.h"
 #include "common/imest_math.h"
 
@@ -156,12 +157,9 @@ static void systematic_bounds(const imest_t *s, const imest_window_t *w, const o
                               float *rs_rel)
 {
   const float we = op->we, ls = s->ls_h, sg = s->sigma;
-  const float a = slip_rate * tr, den = 1.0f + a * a;
-  /* Z and dZ/dT_R = we L_S ws (1 - sigma) / (1 + j a)^2 */
-  const float zr = rs + we * ls * (a * (1.0f - sg)) / den;
-  const float zi = we * ls * (1.0f + sg * a * a) / den;
-  const float k = we * ls * slip_rate * (1.0f - sg) / (den * den);
-  const float dr = k * (1.0f - a * a), di = k * (-2.0f * a);
+  bg_impedance_t z;
+  imest__bg_impedance(we, slip_rate, ls, sg, tr, rs, &z);
+  const float zr = z.zr, zi = z.zi, dr = z.dr, di = z.di;
   const float tau = 2.0f * s->timing_uncertainty_s;
   const float t_pwm = s->t_stair_s[w->duty_input]; /* duty_input is 0 or 1; 0: a smooth source */
   const float share = (w->duty_input && s->duty.zoh > 0.0f) ? 0.3f : 1.0f;
