@@ -128,13 +128,16 @@ int imest_temperature_update(imest_temperature_t *t, const imest_result_t *r)
 /* --- IMEST_TEMP: the temperatures on CAN (the header's layout) --------------------------------- */
 
 /* Every field is whole octets but the valid bits (bit 7 of octets 4 and 5), so the frame is packed
- * octet by octet: one octet (0..255) per element, as the codec of imest_can.h. */
+ * octet by octet: one octet (0..255) per element, as the codec of imest_can.h. The clamp bits of
+ * a temperature and of its uncertainty are neighbours (dec_temp()). */
 _Static_assert(IMEST_TEMPERATURE_CAN_STATOR_C_START == 0u && IMEST_TEMPERATURE_CAN_ROTOR_C_START == 16u &&
                    IMEST_TEMPERATURE_CAN_STATOR_UNCERT_START == 32u &&
                    IMEST_TEMPERATURE_CAN_STATOR_VALID_START == 39u &&
                    IMEST_TEMPERATURE_CAN_ROTOR_UNCERT_START == 40u &&
                    IMEST_TEMPERATURE_CAN_ROTOR_VALID_START == 47u && IMEST_CAN_COUNTER_START == 48u &&
-                   IMEST_CAN_CRC_START == 56u,
+                   IMEST_CAN_CRC_START == 56u &&
+                   IMEST_TEMPERATURE_CAN_CLAMP_STATOR_UNCERT == IMEST_TEMPERATURE_CAN_CLAMP_STATOR_C << 1 &&
+                   IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_UNCERT == IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_C << 1,
                "IMEST_TEMP: the octets below follow the header's layout");
 
 /* 1 iff base_id + 6 is an identifier of base_id's kind; *id receives it. */
@@ -157,27 +160,31 @@ static unsigned int temp_crc(const unsigned char *d)
   return imest_can_crc8(buf, 8u);
 }
 
-/* degC -> raw int16 as 16 bits: nearest 0.01, clamped to +-32767, NaN -> -32768. */
-static uint32_t enc_c(float c)
+/* One temperature's field pair: degC -> raw int16 (nearest 0.01, clamped to +-32767, NaN -> -32768)
+ * into octets d[0], d[1]; K -> raw u7 (nearest 0.2 K, clamped to 0..126, NaN -> 127) with the valid
+ * bit on top into *u. */
+static void enc_temp(float c, float k, int valid, unsigned char *d, unsigned char *u)
 {
-  if (isnan(c)) return 0x8000u;
-  const float x = c * (float)IMEST_TEMPERATURE_CAN_C_SCALE;
-  int32_t v = IMEST_TEMPERATURE_CAN_C_MAX;
-  if (x < (float)-IMEST_TEMPERATURE_CAN_C_MAX)
-    v = -IMEST_TEMPERATURE_CAN_C_MAX;
-  else if (x < (float)IMEST_TEMPERATURE_CAN_C_MAX)
-    v = (int32_t)(x >= 0.0f ? x + 0.5f : x - 0.5f);
-  return (uint32_t)v & 0xFFFFu;
-}
-
-/* K -> raw u7: nearest 0.2 K, clamped to 0..126, NaN -> 127. */
-static unsigned int enc_uncert(float u)
-{
-  if (isnan(u)) return (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_NA;
-  if (!(u > 0.0f)) return 0u;
-  const float x = u * (float)IMEST_TEMPERATURE_CAN_UNCERT_SCALE + 0.5f;
-  if (x >= (float)IMEST_TEMPERATURE_CAN_UNCERT_MAX) return (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_MAX;
-  return (unsigned int)x;
+  uint32_t raw = 0x8000u;
+  if (!isnan(c)) {
+    const float x = c * (float)IMEST_TEMPERATURE_CAN_C_SCALE;
+    int32_t v = IMEST_TEMPERATURE_CAN_C_MAX;
+    if (x < (float)-IMEST_TEMPERATURE_CAN_C_MAX)
+      v = -IMEST_TEMPERATURE_CAN_C_MAX;
+    else if (x < (float)IMEST_TEMPERATURE_CAN_C_MAX)
+      v = (int32_t)(x >= 0.0f ? x + 0.5f : x - 0.5f);
+    raw = (uint32_t)v & 0xFFFFu;
+  }
+  d[0] = (unsigned char)(raw & 0xFFu);
+  d[1] = (unsigned char)(raw >> 8);
+  unsigned int r = (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_NA;
+  if (!isnan(k)) {
+    const float x = k * (float)IMEST_TEMPERATURE_CAN_UNCERT_SCALE + 0.5f;
+    r = !(k > 0.0f)                                    ? 0u
+        : x >= (float)IMEST_TEMPERATURE_CAN_UNCERT_MAX ? (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_MAX
+                                                       : (unsigned int)x;
+  }
+  *u = (unsigned char)(r | (valid ? 0x80u : 0u));
 }
 
 int imest_temperature_can_pack(const imest_temperature_t *t, uint32_t base_id, unsigned int counter,
@@ -186,16 +193,10 @@ int imest_temperature_can_pack(const imest_temperature_t *t, uint32_t base_id, u
   uint32_t id = 0u;
   if (t == NULL || f == NULL) return IMEST_ERR_NULL;
   if (!temp_frame_id(base_id, &id)) return IMEST_ERR_ARG;
-  const uint32_t sc = enc_c(t->stator_c);
-  const uint32_t rc = enc_c(t->rotor_c);
   f->id = id;
   f->dlc = 8u;
-  f->data[0] = (unsigned char)(sc & 0xFFu);
-  f->data[1] = (unsigned char)(sc >> 8);
-  f->data[2] = (unsigned char)(rc & 0xFFu);
-  f->data[3] = (unsigned char)(rc >> 8);
-  f->data[4] = (unsigned char)(enc_uncert(t->stator_uncert_k) | (t->stator_valid ? 0x80u : 0u));
-  f->data[5] = (unsigned char)(enc_uncert(t->rotor_uncert_k) | (t->rotor_valid ? 0x80u : 0u));
+  enc_temp(t->stator_c, t->stator_uncert_k, t->stator_valid, &f->data[0], &f->data[4]);
+  enc_temp(t->rotor_c, t->rotor_uncert_k, t->rotor_valid, &f->data[2], &f->data[5]);
   f->data[6] = (unsigned char)(counter & 0xFFu);
   f->data[7] = (unsigned char)temp_crc(f->data);
   return IMEST_OK;
@@ -212,23 +213,21 @@ int imest_temperature_can_publish(imest_can_pub_t *pub, const imest_temperature_
   return 1;
 }
 
-/* raw int16 (two octets) -> degC; NaN for -32768; *clamped |= bit at +-32767. */
-static float dec_c(unsigned int lo, unsigned int hi, unsigned int *clamped, unsigned int bit)
+/* One temperature's field pair back (enc_temp()): *c, *k and *valid from octets d[0], d[1] and u;
+ * NaN for not available; at a field's end the clamp bits (clamp_c, clamp_c << 1) in *clamped. */
+static void dec_temp(const unsigned char *d, unsigned int u, float *c, float *k, int *valid,
+                     unsigned int *clamped, unsigned int clamp_c)
 {
-  const uint32_t u = ((uint32_t)(hi & 0xFFu) << 8) | (uint32_t)(lo & 0xFFu);
-  const int32_t v = (int32_t)u - ((u & 0x8000u) ? 65536 : 0);
-  if (v == IMEST_TEMPERATURE_CAN_C_NA) return NAN;
-  if (v == IMEST_TEMPERATURE_CAN_C_MAX || v == -IMEST_TEMPERATURE_CAN_C_MAX) *clamped |= bit;
-  return (float)v / (float)IMEST_TEMPERATURE_CAN_C_SCALE;
-}
-
-/* raw u7 (the octet's low bits) -> K; NaN for 127; *clamped |= bit at 126. */
-static float dec_uncert(unsigned int octet, unsigned int *clamped, unsigned int bit)
-{
-  const unsigned int v = octet & 0x7Fu;
-  if (v == (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_NA) return NAN;
-  if (v == (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_MAX) *clamped |= bit;
-  return (float)v / (float)IMEST_TEMPERATURE_CAN_UNCERT_SCALE;
+  const uint32_t raw = ((uint32_t)(d[1] & 0xFFu) << 8) | (uint32_t)(d[0] & 0xFFu);
+  const int32_t v = (int32_t)raw - ((raw & 0x8000u) ? 65536 : 0);
+  const unsigned int r = u & 0x7Fu;
+  *c = v == IMEST_TEMPERATURE_CAN_C_NA ? NAN : (float)v / (float)IMEST_TEMPERATURE_CAN_C_SCALE;
+  if (v == IMEST_TEMPERATURE_CAN_C_MAX || v == -IMEST_TEMPERATURE_CAN_C_MAX) *clamped |= clamp_c;
+  *k = r == (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_NA
+           ? NAN
+           : (float)r / (float)IMEST_TEMPERATURE_CAN_UNCERT_SCALE;
+  if (r == (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_MAX) *clamped |= clamp_c << 1;
+  *valid = (u & 0x80u) ? 1 : 0;
 }
 
 int imest_temperature_can_decode(const imest_can_frame_t *f, uint32_t base_id, imest_temperature_can_t *out)
@@ -240,12 +239,10 @@ int imest_temperature_can_decode(const imest_can_frame_t *f, uint32_t base_id, i
   if (f->id != id) return IMEST_CAN_DEC_FOREIGN;
   if (f->dlc != 8u) return IMEST_CAN_DEC_BAD_DLC;
   if (temp_crc(f->data) != ((unsigned int)f->data[7] & 0xFFu)) return IMEST_CAN_DEC_BAD_CRC;
-  out->stator_c = dec_c(f->data[0], f->data[1], &clamped, IMEST_TEMPERATURE_CAN_CLAMP_STATOR_C);
-  out->rotor_c = dec_c(f->data[2], f->data[3], &clamped, IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_C);
-  out->stator_uncert_k = dec_uncert(f->data[4], &clamped, IMEST_TEMPERATURE_CAN_CLAMP_STATOR_UNCERT);
-  out->rotor_uncert_k = dec_uncert(f->data[5], &clamped, IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_UNCERT);
-  out->stator_valid = ((unsigned int)f->data[4] & 0x80u) ? 1 : 0;
-  out->rotor_valid = ((unsigned int)f->data[5] & 0x80u) ? 1 : 0;
+  dec_temp(&f->data[0], f->data[4], &out->stator_c, &out->stator_uncert_k, &out->stator_valid, &clamped,
+           IMEST_TEMPERATURE_CAN_CLAMP_STATOR_C);
+  dec_temp(&f->data[2], f->data[5], &out->rotor_c, &out->rotor_uncert_k, &out->rotor_valid, &clamped,
+           IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_C);
   out->counter = (unsigned int)f->data[6] & 0xFFu;
   out->clamped = clamped;
   return IMEST_CAN_DEC_OK;
