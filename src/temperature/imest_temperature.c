@@ -151,13 +151,18 @@ static int temp_frame_id(uint32_t base_id, uint32_t *id)
   return 1;
 }
 
-/* CRC-8 over [frame index, octets 0..6], as every frame of imest_can.h. */
+/* CRC-8 SAE J1850 (poly 0x1D, init 0xFF, xor-out 0xFF) over [frame index, octets 0..6], as every
+ * frame of imest_can.h. The module's own copy of imest_can_crc8() (test/can checks the two agree),
+ * so that src/temperature links without src/can, as the optional folders do. */
 static unsigned int temp_crc(const unsigned char *d)
 {
-  unsigned char buf[8];
-  buf[0] = (unsigned char)IMEST_TEMPERATURE_CAN_FRAME;
-  for (unsigned int i = 0u; i < 7u; i++) buf[i + 1u] = d[i];
-  return imest_can_crc8(buf, 8u);
+  unsigned int crc = 0xFFu;
+  for (unsigned int i = 0u; i < 8u; i++) {
+    crc ^= i == 0u ? IMEST_TEMPERATURE_CAN_FRAME : (unsigned int)d[i - 1u] & 0xFFu;
+    for (unsigned int b = 0u; b < 8u; b++)
+      crc = (crc & 0x80u) ? (((crc << 1) ^ 0x1Du) & 0xFFu) : ((crc << 1) & 0xFFu);
+  }
+  return crc ^ 0xFFu;
 }
 
 /* One temperature's field pair: degC -> raw int16 (nearest 0.01, clamped to +-32767, NaN -> -32768)
