@@ -181,7 +181,7 @@ static void enc_temp(float c, float k, int valid, unsigned char *d, unsigned cha
     raw = (uint32_t)v & 0xFFFFu;
   }
   d[0] = (unsigned char)(raw & 0xFFu);
-  d[1] = (unsigned char)(raw >> 8);
+  d[1] = (unsigned char)((raw >> 8) & 0xFFu);
   unsigned int r = (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_NA;
   if (!isnan(k)) {
     const float x = k * (float)IMEST_TEMPERATURE_CAN_UNCERT_SCALE + 0.5f;
@@ -189,7 +189,7 @@ static void enc_temp(float c, float k, int valid, unsigned char *d, unsigned cha
         : x >= (float)IMEST_TEMPERATURE_CAN_UNCERT_MAX ? (unsigned int)IMEST_TEMPERATURE_CAN_UNCERT_MAX
                                                        : (unsigned int)x;
   }
-  *u = (unsigned char)(r | (valid ? 0x80u : 0u));
+  *u = (unsigned char)((r | (valid ? 0x80u : 0u)) & 0xFFu);
 }
 
 int imest_temperature_can_pack(const imest_temperature_t *t, uint32_t base_id, unsigned int counter,
@@ -203,7 +203,7 @@ int imest_temperature_can_pack(const imest_temperature_t *t, uint32_t base_id, u
   enc_temp(t->stator_c, t->stator_uncert_k, t->stator_valid, &f->data[0], &f->data[4]);
   enc_temp(t->rotor_c, t->rotor_uncert_k, t->rotor_valid, &f->data[2], &f->data[5]);
   f->data[6] = (unsigned char)(counter & 0xFFu);
-  f->data[7] = (unsigned char)temp_crc(f->data);
+  f->data[7] = (unsigned char)(temp_crc(f->data) & 0xFFu);
   return IMEST_OK;
 }
 
