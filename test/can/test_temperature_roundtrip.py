@@ -7,7 +7,8 @@ ends, named in 'clamped'), on a heat run from imest-sim (exp2, heating sped up 1
 sets of references (the second makes the temperatures negative), 11- and 29-bit identifiers.
 Without --temperatures the replay's log and the monitor's CSV are what they were; a window whose
 IMEST_TEMP is missing or corrupted shows empty temperature cells; an IMEST_TEMP that comes before
-its window's frames is matched all the same.
+its window's frames is matched all the same; a log of IMEST_TEMP frames alone decodes nothing,
+and the monitor says so.
 
 usage: test_temperature_roundtrip.py REPLAY SIM MONITOR WORKDIR
 Exit status: 0 pass; 1 a check failed (each named); 2 usage error.
@@ -154,6 +155,12 @@ def main():
               f"edited log: the corrupted IMEST_TEMP reported: {err}")
         check("IMEST_TEMP frames %d (corrupted 1, without their window 0)" % (len(rep_rows) - 2) in err,
               f"edited log: the summary: {err}")
+        only = os.path.join(work, "temp_rt_only.log")
+        with open(only, "w") as fh:
+            fh.writelines(x for x in lines if temp_id in x)
+        rc, out, err = run([monitor, "--log", only, "--csv", "--temperatures"])
+        check(rc == 1 and "IMEST_TEMP frame(s) at 0x6A0+6, but none of the six frames 0x6A0..0x6A5" in err,
+              f"a log of IMEST_TEMP frames only: exit {rc}, {err}")
         rc, out, err = run([monitor, "--log", log, "--csv", "--temperatures", "--count", "3"])
         check(rc == 0 and rows(out) == mon_rows[:3], "--count 3 with --temperatures: the first three rows")
     if FAILS:

@@ -630,7 +630,10 @@ static void explain_nothing(const monitor_t *m, int live)
   imest_can_id_format(m->base_id, a, sizeof a);
   imest_can_id_format(last, b, sizeof b);
   fputs("imest-monitor: nothing decoded: ", stderr);
-  if (s->frames == 0u) {
+  if (s->frames == 0u && m->temp_frames + m->temp_corrupt > 0u) {
+    fprintf(stderr, "%lu IMEST_TEMP frame(s) at %s+6, but none of the six frames %s..%s\n",
+            m->temp_frames + m->temp_corrupt, a, a, b);
+  } else if (s->frames == 0u) {
     if (live) {
       fputs("no frame received\n", stderr);
     } else if (m->lines == 0u) {
