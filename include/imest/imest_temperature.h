@@ -108,10 +108,11 @@
  * Below: its layout, the packer, the publisher and the decoder.
  *
  * Numeric behaviour: float32 arithmetic and outputs (the result's double T_R, R_S and bounds are
- * converted to float first), no libm call but isfinite, no malloc, no stdio, no global state; the
- * instance is caller-owned (CMSIS-DSP style) and used from one context (the background task).
- * Not linked by the estimator: a firmware that does not call it pays no flash for it
- * (fw/README.md states its size).
+ * converted to float first), no libm call but the isfinite and isnan macros, no malloc, no stdio,
+ * no global state; the instance is caller-owned (CMSIS-DSP style) and used from one context (the
+ * background task). Not linked by the estimator: a firmware that does not call it pays no flash
+ * for it (fw/README.md states its size; a sending firmware built with --gc-sections does not link
+ * the decoder either). Its CAN functions need the types of imest_can.h but no code of src/can/.
  */
 #ifndef IMEST_IMEST_TEMPERATURE_H
 #define IMEST_IMEST_TEMPERATURE_H
