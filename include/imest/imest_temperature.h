@@ -95,14 +95,24 @@
  * tr_bound_rel (< 1) and rotor_tol_k. A temperature that is not valid keeps its number (NaN if it
  * could not be computed), as the estimator's results do.
  *
- * Not on CAN: the estimator's frames (tools/imest.dbc) carry T_R and R_S, from which a receiver
- * can compute the same figures; sending the temperatures would need a new frame in the DBC.
+ * On CAN: the frame IMEST_TEMP at base + 6 (tools/imest.dbc, port/README.md), sent after the
+ * window's six frames (imest_can.h) with the same rolling counter, so that a receiver can match
+ * it with them (imest-monitor --temperatures does):
+ *
+ *     (void)imest_can_publish(&can, &r);
+ *     (void)imest_temperature_update(&tmp, &r);
+ *     (void)imest_temperature_can_publish(&can, &tmp);   // IMEST_TEMP, same counter as r's frames
+ *
+ * Optional: a firmware that does not call it sends the six frames only, and readers of the six
+ * (imest_can_rx_feed(), imest_can_decode_frame()) classify base + 6 as foreign and ignore it.
+ * Below: its layout, the packer, the publisher and the decoder.
  *
  * Numeric behaviour: float32 arithmetic and outputs (the result's double T_R, R_S and bounds are
- * converted to float first), no libm call but isfinite, no malloc, no stdio, no global state; the
- * instance is caller-owned (CMSIS-DSP style) and used from one context (the background task).
- * Not linked by the estimator: a firmware that does not call it pays no flash for it
- * (fw/README.md states its size).
+ * converted to float first), no libm call but the isfinite and isnan macros, no malloc, no stdio,
+ * no global state; the instance is caller-owned (CMSIS-DSP style) and used from one context (the
+ * background task). Not linked by the estimator: a firmware that does not call it pays no flash
+ * for it (fw/README.md states its size; a sending firmware built with --gc-sections does not link
+ * the decoder either). Its CAN functions need the types of imest_can.h but no code of src/can/.
  */
 #ifndef IMEST_IMEST_TEMPERATURE_H
 #define IMEST_IMEST_TEMPERATURE_H
@@ -110,6 +120,7 @@
 #include <stdint.h>
 
 #include "imest/imest.h"
+#include "imest/imest_can.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -189,6 +200,104 @@ int imest_temperature_init(imest_temperature_t *t, const imest_temperature_confi
  * @retval IMEST_ERR_NULL  t or r is NULL (nothing changes)
  */
 int imest_temperature_update(imest_temperature_t *t, const imest_result_t *r);
+
+/* ----------------------------------------------------------------------------
+ * IMEST_TEMP: the temperatures on CAN (frame index 6, identifier base + 6)
+ * ------------------------------------------------------------------------- */
+
+/** IMEST_TEMP's frame index: its identifier is base_id + 6 (29-bit: (base + 6) | IMEST_CAN_ID_EXT,
+ *  as the six frames of imest_can.h). Nodes are IMEST_CAN_ID_STRIDE (8) apart, so base + 6 is
+ *  free. The index is also the first octet the CRC covers. */
+#define IMEST_TEMPERATURE_CAN_FRAME 6u
+
+/** The layout (Intel byte order, DBC start bits; tools/imest.dbc, port/README.md):
+ *   bits  0..15 Stator_C        int16, 0.01 degC; -327.67 .. 327.67; raw -32768 = not available
+ *                               (NaN); beyond the range clamped to +-32767 (a bound: "or more")
+ *   bits 16..31 Rotor_C         the same for the rotor
+ *   bits 32..38 Stator_uncert_K u7, 0.2 K; 0 .. 25.0 K in raw 0..125, rounded to the nearest
+ *                               0.2 K; raw 126 = 25.2 K or more (clamped); 127 = not available
+ *   bit  39     Stator_valid    stator_valid
+ *   bits 40..46 Rotor_uncert_K  as Stator_uncert_K
+ *   bit  47     Rotor_valid     rotor_valid
+ *   bits 48..55 Counter         the rolling counter of the window the temperatures come from
+ *   bits 56..63 CRC             CRC-8 SAE J1850 over [6, bytes 0..6] (imest_can_crc8()) */
+#define IMEST_TEMPERATURE_CAN_STATOR_C_START      0u
+#define IMEST_TEMPERATURE_CAN_ROTOR_C_START       16u
+#define IMEST_TEMPERATURE_CAN_C_BITS              16u
+#define IMEST_TEMPERATURE_CAN_C_SCALE             100 /**< raw counts per degC */
+#define IMEST_TEMPERATURE_CAN_C_NA                (-32768)
+#define IMEST_TEMPERATURE_CAN_C_MAX               32767 /**< largest raw (-this: the smallest) */
+#define IMEST_TEMPERATURE_CAN_STATOR_UNCERT_START 32u
+#define IMEST_TEMPERATURE_CAN_STATOR_VALID_START  39u
+#define IMEST_TEMPERATURE_CAN_ROTOR_UNCERT_START  40u
+#define IMEST_TEMPERATURE_CAN_ROTOR_VALID_START   47u
+#define IMEST_TEMPERATURE_CAN_UNCERT_BITS         7u
+#define IMEST_TEMPERATURE_CAN_UNCERT_SCALE        5   /**< raw counts per K (0.2 K) */
+#define IMEST_TEMPERATURE_CAN_UNCERT_NA           127 /**< not available */
+#define IMEST_TEMPERATURE_CAN_UNCERT_MAX          126 /**< 25.2 K or more */
+
+/** imest_temperature_can_t.clamped: the value was at its field's end, so it is a bound ("327.67
+ *  or more", "25.2 K or more"), not a value. */
+#define IMEST_TEMPERATURE_CAN_CLAMP_STATOR_C      0x1u
+#define IMEST_TEMPERATURE_CAN_CLAMP_STATOR_UNCERT 0x2u
+#define IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_C       0x4u
+#define IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_UNCERT  0x8u
+
+/** One IMEST_TEMP frame, decoded. */
+typedef struct {
+  float stator_c;        /**< [degC], to 0.01 (NaN: not available) */
+  float stator_uncert_k; /**< [K], to 0.2 (NaN: not available) */
+  int stator_valid;      /**< 0 or 1 */
+  float rotor_c;         /**< [degC] (NaN: not available) */
+  float rotor_uncert_k;  /**< [K] (NaN: not available) */
+  int rotor_valid;       /**< 0 or 1 */
+  unsigned int counter;  /**< rolling counter (0..255): that of the window's six frames */
+  unsigned int clamped;  /**< IMEST_TEMPERATURE_CAN_CLAMP_* of the values at their field's end */
+} imest_temperature_can_t;
+
+/**
+ * Pack t's temperatures into IMEST_TEMP (id base_id + 6, dlc 8). Temperatures are rounded to the
+ * nearest 0.01 degC and uncertainties to the nearest 0.2 K; NaN is sent as not available, values
+ * beyond a field's range (+-inf too) as its end: +-327.67 degC, 25.2 K (a negative uncertainty,
+ * which the module does not produce, as 0). A valid bit is sent as 1 iff the module's is nonzero.
+ * @param counter  the rolling counter of the window t was updated from (sent mod 256): right
+ *                 after imest_can_publish(pub, r), pub->counter - 1 (imest_can_publish() advances
+ *                 it by one per window); imest_temperature_can_publish() does this
+ * @retval IMEST_OK        *f holds the frame
+ * @retval IMEST_ERR_NULL  t or f is NULL
+ * @retval IMEST_ERR_ARG   base_id + 6 is not an identifier of base_id's kind (11-bit: base_id
+ *                         <= 0x7F9; 29-bit: <= 0x1FFFFFF9 | IMEST_CAN_ID_EXT), or bits other than
+ *                         IMEST_CAN_ID_EXT are set above the identifier
+ */
+int imest_temperature_can_pack(const imest_temperature_t *t, uint32_t base_id, unsigned int counter,
+                               imest_can_frame_t *f);
+
+/**
+ * Send IMEST_TEMP through pub's port, with the counter of the window pub published last
+ * (pub->counter - 1): call it after imest_can_publish() of the window t was updated from, before
+ * the next one. Handed once to port->send (no retry); a refusal is counted in pub->tx_failed (and
+ * so in the next window's IMEST_STAT). Background context only, as imest_can_publish(). Before
+ * the first imest_can_publish() the counter sent is 255. tx_failed saturates as imest_can_publish()'s.
+ * @retval 0               sent
+ * @retval 1               the port refused it (counted)
+ * @retval IMEST_ERR_NULL  pub or t is NULL, or pub was not initialised
+ * @retval IMEST_ERR_ARG   pub->base_id has no base + 6 (imest_temperature_can_pack())
+ */
+int imest_temperature_can_publish(imest_can_pub_t *pub, const imest_temperature_t *t);
+
+/**
+ * Check one frame and decode it if it is IMEST_TEMP of the node at base_id, the conventions of
+ * imest_can_decode_frame(): the identifier must be base_id + 6 of base_id's kind (anything else,
+ * the six frames base..base+5 too, is foreign), then 8 data bytes, then the CRC. A not-available
+ * raw value decodes as NaN; a value at its field's end sets its bit in out->clamped.
+ * @retval IMEST_CAN_DEC_OK       *out holds the frame's values
+ * @retval IMEST_CAN_DEC_FOREIGN  not IMEST_TEMP of this node (*out unchanged)
+ * @retval IMEST_CAN_DEC_BAD_DLC  IMEST_TEMP, but not 8 data bytes (*out unchanged)
+ * @retval IMEST_CAN_DEC_BAD_CRC  IMEST_TEMP, checksum mismatch (*out unchanged)
+ * @retval IMEST_ERR_NULL         f or out is NULL
+ * @retval IMEST_ERR_ARG          base_id has no base + 6 (as imest_temperature_can_pack())
+ */
+int imest_temperature_can_decode(const imest_can_frame_t *f, uint32_t base_id, imest_temperature_can_t *out);
 
 #ifdef __cplusplus
 }

@@ -5,8 +5,10 @@
  * deterministic function of the window number, with edge values (NaN,
  * infinity, out-of-range, saturation) mixed in, so two runs can be compared
  * after decoding. Used by the socketcan end-to-end test (qemu guest) and by
- * the DBC and monitor tests. --table prints the codec's signal table and the
- * reason names instead (test_dbc.py compares them with tools/imest.dbc). */
+ * the DBC and monitor tests. --temperatures adds each window's IMEST_TEMP
+ * frame (imest_temperature.h), synthetic too. --table prints the codec's signal
+ * table, IMEST_TEMP's layout and the reason names instead (test_dbc.py compares
+ * them with tools/imest.dbc). */
 #define _GNU_SOURCE 1
 #include <float.h>
 #include <math.h>
@@ -17,6 +19,7 @@
 
 #include "imest/imest.h"
 #include "imest/imest_can.h"
+#include "imest/imest_temperature.h"
 #include "imest_can_id.h"
 #include "imest_candump.h"
 #ifdef IMEST_SELFTEST_SOCKETCAN
@@ -100,10 +103,37 @@ static void synth(unsigned int k, imest_result_t *r)
   }
 }
 
+/* Window k's temperatures (--temperatures): a sweep over the fields' ranges, negative ones too,
+ * with not-available and clamped values mixed in. */
+static void synth_temp(unsigned int k, imest_temperature_t *t)
+{
+  memset(t, 0, sizeof *t);
+  t->stator_c = -40.0f + 7.37f * (float)k;
+  t->stator_uncert_k = 0.37f * (float)(k % 9u);
+  t->stator_valid = (int)(k % 2u);
+  t->rotor_c = 150.0f - 11.13f * (float)k;
+  t->rotor_uncert_k = 0.71f * (float)(k % 5u);
+  t->rotor_valid = k % 3u == 0u;
+  switch (k % 10u) {
+  case 3u: /* nothing computed (the window has no candidate) */
+    t->stator_c = t->stator_uncert_k = t->rotor_c = t->rotor_uncert_k = NAN;
+    t->stator_valid = t->rotor_valid = 0;
+    break;
+  case 5u: /* every field beyond its range */
+    t->stator_c = 1.0e4f;
+    t->stator_uncert_k = 100.0f;
+    t->rotor_c = -INFINITY;
+    t->rotor_uncert_k = INFINITY;
+    break;
+  case 8u: /* a temperature without its uncertainty */ t->rotor_uncert_k = NAN; break;
+  default: break;
+  }
+}
+
 static void usage(void)
 {
   fputs("usage: imest-can-selftest (--iface NAME | --log FILE|-) [--count N] [--period-ms MS]\n"
-        "                          [--base-id ID] [--ext] [--epoch SEC]\n"
+        "                          [--base-id ID] [--ext] [--epoch SEC] [--temperatures]\n"
         "       imest-can-selftest --table\n",
         stderr);
 }
@@ -120,6 +150,20 @@ static void print_table(void)
     printf("signal %u %u %u %s %lu %u\n", t[k].frame, t[k].start, t[k].len, kind[t[k].kind],
            (unsigned long)t[k].scale, t[k].mask);
   }
+  /* IMEST_TEMP: frame index, then its signals as above (kinds of its own) */
+  printf("optional %u\n", IMEST_TEMPERATURE_CAN_FRAME);
+  printf("signal %u %u %u temp_c %d 0\n", IMEST_TEMPERATURE_CAN_FRAME, IMEST_TEMPERATURE_CAN_STATOR_C_START,
+         IMEST_TEMPERATURE_CAN_C_BITS, IMEST_TEMPERATURE_CAN_C_SCALE);
+  printf("signal %u %u %u temp_c %d 0\n", IMEST_TEMPERATURE_CAN_FRAME, IMEST_TEMPERATURE_CAN_ROTOR_C_START,
+         IMEST_TEMPERATURE_CAN_C_BITS, IMEST_TEMPERATURE_CAN_C_SCALE);
+  printf("signal %u %u %u temp_k %d 0\n", IMEST_TEMPERATURE_CAN_FRAME,
+         IMEST_TEMPERATURE_CAN_STATOR_UNCERT_START, IMEST_TEMPERATURE_CAN_UNCERT_BITS,
+         IMEST_TEMPERATURE_CAN_UNCERT_SCALE);
+  printf("signal %u %u 1 bool 1 0\n", IMEST_TEMPERATURE_CAN_FRAME, IMEST_TEMPERATURE_CAN_STATOR_VALID_START);
+  printf("signal %u %u %u temp_k %d 0\n", IMEST_TEMPERATURE_CAN_FRAME,
+         IMEST_TEMPERATURE_CAN_ROTOR_UNCERT_START, IMEST_TEMPERATURE_CAN_UNCERT_BITS,
+         IMEST_TEMPERATURE_CAN_UNCERT_SCALE);
+  printf("signal %u %u 1 bool 1 0\n", IMEST_TEMPERATURE_CAN_FRAME, IMEST_TEMPERATURE_CAN_ROTOR_VALID_START);
   for (int r = 0; r < 255; r++) {
     if (strcmp(imest_reason_name(r), "unknown") != 0) printf("reason %d %s\n", r, imest_reason_name(r));
   }
@@ -130,7 +174,7 @@ int main(int argc, char **argv)
   const char *iface = NULL, *log = NULL, *base_text = NULL;
   unsigned long count = 20u, period_ms = 0u;
   uint32_t base = IMEST_CAN_DEFAULT_BASE_ID;
-  int ext = 0;
+  int ext = 0, temps = 0;
   double epoch = 1700000000.0;
   imest_candump_port_t cd;
   FILE *fp = NULL;
@@ -148,6 +192,10 @@ int main(int argc, char **argv)
     }
     if (strcmp(argv[i], "--ext") == 0) {
       ext = 1;
+      continue;
+    }
+    if (strcmp(argv[i], "--temperatures") == 0) {
+      temps = 1;
       continue;
     }
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -212,6 +260,11 @@ int main(int argc, char **argv)
     if (log != NULL) imest_candump_port_set_time(&cd, epoch + r.t_end_s);
     const int f = imest_can_publish(&pub, &r);
     if (f > 0) failed += (unsigned long)f;
+    if (temps) {
+      imest_temperature_t t;
+      synth_temp(k, &t);
+      if (imest_temperature_can_publish(&pub, &t) != 0) failed++;
+    }
     if (period_ms != 0u) {
       struct timespec ts;
       ts.tv_sec = (time_t)(period_ms / 1000u);

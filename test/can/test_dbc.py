@@ -3,14 +3,16 @@
 """tools/imest.dbc against the C codec, in two ways:
 
 1. Structure: the C signal table (imest-can-selftest --table, i.e.
-   src/can/can_signals.c) and the DBC (loaded with python3-canmatrix) must
-   describe the same signals: frame, start bit, length, byte order,
-   signedness / float, factor, offset, min/max, not-available and enum value
-   tables (reason names = imest_reason_name()). Mutated copies of the DBC
-   must be caught (the comparison can fail).
+   src/can/can_signals.c, and IMEST_TEMP's layout from imest_temperature.h)
+   and the DBC (loaded with python3-canmatrix) must describe the same
+   signals: frame, start bit, length, byte order, signedness / float, factor,
+   offset, min/max, not-available and enum value tables (reason names =
+   imest_reason_name()). Mutated copies of the DBC must be caught (the
+   comparison can fail), IMEST_TEMP's signals too.
 2. Values: an independent decoder (canmatrix) decodes a candump log written
-   by the C library, and every signal must equal what the C decoder
-   (imest-monitor --csv) prints.
+   by the C library (the six frames and IMEST_TEMP per window), and every
+   signal must equal what the C decoder (imest-monitor --csv --temperatures)
+   prints.
 
 usage: test_dbc.py SELFTEST MONITOR DBC WORKDIR
 """
@@ -40,7 +42,7 @@ def check(cond, msg):
 
 def c_table():
     out = subprocess.run([selftest, "--table"], check=True, capture_output=True, text=True).stdout
-    t = {"signals": [], "reasons": {}}
+    t = {"signals": [], "reasons": {}, "optional": []}
     for line in out.splitlines():
         f = line.split()
         if f[0] == "frames":
@@ -48,6 +50,8 @@ def c_table():
         elif f[0] == "signal":
             t["signals"].append({"frame": int(f[1]), "start": int(f[2]), "len": int(f[3]), "kind": f[4],
                                  "scale": int(f[5]), "mask": int(f[6])})
+        elif f[0] == "optional":
+            t["optional"].append(int(f[1]))
         elif f[0] == "reason":
             t["reasons"][int(f[1])] = f[2]
     return t
@@ -57,9 +61,10 @@ def compare(db, t):
     """Every difference between the DBC and the C table, as messages."""
     bad = []
     frames = {f.arbitration_id.id: f for f in db.frames}
-    want_ids = [BASE + i for i in range(t["nframes"])]
+    want_ids = [BASE + i for i in list(range(t["nframes"])) + t["optional"]]
     if sorted(frames) != want_ids:
-        bad.append(f"DBC frames {[hex(i) for i in sorted(frames)]}, C has {t['nframes']} from 0x{BASE:X}")
+        bad.append(f"DBC frames {[hex(i) for i in sorted(frames)]}, C has {t['nframes']} from 0x{BASE:X} "
+                   f"and {t['optional']}")
     enum_values = dict(t["reasons"])
     enum_values[255] = "out_of_range"
     c_by_pos = {(s["frame"], s["start"]): s for s in t["signals"]}
@@ -93,22 +98,30 @@ def compare(db, t):
             if s.size != c["len"]:
                 bad.append(f"{where}: {s.size} bits, C {c['len']}")
             is_f32 = c["kind"] == "f32"
-            if bool(s.is_float) != is_f32 or bool(s.is_signed) != is_f32:
+            is_signed = c["kind"] in ("f32", "temp_c")  # temp_c: int16, -32768 = not available
+            if bool(s.is_float) != is_f32 or bool(s.is_signed) != is_signed:
                 bad.append(f"{where}: float {s.is_float} signed {s.is_signed}, C kind {c['kind']}")
-            factor = Decimal(1) / Decimal(c["scale"]) if c["kind"] == "scaled" else Decimal(1)
+            scaled = c["kind"] in ("scaled", "temp_c", "temp_k")
+            factor = Decimal(1) / Decimal(c["scale"]) if scaled else Decimal(1)
             if Decimal(str(s.factor)) != factor or Decimal(str(s.offset)) != 0:
                 bad.append(f"{where}: factor {s.factor} offset {s.offset}, C factor {factor} offset 0")
+            want_min = Decimal(0)
             if is_f32:
                 want_max = Decimal(0)  # unspecified: the whole float range
-            elif c["kind"] == "scaled":
+            elif c["kind"] == "temp_c":  # +-(2^(len-1) - 1): the most negative raw is not available
+                want_max = Decimal((ones >> 1)) * factor
+                want_min = -want_max
+            elif scaled:
                 want_max = Decimal(ones - 1) * factor
             else:
                 want_max = Decimal(ones)
-            if Decimal(str(s.min)) != 0 or Decimal(str(s.max)) != want_max:
-                bad.append(f"{where}: range [{s.min}|{s.max}], C [0|{want_max}]")
+            if Decimal(str(s.min)) != want_min or Decimal(str(s.max)) != want_max:
+                bad.append(f"{where}: range [{s.min}|{s.max}], C [{want_min}|{want_max}]")
             values = {int(k): v for k, v in s.values.items()}
-            if c["kind"] == "scaled":
+            if c["kind"] in ("scaled", "temp_k"):
                 want_values = {ones: "not_available"}
+            elif c["kind"] == "temp_c":
+                want_values = {-(1 << (c["len"] - 1)): "not_available"}
             elif c["kind"] == "enum":
                 want_values = enum_values
             else:
@@ -146,6 +159,15 @@ mutations = {
     "reason name": ('VAL_ 1700 RS_reason 0 "ok" 10 "warmup"', 'VAL_ 1700 RS_reason 0 "ok" 10 "warm_up"'),
     "signal removed": (" SG_ Windows : 40|8@1+ (1,0) [0|255] \"\" IMEST_MONITOR\n", ""),
     "signedness": (" SG_ Seq : 0|32@1+", " SG_ Seq : 0|32@1-"),
+    "IMEST_TEMP factor": (" SG_ Stator_C : 0|16@1- (0.01,0)", " SG_ Stator_C : 0|16@1- (0.1,0)"),
+    "IMEST_TEMP signedness": (" SG_ Rotor_C : 16|16@1-", " SG_ Rotor_C : 16|16@1+"),
+    "IMEST_TEMP start bit": (" SG_ Rotor_uncert_K : 40|7@1+", " SG_ Rotor_uncert_K : 41|7@1+"),
+    "IMEST_TEMP length": (" SG_ Stator_uncert_K : 32|7@1+", " SG_ Stator_uncert_K : 32|8@1+"),
+    "IMEST_TEMP range": ("[-327.67|327.67] \"degC\" IMEST_MONITOR\n SG_ Rotor_C",
+                         "[-327.68|327.67] \"degC\" IMEST_MONITOR\n SG_ Rotor_C"),
+    "IMEST_TEMP not available": ('VAL_ 1702 Rotor_C -32768 "not_available"', 'VAL_ 1702 Rotor_C 32767 "not_available"'),
+    "IMEST_TEMP valid bit removed": (" SG_ Rotor_valid : 47|1@1+ (1,0) [0|1] \"\" IMEST_MONITOR\n", ""),
+    "IMEST_TEMP identifier": (" 1702 ", " 1703 "),  # its BO_, CM_ and VAL_ lines
 }
 for what, (old, new) in mutations.items():
     check(old in dbc_text, f"mutation '{what}': text not found in the DBC")
@@ -159,8 +181,8 @@ for what, (old, new) in mutations.items():
 log = os.path.join(work, "dbc_check.log")
 N = 40
 NF = table["nframes"]
-subprocess.run([selftest, "--log", log, "--count", str(N)], check=True)
-out = subprocess.run([monitor, "--log", log, "--csv"], check=True, capture_output=True, text=True)
+subprocess.run([selftest, "--log", log, "--count", str(N), "--temperatures"], check=True)
+out = subprocess.run([monitor, "--log", log, "--csv", "--temperatures"], check=True, capture_output=True, text=True)
 rows = list(csv.DictReader(out.stdout.splitlines()))
 check(len(rows) == N, f"monitor printed {len(rows)} rows, expected {N}")
 frames = {f.arbitration_id.id: f for f in db.frames}
@@ -243,9 +265,43 @@ def reason(w, name, row_val, k):
           f"window {k}: {name} {raw} = {reason_names.get(raw)!r} in the DBC, C says {row_val!r}")
 
 
+def temperature(w, name, row, col, k):
+    """A temperature or an uncertainty: the DBC's value within float32 of the C decoder's; not
+    available (raw -32768, 127) as nan; a value at its field's end named in 'clamped'."""
+    sig = frames[BASE + 6].signal_by_name(name)
+    raw = int(w[name].raw_value)
+    na = -(1 << (sig.size - 1)) if sig.is_signed else (1 << sig.size) - 1
+    if raw == na:
+        check(row[col] == "nan", f"window {k}: {name} raw {raw} (n/a) but C printed {row[col]!r}")
+        return None
+    top = (1 << (sig.size - 1)) - 1 if sig.is_signed else (1 << sig.size) - 2
+    phys = float(w[name].phys_value)
+    check(abs(phys - float(row[col])) <= 1e-4, f"window {k}: {name} DBC {phys} C {row[col]}")
+    check((col in row["clamped"].split(";")) == (abs(raw) == top),
+          f"window {k}: {col} in clamped {row['clamped']!r}, raw {raw}")
+    return phys
+
+
 for k, (w, row) in enumerate(zip(windows, rows)):
-    check(sorted(w["_ids"]) == list(range(NF)), f"window {k}: frames {w['_ids']}")
-    check(row["frames"] == "0x%x" % ((1 << NF) - 1), f"window {k}: frames mask {row['frames']}")
+    check(sorted(w["_ids"]) == list(range(NF)) + table["optional"], f"window {k}: frames {w['_ids']}")
+    check(row["frames"] == "0x%x" % ((1 << (NF + 1)) - 1), f"window {k}: frames mask {row['frames']}")
+    stator = temperature(w, "Stator_C", row, "stator_c", k)
+    rotor = temperature(w, "Rotor_C", row, "rotor_c", k)
+    temperature(w, "Stator_uncert_K", row, "stator_uncert_k", k)
+    temperature(w, "Rotor_uncert_K", row, "rotor_uncert_k", k)
+    check(int(w["Stator_valid"].raw_value) == int(row["stator_valid"]), f"window {k}: stator_valid")
+    check(int(w["Rotor_valid"].raw_value) == int(row["rotor_valid"]), f"window {k}: rotor_valid")
+    # the synthetic temperatures (can_selftest.c): within the frame's resolution, edges as sent
+    if k % 10 == 3:
+        check(stator is None and rotor is None, f"window {k}: temperatures not available")
+    elif k % 10 == 5:
+        check(stator == 327.67 and rotor == -327.67 and row["stator_uncert_k"] == "25.2"
+              and row["rotor_uncert_k"] == "25.2", f"window {k}: clamped temperatures {row}")
+    else:
+        check(abs(stator - (-40.0 + 7.37 * k)) <= 0.0051 and abs(rotor - (150.0 - 11.13 * k)) <= 0.0051,
+              f"window {k}: temperatures {stator} {rotor}")
+        check(int(row["stator_valid"]) == k % 2 and int(row["rotor_valid"]) == (k % 3 == 0),
+              f"window {k}: valid bits {row['stator_valid']} {row['rotor_valid']}")
     check(abs(w["t"] - float(row["t_s"])) < 1e-6, f"window {k}: t {w['t']} vs {row['t_s']}")
     check(int(w["Seq"].raw_value) == int(row["seq"]), f"window {k}: seq")
     tr = float(w["TR_s"].phys_value)
@@ -296,7 +352,8 @@ for k, (w, row) in enumerate(zip(windows, rows)):
         check(tr == 3.4028234663852886e38 and rs == -math.inf, f"window {k}: {tr} {rs}")
         check(float(row["T_R_s"]) > 1e38 and row["pe_k1_rel"] == "1.31068"
               and row["rs_bound_rel"] == "0.00000" and row["span_s"] == "65.534"
-              and row["clamped"] == "T_R_s;E_I;pe_k1_rel;pe_k2_rel;span_s;tr_bound_rel;rs_bound_rel",
+              and row["clamped"] == "T_R_s;E_I;pe_k1_rel;pe_k2_rel;span_s;tr_bound_rel;rs_bound_rel;"
+                                    "stator_c;stator_uncert_k;rotor_c;rotor_uncert_k",
               f"window {k}: {row}")
         check(row["rs_reason"] == "out_of_range" and row["windows"] == "255", f"window {k}: {row}")
     if k % 10 == 7:
@@ -310,6 +367,6 @@ if fails:
     print("\n".join(fails[:50]))
     print(f"FAILED: {len(fails)} mismatch(es)")
     sys.exit(1)
-print(f"DBC and C table agree on {len(table['signals'])} signals in {NF} frames "
+print(f"DBC and C table agree on {len(table['signals'])} signals in {NF} + {len(table['optional'])} frames "
       f"({len(mutations)} mutations of the DBC detected); DBC and C decoder agree on "
-      f"{len(rows)} windows ({NF * len(rows)} frames)")
+      f"{len(rows)} windows ({(NF + 1) * len(rows)} frames)")

@@ -3,7 +3,9 @@
  * from a candump -L log, print a table or CSV, and report lost, repeated,
  * late and corrupted frames, estimator overruns and sender restarts (each on
  * stderr, and a summary at the end). When nothing could be decoded it says
- * what the input held and what is likely wrong, and exits 1.
+ * what the input held and what is likely wrong, and exits 1. With
+ * --temperatures it also shows each window's IMEST_TEMP frame (base + 6,
+ * imest_temperature.h), matched to the window by the rolling counter.
  *
  * Exit codes: 0 windows decoded; 1 unusable input (nothing decoded, cannot
  * open or read the log, interface error); 2 usage error; 3 with
@@ -20,6 +22,7 @@
 
 #include "imest/imest.h"
 #include "imest/imest_can.h"
+#include "imest/imest_temperature.h"
 #include "imest_can_id.h"
 #include "imest_candump.h"
 #include "tool_args.h"
@@ -62,12 +65,21 @@ typedef struct {
   uint32_t last_tx_failed;
   int have_tx_failed;
   id_census_t foreign;
+  /* IMEST_TEMP (--temperatures): a window waits for its frame until that comes, a frame of
+   * another window comes, or the input ends; a frame that came first waits for its window */
+  int temps;
+  int have_pending, have_temp;
+  imest_can_window_t pending;
+  double pending_t;
+  imest_temperature_can_t temp;
+  unsigned long temp_frames, temp_corrupt, temp_unmatched;
 } monitor_t;
 
 static void usage(FILE *f)
 {
   fputs("usage: imest-monitor (--can-iface NAME | --log FILE|-) [--can-base-id ID] [--can-ext]\n"
-        "                     [--csv] [--count N] [--timeout SEC] [--require-valid[=WHICH]]\n"
+        "                     [--csv] [--temperatures] [--count N] [--timeout SEC]\n"
+        "                     [--require-valid[=WHICH]]\n"
         "  --can-iface NAME    read live from a SocketCAN interface (e.g. can0, vcan0);\n"
         "                      --iface NAME is the same (the older spelling)\n"
         "  --log FILE          read a candump -L log ('-' = stdin); record one with candump -L\n"
@@ -86,6 +98,15 @@ static void usage(FILE *f)
         "                      the sender clamped to its field's range is printed as that\n"
         "                      limit, and its column is named in 'clamped' (';'-separated;\n"
         "                      'sat' is the same as a bit mask). Empty: its frame is missing\n"
+        "  --temperatures      also the stator's and the rotor's temperatures of the frame\n"
+        "                      IMEST_TEMP (ID+6, sent by firmware that runs the temperature\n"
+        "                      module), matched to its window by the rolling counter: in the\n"
+        "                      CSV the columns stator_c,stator_uncert_k,stator_valid,rotor_c,\n"
+        "                      rotor_uncert_k,rotor_valid (imest-replay --temperatures' names,\n"
+        "                      without rr_ohm) after rs_bound_rel, empty when no IMEST_TEMP\n"
+        "                      came with the window, nan when it says not available; 'frames'\n"
+        "                      has bit 0x40 for it. A window is shown when its IMEST_TEMP\n"
+        "                      arrives, or a frame of another window, or the input ends\n"
         "  --count N           stop after N windows (N >= 1)\n"
         "  --timeout SEC       live: stop after SEC seconds without any frame (default: never)\n"
         "  --require-valid[=WHICH]  exit 3 when windows were decoded but none has WHICH = 1:\n"
@@ -174,10 +195,43 @@ static void csv_reason(int have, int reason)
   if (have) fputs(reason == 255 ? "out_of_range" : imest_reason_name(reason), stdout);
 }
 
+/* IMEST_TEMP's values and the columns named in 'clamped' when at their field's end. */
+static const struct {
+  unsigned int bit;
+  const char *column;
+} k_temp_clamp[] = {{IMEST_TEMPERATURE_CAN_CLAMP_STATOR_C, "stator_c"},
+                    {IMEST_TEMPERATURE_CAN_CLAMP_STATOR_UNCERT, "stator_uncert_k"},
+                    {IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_C, "rotor_c"},
+                    {IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_UNCERT, "rotor_uncert_k"}};
+
+/* A temperature cell: empty without the frame, "nan" when not available (as imest-replay). */
+static void csv_temp(const imest_temperature_can_t *tc, const char *fmt, float v)
+{
+  putchar(',');
+  if (tc == NULL) return;
+  if (isnan(v))
+    fputs("nan", stdout);
+  else
+    printf(fmt, (double)v);
+}
+
+static void csv_temperatures(const imest_temperature_can_t *tc)
+{
+  csv_temp(tc, "%.2f", tc ? tc->stator_c : 0.0f);
+  csv_temp(tc, "%.1f", tc ? tc->stator_uncert_k : 0.0f);
+  putchar(',');
+  if (tc) printf("%d", tc->stator_valid);
+  csv_temp(tc, "%.2f", tc ? tc->rotor_c : 0.0f);
+  csv_temp(tc, "%.1f", tc ? tc->rotor_uncert_k : 0.0f);
+  putchar(',');
+  if (tc) printf("%d", tc->rotor_valid);
+}
+
 /* One CSV row: imest-replay's columns and order for what the frames carry
- * (print_header lists them), then the monitor's own. */
+ * (print_header lists them), then the monitor's own. temps: --temperatures (tc NULL: no
+ * IMEST_TEMP came with this window). */
 static void print_csv_row(const imest_can_window_t *w, double t, int h_tr, int h_rs, int h_q, int h_v,
-                          int h_b)
+                          int h_b, int temps, const imest_temperature_can_t *tc)
 {
   const imest_result_t *r = &w->result;
   const int h_st = (int)((w->have >> IMEST_CAN_FRAME_STAT) & 1u);
@@ -202,6 +256,7 @@ static void print_csv_row(const imest_can_window_t *w, double t, int h_tr, int h
   csv_uint(h_v, r->windows);
   csv_num(h_b, "%.5f", r->tr_bound_rel);
   csv_num(h_b, "%.5f", r->rs_bound_rel);
+  if (temps) csv_temperatures(tc);
   putchar(',');
   const char *sep = "";
   for (size_t k = 0; k < sizeof k_clamp / sizeof k_clamp[0]; ++k) {
@@ -210,10 +265,51 @@ static void print_csv_row(const imest_can_window_t *w, double t, int h_tr, int h
       sep = ";";
     }
   }
+  for (size_t k = 0; tc != NULL && k < sizeof k_temp_clamp / sizeof k_temp_clamp[0]; ++k) {
+    if (tc->clamped & k_temp_clamp[k].bit) {
+      printf("%s%s", sep, k_temp_clamp[k].column);
+      sep = ";";
+    }
+  }
   putchar(',');
   if (h_q) printf("0x%x", w->sat);
   csv_uint(h_st, (unsigned long)w->tx_failed);
-  printf(",%u,0x%x\n", w->counter, w->have);
+  printf(",%u,0x%x\n", w->counter, w->have | (tc ? 1u << IMEST_TEMPERATURE_CAN_FRAME : 0u));
+}
+
+/* The table's temperature columns: value (a clamped one as a bound), uncertainty, verdict. */
+static void fmt_temp(char *buf, size_t n, const imest_temperature_can_t *tc, float v, const char *fmt,
+                     unsigned int clamp_bit)
+{
+  if (tc == NULL) {
+    buf[0] = '\0';
+  } else if (isnan(v)) {
+    snprintf(buf, n, "n/a");
+  } else if (tc->clamped & clamp_bit) {
+    buf[0] = v > 0.0f ? '>' : '<';
+    snprintf(buf + 1, n - 1u, fmt, (double)v);
+  } else {
+    snprintf(buf, n, fmt, (double)v);
+  }
+}
+
+static void print_table_temperatures(const imest_temperature_can_t *tc)
+{
+  char sc[24], su[16], rc[24], ru[16];
+  fmt_temp(sc, sizeof sc, tc, tc ? tc->stator_c : 0.0f, "%.2f", IMEST_TEMPERATURE_CAN_CLAMP_STATOR_C);
+  fmt_temp(su, sizeof su, tc, tc ? tc->stator_uncert_k : 0.0f, "%.1f",
+           IMEST_TEMPERATURE_CAN_CLAMP_STATOR_UNCERT);
+  fmt_temp(rc, sizeof rc, tc, tc ? tc->rotor_c : 0.0f, "%.2f", IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_C);
+  fmt_temp(ru, sizeof ru, tc, tc ? tc->rotor_uncert_k : 0.0f, "%.1f",
+           IMEST_TEMPERATURE_CAN_CLAMP_ROTOR_UNCERT);
+  printf(" %9s %5s %-2s %9s %5s %-2s", sc, su,
+         tc == NULL         ? ""
+         : tc->stator_valid ? "ok"
+                            : "no",
+         rc, ru,
+         tc == NULL        ? ""
+         : tc->rotor_valid ? "ok"
+                           : "no");
 }
 
 /* --require-valid: whether the window has the column asked for at 1. */
@@ -226,7 +322,9 @@ static void count_valid(monitor_t *m, const imest_can_window_t *w, int h_q, int 
     m->n_valid++;
 }
 
-static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
+/* tc: the window's IMEST_TEMP (NULL: none, or no --temperatures) */
+static void print_window(monitor_t *m, const imest_can_window_t *w, double t,
+                         const imest_temperature_can_t *tc)
 {
   const imest_result_t *r = &w->result;
   const int h_tr = (int)((w->have >> IMEST_CAN_FRAME_TR) & 1u);
@@ -270,16 +368,17 @@ static void print_window(monitor_t *m, const imest_can_window_t *w, double t)
   fmt_reason(rsr, sizeof rsr, h_v, r->rs_reason);
   fmt_value(span, sizeof span, h_v, "%.3f", r->span_s, sat, IMEST_CAN_SAT_SPAN);
   if (m->csv) {
-    print_csv_row(w, t, h_tr, h_rs, h_q, h_v, h_b);
+    print_csv_row(w, t, h_tr, h_rs, h_q, h_v, h_b, m->temps, tc);
   } else {
     /* verdict per parameter: "ok", or why not; bounds in % */
     const char *trw = !h_v ? "" : r->tr_valid ? "ok" : trr;
     const char *rsw = !h_v ? "" : r->rs_valid ? "ok" : rsr;
     fmt_percent(trb, sizeof trb, h_b, r->tr_bound_rel, sat, IMEST_CAN_SAT_TRB);
     fmt_percent(rsb, sizeof rsb, h_b, r->rs_bound_rel, sat, IMEST_CAN_SAT_RSB);
-    printf("%17.6f %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %2s/%-2s %6s %5s%s\n", t, seq, tr, trb,
-           trw, rs, rsb, rsw, ei, pk1, pk2, span, na, nr, flags, txf,
-           w->have == ALL_FRAMES ? "" : "  (incomplete)");
+    printf("%17.6f %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %2s/%-2s %6s %5s", t, seq, tr, trb, trw,
+           rs, rsb, rsw, ei, pk1, pk2, span, na, nr, flags, txf);
+    if (m->temps) print_table_temperatures(tc);
+    printf("%s\n", w->have == ALL_FRAMES ? "" : "  (incomplete)");
   }
   if (h_st) {
     m->last_tx_failed = w->tx_failed;
@@ -293,13 +392,16 @@ static void print_header(const monitor_t *m)
 {
   if (m->csv) {
     /* imest-replay's names and order (tools/replay/replay.c), then the monitor's own */
-    puts("t_s,T_R_s,R_S_ohm,E_I,valid,status,seq,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,flags,"
-         "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel,"
-         "clamped,sat,tx_failed,counter,frames");
+    printf("t_s,T_R_s,R_S_ohm,E_I,valid,status,seq,pe_k1_rel,pe_k2_rel,n_roots,n_admissible,flags,"
+           "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel,%s"
+           "clamped,sat,tx_failed,counter,frames\n",
+           m->temps ? "stator_c,stator_uncert_k,stator_valid,rotor_c,rotor_uncert_k,rotor_valid," : "");
   } else {
-    printf("%17s %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %5s %6s %5s\n", "t [s]", "seq", "T_R [s]",
+    printf("%17s %8s %14s %9s %-17s %14s %9s %-17s %7s %9s %9s %8s %5s %6s %5s", "t [s]", "seq", "T_R [s]",
            "+-T_R", "T_R verdict", "R_S [ohm]", "+-R_S", "R_S verdict", "E_I", "PE_K1", "PE_K2", "span [s]",
            "adm/r", "flags", "txf");
+    if (m->temps) printf(" %9s %5s %-2s %9s %5s %-2s", "stator[C]", "+-K", "ok", "rotor[C]", "+-K", "ok");
+    putchar('\n');
   }
   fflush(stdout);
 }
@@ -355,11 +457,78 @@ static void census_add(id_census_t *c, uint32_t id)
   }
 }
 
+/* --- IMEST_TEMP: windows and their temperatures matched by the counter --------- */
+
+/* The window waiting for its IMEST_TEMP, shown without it. */
+static void flush_pending(monitor_t *m)
+{
+  if (!m->have_pending) return;
+  m->have_pending = 0;
+  print_window(m, &m->pending, m->pending_t, NULL);
+}
+
+/* A window the reader returned: shown now without --temperatures or with its IMEST_TEMP if that
+ * came first; else it waits for it. */
+static void deliver_window(monitor_t *m, const imest_can_window_t *w, double t)
+{
+  if (!m->temps) {
+    print_window(m, w, t, NULL);
+    return;
+  }
+  flush_pending(m);
+  if (m->have_temp && m->temp.counter == w->counter) {
+    m->have_temp = 0;
+    print_window(m, w, t, &m->temp);
+    return;
+  }
+  if (m->have_temp) m->temp_unmatched++; /* its window never came */
+  m->have_temp = 0;
+  m->pending = *w;
+  m->pending_t = t;
+  m->have_pending = 1;
+}
+
+static void handle_temp(monitor_t *m, const imest_temperature_can_t *tc)
+{
+  m->temp_frames++;
+  if (!m->temps) {
+    if (m->temp_frames == 1u)
+      fprintf(stderr,
+              "imest-monitor: %s: IMEST_TEMP frames (the motor's temperatures) on the bus: "
+              "--temperatures shows them\n",
+              m->where);
+    return;
+  }
+  if (m->have_pending && m->pending.counter == tc->counter) {
+    m->have_pending = 0;
+    print_window(m, &m->pending, m->pending_t, tc);
+    return;
+  }
+  flush_pending(m);                      /* its IMEST_TEMP was lost */
+  if (m->have_temp) m->temp_unmatched++; /* a second one before its window: the first is stale */
+  m->temp = *tc;                         /* for a window still being assembled */
+  m->have_temp = 1;
+}
+
 static void handle_frame(monitor_t *m, const imest_can_frame_t *f, double t)
 {
   imest_can_window_t w;
   imest_can_rx_event_t ev;
+  imest_temperature_can_t tc;
   const double prev_t = m->win_t;
+  const int td = imest_temperature_can_decode(f, m->base_id, &tc); /* < 0: the base has no ID+6 */
+  if (td == IMEST_CAN_DEC_OK) {
+    handle_temp(m, &tc);
+    return;
+  }
+  if (td == IMEST_CAN_DEC_BAD_DLC || td == IMEST_CAN_DEC_BAD_CRC) {
+    char tid[24];
+    m->temp_corrupt++;
+    fprintf(stderr, "imest-monitor: %s: corrupted frame %s (IMEST_TEMP): %s\n", m->where,
+            imest_can_id_format(f->id, tid, sizeof tid),
+            td == IMEST_CAN_DEC_BAD_DLC ? "not 8 data bytes" : "checksum mismatch");
+    return;
+  }
   const int rc = imest_can_rx_feed(&m->rx, f, &w, &ev);
   const unsigned int e = rc < 0 ? 0u : (unsigned int)rc;
   const char *name = ev.index < IMEST_CAN_NFRAMES ? k_frame_name[ev.index] : "?";
@@ -388,9 +557,11 @@ static void handle_frame(monitor_t *m, const imest_can_frame_t *f, double t)
             m->where, id, name, ev.counter);
     return;
   }
+  /* a frame of another window: the waiting one's IMEST_TEMP is not coming */
+  if (m->have_pending && ev.counter != m->pending.counter) flush_pending(m);
   if (e & IMEST_CAN_EV_WINDOW) {
     report_window_events(m, e, &ev, &w);
-    print_window(m, &w, (e & IMEST_CAN_EV_INCOMPLETE) ? prev_t : t);
+    deliver_window(m, &w, (e & IMEST_CAN_EV_INCOMPLETE) ? prev_t : t);
   }
   m->win_t = t;
 }
@@ -459,7 +630,10 @@ static void explain_nothing(const monitor_t *m, int live)
   imest_can_id_format(m->base_id, a, sizeof a);
   imest_can_id_format(last, b, sizeof b);
   fputs("imest-monitor: nothing decoded: ", stderr);
-  if (s->frames == 0u) {
+  if (s->frames == 0u && m->temp_frames + m->temp_corrupt > 0u) {
+    fprintf(stderr, "%lu IMEST_TEMP frame(s) at %s+6, but none of the six frames %s..%s\n",
+            m->temp_frames + m->temp_corrupt, a, a, b);
+  } else if (s->frames == 0u) {
     if (live) {
       fputs("no frame received\n", stderr);
     } else if (m->lines == 0u) {
@@ -492,14 +666,17 @@ static int finish(monitor_t *m, int live)
   imest_can_window_t w;
   imest_can_rx_event_t ev;
   const imest_can_rx_stats_t *s = &m->rx.st;
+  if (m->count == 0u || m->windows < m->count) flush_pending(m);
   if (m->count == 0u || m->windows < m->count) {
     const int rc = imest_can_rx_flush(&m->rx, &w, &ev);
     if (rc > 0) {
       snprintf(m->where, sizeof m->where, "end of input");
       report_window_events(m, (unsigned int)rc, &ev, &w);
-      print_window(m, &w, m->win_t);
+      deliver_window(m, &w, m->win_t);
+      flush_pending(m);
     }
   }
+  if (m->have_temp) m->temp_unmatched++;
   fprintf(stderr,
           "imest-monitor: summary: frames %lu (foreign %lu), windows %lu (incomplete %lu), "
           "lost %lu, repeated %lu, corrupted %lu, estimator gaps %lu, restarts %lu, late %lu, "
@@ -509,6 +686,11 @@ static int finish(monitor_t *m, int live)
           (unsigned long)s->corrupt, (unsigned long)s->seq_gaps, (unsigned long)s->restarts,
           (unsigned long)s->late, m->malformed, m->have_tx_failed ? "" : "n/a ",
           (unsigned long)m->last_tx_failed);
+  if (m->temp_frames > 0u || m->temp_corrupt > 0u) {
+    fprintf(stderr, "imest-monitor: IMEST_TEMP frames %lu (corrupted %lu, without their window %lu)%s\n",
+            m->temp_frames, m->temp_corrupt, m->temp_unmatched,
+            m->temps ? "" : ": not shown, --temperatures shows them");
+  }
   if (m->windows == 0u) {
     explain_nothing(m, live);
     return TOOL_EXIT_DATA;
@@ -669,6 +851,9 @@ int main(int argc, char **argv)
     } else if (tool_args_is(&a, "--csv")) {
       if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
       m.csv = 1;
+    } else if (tool_args_is(&a, "--temperatures")) {
+      if (tool_args_flag(&a)) return TOOL_EXIT_USAGE;
+      m.temps = 1;
     } else if (tool_args_is(&a, "--require-valid")) {
       if (tool_args_require_valid(&a, &m.require)) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--can-ext") || tool_args_is(&a, "--ext")) {

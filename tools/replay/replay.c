@@ -20,6 +20,7 @@
 #include "drive_loop.h"
 #include "imest/imest.h"
 #include "imest/imest_can.h"
+#include "imest/imest_temperature.h"
 #include "replay_advice.h"
 #include "replay_align.h"
 #include "replay_options.h"
@@ -118,13 +119,18 @@ static int can_log_open(can_log_t *c, const replay_opts_t *o, FILE *to_stdout)
 #endif
 }
 
-static void can_log_publish(can_log_t *c, const imest_result_t *r)
+/* The window's six frames, then (--temperatures: t not NULL) its IMEST_TEMP with the same counter,
+ * as a firmware running the temperature module sends them (imest_temperature.h). */
+static void can_log_publish(can_log_t *c, const imest_result_t *r, const imest_temperature_t *t)
 {
 #ifdef IMEST_HAVE_CANDUMP
-  if (c->f) (void)imest_can_publish(&c->pub, r); /* a failed write: can_log_close() says so */
+  if (c->f == NULL) return;
+  (void)imest_can_publish(&c->pub, r); /* a failed write: can_log_close() says so */
+  if (t != NULL) (void)imest_temperature_can_publish(&c->pub, t);
 #else
   (void)c;
   (void)r;
+  (void)t;
 #endif
 }
 
@@ -180,7 +186,8 @@ static void print_row(void *ctx, const imest_result_t *r)
 {
   const row_ctx_t *x = (const row_ctx_t *)ctx;
   const double t0_s = x->t0_s;
-  can_log_publish(x->can, r);
+  if (x->temp != NULL) (void)imest_temperature_update(x->temp, r); /* r and x->temp are not NULL */
+  can_log_publish(x->can, r, x->temp);
   printf("%.6f,%.9g,%.9g,%.6g,%d,%s,%u,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%u,%u,%.4g,%.6g,%u,0x%x,",
          t0_s + r->t_end_s, r->tr_s, r->rs_ohm, r->e_i, r->valid, imest_reason_name(r->status), r->seq, r->k1,
          r->k2, r->pe_k1_rel, r->pe_k2_rel, r->hessian[0][0], r->hessian[0][1], r->hessian[1][1],
@@ -191,7 +198,6 @@ static void print_row(void *ctx, const imest_result_t *r)
   print_bound(r->tr_bound_rel);
   print_bound(r->rs_bound_rel);
   if (x->temp != NULL) {
-    (void)imest_temperature_update(x->temp, r); /* r and x->temp are not NULL */
     const imest_temperature_t *t = x->temp;
     print_bound((double)t->stator_c);
     print_bound((double)t->stator_uncert_k);
