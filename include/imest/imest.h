@@ -386,35 +386,35 @@ typedef struct {
   /** time the estimate is drawn from [s]: the window length, longer when consecutive windows were
    *  combined */
   double span_s;
-  unsigned int windows; /**< windows combined into this estimate (1: this one alone) */
-  double tr_s;          /**< rotor time constant T_R [s] (NaN if no candidate) */
-  double rs_ohm;        /**< stator resistance R_S [ohm] */
-  double tr_bound_rel;  /**< error bound of T_R, relative (NaN if not computed) */
-  double rs_bound_rel;  /**< error bound of R_S, relative (NaN if not computed) */
-  double k1;            /**< K1 = gamma [1/s] */
-  double k2;            /**< K2 = 1/T_R [1/s] */
-  double e;             /**< E_p^2 at the minimum (units of y^2 * samples) */
-  double e_i;           /**< residual error index sqrt(E/R_y) */
-  double e_i_noise;     /**< the part of E_I that the sensors' white noise explains */
-  double noise_i_a;     /**< white noise of the current per alpha/beta axis, rms [A] */
-  double noise_u_v;     /**< white noise of the measured voltage per axis, rms [V] (0: duty input) */
-  double hessian[2][2]; /**< d2E/dK^2 at the minimum, K = (K1, K2) */
-  double pe_k1;         /**< parametric error index of K1 (absolute, 1/s) */
-  double pe_k2;         /**< parametric error index of K2 (absolute, 1/s) */
-  double pe_k1_rel;     /**< pe_k1 / K1 */
-  double pe_k2_rel;     /**< pe_k2 / K2 */
-  double slip_ratio;    /**< slip excitation (slip frequency x tr_nominal_s), see min_slip_ratio */
-  double i_rms_a;       /**< rms stator current over the window (alpha/beta amplitude) */
-  double ls_noload_h;   /**< L_S measured in a window at no load (NaN: none); more than 6 % from
-                                  the configured L_S (with a magnetising curve: the curve's L_S
-                                  at this window's current) is constants_mismatch from then on */
-  /** L_S at the window's flux from the magnetising curve [H] (ls_curve_points); T_R and R_S are
-   *  then the estimate with this L_S and sigma x ls_h / ls_window_h (sigma L_S held), k1 and k2
-   *  the fit's with ls_h. NaN: no curve, or a window where the correction does not apply (no
-   *  estimate, or beyond the pull-out slip) */
-  double ls_window_h;
-  unsigned int n_roots;             /**< positive roots of the resultant */
-  unsigned int n_admissible;        /**< roots with K1 > 0 and T_R in band */
+  unsigned int windows;      /**< windows combined into this estimate (1: this one alone) */
+  double tr_s;               /**< rotor time constant T_R [s] (NaN if no candidate) */
+  double rs_ohm;             /**< stator resistance R_S [ohm] */
+  double tr_bound_rel;       /**< error bound of T_R, relative (NaN if not computed) */
+  double rs_bound_rel;       /**< error bound of R_S, relative (NaN if not computed) */
+  double k1;                 /**< K1 = gamma [1/s] */
+  double k2;                 /**< K2 = 1/T_R [1/s] */
+  double e;                  /**< E_p^2 at the minimum (units of y^2 * samples) */
+  double e_i;                /**< residual error index sqrt(E/R_y) */
+  double e_i_noise;          /**< the part of E_I that the sensors' white noise explains */
+  double noise_i_a;          /**< white noise of the current per alpha/beta axis, rms [A] */
+  double noise_u_v;          /**< white noise of the measured voltage per axis, rms [V] (0: duty input) */
+  double hessian[2][2];      /**< d2E/dK^2 at the minimum, K = (K1, K2) */
+  double pe_k1;              /**< parametric error index of K1 (absolute, 1/s) */
+  double pe_k2;              /**< parametric error index of K2 (absolute, 1/s) */
+  double pe_k1_rel;          /**< pe_k1 / K1 */
+  double pe_k2_rel;          /**< pe_k2 / K2 */
+  double slip_ratio;         /**< slip excitation (slip frequency x tr_nominal_s), see min_slip_ratio */
+  double i_rms_a;            /**< rms stator current over the window (alpha/beta amplitude) */
+  double ls_noload_h;        /**< L_S measured in a window at no load (NaN: none); more than 6 % from
+                                  the configured L_S (with a magnetising curve: the curve's L_S at
+                                  this window's current) is constants_mismatch from then on */
+  double ls_window_h;        /**< L_S at the window's flux from the magnetising curve [H]; T_R and
+                                  R_S are then the estimate with this L_S and sigma x ls_h /
+                                  ls_window_h (sigma L_S held), k1 and k2 the fit's with ls_h.
+                                  NaN: no curve, or a window where the correction does not apply
+                                  (no estimate, beyond the pull-out slip) */
+  unsigned int n_roots;      /**< positive roots of the resultant */
+  unsigned int n_admissible; /**< roots with K1 > 0 and T_R in band */
   double roots_k2[IMEST_MAX_ROOTS]; /**< the positive roots, ascending */
 } imest_result_t;
 

@@ -7,34 +7,31 @@
  * window's impedance Z (bg_impedance.h) with the configured constants, so Z
  * follows from the estimate, and the estimate with L_w, sigma_w is the one
  * that gives the same Z: solved in closed form (no linearisation), twice,
- * because i_d = |i| / sqrt(1 + a^2) depends on a = slip frequency x T_R.
+ * because i_d = |i| / sqrt(1 + a^2) depends on a = slip frequency x T_R
+ * (a secant step on L_w, FLUX_MAX_CONTRACTION).
  * float32: every figure is relative, as in bg_validity.c. */
 #include <math.h>
 
 #include "bg_flux.h"
 #include "bg_impedance.h"
 
-/* Passes of the fixed point i_d(T_R) -> L_w -> T_R: the first takes i_d at
- * the fit's T_R, the second at the first's. The second's change, scaled by
- * the contraction the two passes show (k = change 2 / change 1), bounds what
- * further passes would change: k / (1 - k) x change 2 (4 kW at rated load:
- * the first moves T_R by +4.5 %, the second by +1 %). */
-#define FLUX_PASSES        2
+/* The fixed point L = curve(i_d(T_R(L))) is solved by one secant step: the
+ * fit's T_R gives L_1 = curve(i_d), the estimate with L_1 gives L_2; the
+ * fixed point of the straight line through (ls_h, L_1), (L_1, L_2) is L_w,
+ * and the estimate with L_w is the result (two estimates in all). The step's
+ * contraction k = (L_2 - L_1) / (L_1 - ls_h) must be below this (4 kW, rated
+ * load: k about 0.3): beyond it the curve is too steep at this flux for the
+ * step to be trusted, and the window's bounds say so. */
+#define FLUX_MAX_CONTRACTION 0.5f
 /* The steady-state picture against the estimator: moved to L_w, the estimate
  * is the one re-estimating with L_S = L_w gives to within this share of the
  * move (measured: tools/studies/saturation, 4 and 11 kW motors, 25-100 % load
  * and field weakening; docs/METHOD.md §18.2). */
-#define FLUX_PICTURE_SHARE 0.02f
+#define FLUX_PICTURE_SHARE   0.02f
 
 static float seg_slope(const float *x, const float *y, unsigned int k)
 {
   return (y[k + 1u] - y[k]) / (x[k + 1u] - x[k]);
-}
-
-/* The curvature the slopes show at inner point j (1 .. n-2), second divided difference x 2. */
-static float node_curvature(const float *x, const float *y, unsigned int j)
-{
-  return 2.0f * fabsf(seg_slope(x, y, j) - seg_slope(x, y, j - 1u)) / (x[j + 1u] - x[j - 1u]);
 }
 
 float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
@@ -55,11 +52,10 @@ float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
     return y[n - 1u];
   }
   const float t = (i_a - x[k]) / h;
-  float c = 0.0f;
-  if (k >= 1u) c = node_curvature(x, y, k);
-  if (k + 2u < n) c = fmaxf(c, node_curvature(x, y, k + 1u));
-  if (n == 2u) c = 2.0f * fabsf(y[1] - y[0]) / (h * h);
-  *err_h = t * (1.0f - t) * h * h * c * 0.5f;
+  float dslope = n == 2u ? fabsf(slope) : 0.0f; /* the slope's change at the segment's ends */
+  if (k >= 1u) dslope = fabsf(slope - seg_slope(x, y, k - 1u));
+  if (k + 2u < n) dslope = fmaxf(dslope, fabsf(seg_slope(x, y, k + 1u) - slope));
+  *err_h = t * (1.0f - t) * h * dslope;
   return y[k] + t * (y[k + 1u] - y[k]);
 }
 
@@ -76,15 +72,25 @@ static int refit(const bg_impedance_t *z, float we, float ws, float ls, float sg
   return 1;
 }
 
-/* What passes beyond the last would still change, from the last two
- * changes: k / (1 - k) x the last, k their ratio; infinite unless k < 1/2
- * (the fixed point then converges too slowly to be trusted after two). */
-static float passes_left(const float d[FLUX_PASSES])
+/* L_S of the curve at the flux-producing current of the estimate with T_R tr:
+ * i_d = |i| / sqrt(1 + a^2), a = ws tr. */
+static float ls_at(const imest_t *s, float i2, float ws, float tr, float *err)
 {
-  const float last = d[FLUX_PASSES - 1], before = d[FLUX_PASSES - 2];
-  if (!(last > 0.0f)) return 0.0f;
-  const float k = last / before;
-  return k < 0.5f ? last * k / (1.0f - k) : INFINITY;
+  const float a = ws * tr;
+  return imest__bg_flux_ls(s, sqrtf(i2 / (1.0f + a * a)), err);
+}
+
+/* The secant step of FLUX_MAX_CONTRACTION: L_w from ls_h and the two curve
+ * values; 0 if the step cannot be trusted. */
+static int secant(float l0, float l1, float l2, float *lw)
+{
+  const float f0 = l1 - l0, f1 = l2 - l1;
+  *lw = l1;
+  if (f0 == 0.0f || f1 == 0.0f) return 1; /* on the fixed point already */
+  const float k = f1 / f0;
+  if (!(fabsf(k) < FLUX_MAX_CONTRACTION)) return 0;
+  *lw = l1 + f1 / (1.0f - k);
+  return 1;
 }
 
 void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums_t *sm, uint32_t nreg,
@@ -107,32 +113,31 @@ void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums
   const float sls = s->sigma * s->ls_h;
   bg_impedance_t z; /* the window's impedance, as the fit saw it */
   imest__bg_impedance(we, ws, s->ls_h, s->sigma, tr0, rs0, &z);
-  float tr = tr0, rs = rs0, lw = s->ls_h, err = 0.0f;
-  float d_tr[FLUX_PASSES], d_rs[FLUX_PASSES]; /* each pass's change */
-  for (int p = 0; p < FLUX_PASSES; ++p) {
-    const float a = ws * tr, tr_in = tr, rs_in = rs;
-    lw = imest__bg_flux_ls(s, sqrtf(i2 / (1.0f + a * a)), &err);
-    if (!refit(&z, we, ws, lw, sls / lw, &tr, &rs)) {
-      /* no motor with L_w gives this impedance: the curve and the window
-       * disagree; the estimate stays, and its bounds say it is not known */
-      fx->tr_b = INFINITY;
-      fx->rs_b = INFINITY;
-      return;
-    }
-    d_tr[p] = fabsf(tr - tr_in);
-    d_rs[p] = fabsf(rs - rs_in);
+  float tr = tr0, rs = rs0, err;
+  const float l1 = ls_at(s, i2, ws, tr0, &err);
+  float lw = l1;
+  int ok = refit(&z, we, ws, l1, sls / l1, &tr, &rs);
+  if (ok) ok = secant(s->ls_h, l1, ls_at(s, i2, ws, tr, &err), &lw);
+  if (ok) ok = refit(&z, we, ws, lw, sls / lw, &tr, &rs);
+  if (!ok) {
+    /* no motor with the curve's L_S gives this impedance, or the curve is too
+     * steep here: the curve and the window disagree. The estimate stays the
+     * fit's, and its bounds say that it is not known. */
+    fx->tr_b = INFINITY;
+    fx->rs_b = INFINITY;
+    return;
   }
-  /* The bounds: the curve's uncertainty at i_d through the first-order move
-   * of the estimate with L_S (sigma L_S held: sigma moves the other way), what
-   * more passes would change, and the picture's share of the move. */
-  const float sg = sls / lw, e = err / lw;
+  /* The bounds: how far L_w is from the curve's at the result's own i_d (the
+   * step's remainder) and the curve's uncertainty there, through the
+   * first-order move of the estimate with L_S (sigma L_S held: sigma moves the
+   * other way), and the picture's share of the move. */
+  const float l3 = ls_at(s, i2, ws, tr, &err), sg = sls / lw, e = (fabsf(l3 - lw) + err) / lw;
   bg_impedance_t zw;
   imest__bg_impedance(we, ws, lw, sg, tr, rs, &zw);
   float e_tr, e_rs;
   imest__bg_constants_shift(&zw, sg, e, -e, tr, rs, &e_tr, &e_rs);
-  const float ars = fabsf(rs);
-  fx->tr_b = fabsf(e_tr) + (passes_left(d_tr) + FLUX_PICTURE_SHARE * fabsf(tr0 - tr)) / tr;
-  fx->rs_b = fabsf(e_rs) + (passes_left(d_rs) + FLUX_PICTURE_SHARE * fabsf(rs0 - rs)) / ars;
+  fx->tr_b = fabsf(e_tr) + FLUX_PICTURE_SHARE * fabsf(tr0 - tr) / tr;
+  fx->rs_b = fabsf(e_rs) + FLUX_PICTURE_SHARE * fabsf(rs0 - rs) / fabsf(rs);
   r->tr_s = (double)tr;
   r->rs_ohm = (double)rs;
   r->ls_window_h = (double)lw;
