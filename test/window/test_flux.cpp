@@ -189,7 +189,7 @@ TEST(FluxCorrection, ExactForAFlatCurve)
       EXPECT_NEAR(x.r.rs_ohm / x.rs_true - 1.0, 0.0, 2e-4)
           << "the fit's R_S was off by " << x.rs_fit / x.rs_true - 1.0;
       EXPECT_GE(fx.tr_b, 0.0f);
-      EXPECT_LT(fx.tr_b, 0.02f * std::fabs(x.tr_fit / x.tr_true - 1.0) + 1e-4);
+      EXPECT_LT(fx.tr_b, 0.06 * std::fabs(x.tr_fit / x.tr_true - 1.0) + 1e-4) << "the picture's share only";
     }
   }
 }
