@@ -317,7 +317,7 @@ typedef struct {
    *  whose R_S lies outside what heating explains (0.7 .. 1.9 x this) is constants_mismatch */
   float rs_nominal_ohm;
 
-  /* Main-flux saturation: L_S at the window's flux (docs/METHOD.md §18.2). The points of a no-load
+  /* Main-flux saturation: L_S at the window's flux (docs/METHOD.md §18.5). The points of a no-load
    * test at several voltages (the reactive power over |i|^2 w_e at each, or the no-load windows'
    * ls_noload_h): L_S against the magnetising current. In a window where the steady-state picture
    * holds (slip frequency x T_R x sigma below 1, as for tr_uncertain) the estimate is moved to

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: L_S at the window's flux (main-flux saturation) from the
  * configured magnetising curve, and T_R and R_S moved to it (docs/METHOD.md
- * §18.2). Saturation moves the main inductance, not the leakage: the window's
+ * §18.5). Saturation moves the main inductance, not the leakage: the window's
  * motor has L_w = L_S(i_d) and sigma_w = sigma ls_h / L_w (sigma L_S held),
  * where the solve assumed ls_h and sigma. In steady state the fit matches the
  * window's impedance Z (bg_impedance.h) with the configured constants, so Z
@@ -28,7 +28,7 @@
  * move (measured, tools/studies/saturation: 4 and 11 kW motors, 25-100 % load
  * at 50 Hz and field weakening at 75 Hz; T_R within 5 % of its move (11 kW at
  * 25 % load: +0.50 % moved, +0.41 % re-estimated, from -1.34 % without), R_S
- * within 8 % (the same window); docs/METHOD.md §18.2). */
+ * within 8 % (the same window); docs/METHOD.md §18.5). */
 #define FLUX_PICTURE_SHARE_TR 0.05f
 #define FLUX_PICTURE_SHARE_RS 0.1f
 

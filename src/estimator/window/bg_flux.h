@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Background stage: L_S at the window's flux from the configured magnetising
  * curve (main-flux saturation), and the estimate moved to it (docs/METHOD.md
- * §18.2). Runs after the solve, before the verdict. Internal: not part of the
+ * §18.5). Runs after the solve, before the verdict. Internal: not part of the
  * public API. */
 #ifndef IMEST_BG_FLUX_H
 #define IMEST_BG_FLUX_H
