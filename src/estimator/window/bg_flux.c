@@ -62,12 +62,12 @@ float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
   return y[k] + t * (y[k + 1u] - y[k]);
 }
 
-/* The T_R and R_S that give the impedance z with the constants ls, sg:
- * Im Z / (we ls) = (1 + sg a^2) / (1 + a^2) gives a^2, Re Z gives R_S.
+/* The T_R and R_S that give the impedance z with L_S = ls and sigma L_S =
+ * sls: Im Z / (we ls) = (1 + sg a^2) / (1 + a^2) gives a^2, Re Z gives R_S.
  * 0 if no such motor exists (Im Z outside (sg, 1) x we ls). */
-static int refit(const bg_impedance_t *z, float we, float ws, float ls, float sg, float *tr, float *rs)
+static int refit(const bg_impedance_t *z, float we, float ws, float ls, float sls, float *tr, float *rs)
 {
-  const float q = z->zi / (we * ls);
+  const float sg = sls / ls, q = z->zi / (we * ls);
   if (!(q > sg && q < 1.0f)) return 0;
   const float a2 = (1.0f - q) / (q - sg), a = copysignf(sqrtf(a2), ws);
   *tr = fabsf(a / ws);
@@ -114,14 +114,20 @@ void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums
         fabsf(ws * tr0) * s->sigma < 1.0f))
     return;
   const float sls = s->sigma * s->ls_h;
-  bg_impedance_t z; /* the window's impedance, as the fit saw it */
-  imest__bg_impedance(we, ws, s->ls_h, s->sigma, tr0, rs0, &z);
-  float tr = tr0, rs = rs0, err;
+  bg_impedance_t z; /* the window's impedance, as the fit saw it (bg_impedance.h): zr, zi */
+  const float a0 = ws * tr0, x = we * s->ls_h / (1.0f + a0 * a0);
+  z.zr = rs0 + x * a0 * (1.0f - s->sigma);
+  z.zi = x * (1.0f + s->sigma * a0 * a0);
+  float tr = tr0, rs = rs0, err, lw = s->ls_h, tr_e, rs_e;
   const float l1 = ls_at(s, i2, ws, tr0, &err);
-  float lw = l1;
-  int ok = refit(&z, we, ws, l1, sls / l1, &tr, &rs);
-  if (ok) ok = secant(s->ls_h, l1, ls_at(s, i2, ws, tr, &err), &lw);
-  if (ok) ok = refit(&z, we, ws, lw, sls / lw, &tr, &rs);
+  int ok = refit(&z, we, ws, l1, sls, &tr, &rs) && secant(s->ls_h, l1, ls_at(s, i2, ws, tr, &err), &lw) &&
+           refit(&z, we, ws, lw, sls, &tr, &rs);
+  /* The curve's share of the bounds: L_w's uncertainty, i.e. its distance
+   * from the curve at the result's own i_d (the step's remainder) plus the
+   * curve's uncertainty there, taken through the same closed form (the
+   * estimate with L_w that much higher); and the picture's share of the move. */
+  const float dl = fabsf(ls_at(s, i2, ws, tr, &err) - lw) + err;
+  ok = ok && refit(&z, we, ws, lw + dl, sls, &tr_e, &rs_e);
   if (!ok) {
     /* no motor with the curve's L_S gives this impedance, or the curve is too
      * steep here: the curve and the window disagree. The estimate stays the
@@ -130,17 +136,8 @@ void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums
     fx->rs_b = INFINITY;
     return;
   }
-  /* The bounds: how far L_w is from the curve's at the result's own i_d (the
-   * step's remainder) and the curve's uncertainty there, through the
-   * first-order move of the estimate with L_S (sigma L_S held: sigma moves the
-   * other way), and the picture's share of the move. */
-  const float l3 = ls_at(s, i2, ws, tr, &err), sg = sls / lw, e = (fabsf(l3 - lw) + err) / lw;
-  bg_impedance_t zw;
-  imest__bg_impedance(we, ws, lw, sg, tr, rs, &zw);
-  float e_tr, e_rs;
-  imest__bg_constants_shift(&zw, sg, e, -e, tr, rs, &e_tr, &e_rs);
-  fx->tr_b = fabsf(e_tr) + FLUX_PICTURE_SHARE_TR * fabsf(tr0 - tr) / tr;
-  fx->rs_b = fabsf(e_rs) + FLUX_PICTURE_SHARE_RS * fabsf(rs0 - rs) / fabsf(rs);
+  fx->tr_b = (fabsf(tr_e - tr) + FLUX_PICTURE_SHARE_TR * fabsf(tr0 - tr)) / tr;
+  fx->rs_b = (fabsf(rs_e - rs) + FLUX_PICTURE_SHARE_RS * fabsf(rs0 - rs)) / fabsf(rs);
   r->tr_s = (double)tr;
   r->rs_ohm = (double)rs;
   r->ls_window_h = (double)lw;
