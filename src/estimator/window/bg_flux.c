@@ -13,7 +13,6 @@
 #include <math.h>
 
 #include "bg_flux.h"
-#include "bg_impedance.h"
 
 /* The fixed point L = curve(i_d(T_R(L))) is solved by one secant step: the
  * fit's T_R gives L_1 = curve(i_d), the estimate with L_1 gives L_2; the
@@ -32,18 +31,18 @@
 #define FLUX_PICTURE_SHARE_TR 0.05f
 #define FLUX_PICTURE_SHARE_RS 0.1f
 
-static float seg_slope(const float *x, const float *y, unsigned int k)
+static float seg_slope(const float *x, const float *y, uint32_t k)
 {
   return (y[k + 1u] - y[k]) / (x[k + 1u] - x[k]);
 }
 
 float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
 {
-  const unsigned int n = s->ls_curve_points;
+  const uint32_t n = s->ls_curve_points;
   const float *x = s->ls_curve_i_a, *y = s->ls_curve_h;
   *err_h = 0.0f;
   if (n < 2u) return s->ls_h;
-  unsigned int k = 0u; /* the segment [x_k, x_k+1]: the first, the last, or the one holding i_a */
+  uint32_t k = 0u; /* the segment [x_k, x_k+1]: the first, the last, or the one holding i_a */
   while (k + 2u < n && i_a > x[k + 1u]) ++k;
   const float h = x[k + 1u] - x[k], slope = seg_slope(x, y, k);
   if (!(i_a > x[0])) {
@@ -62,10 +61,15 @@ float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
   return y[k] + t * (y[k + 1u] - y[k]);
 }
 
+/* A window's impedance Z = zr + j zi [ohm]. */
+typedef struct {
+  float zr, zi;
+} flux_z_t;
+
 /* The T_R and R_S that give the impedance z with L_S = ls and sigma L_S =
  * sls: Im Z / (we ls) = (1 + sg a^2) / (1 + a^2) gives a^2, Re Z gives R_S.
  * 0 if no such motor exists (Im Z outside (sg, 1) x we ls). */
-static int refit(const bg_impedance_t *z, float we, float ws, float ls, float sls, float *tr, float *rs)
+static int refit(const flux_z_t *z, float we, float ws, float ls, float sls, float *tr, float *rs)
 {
   const float sg = sls / ls, q = z->zi / (we * ls);
   if (!(q > sg && q < 1.0f)) return 0;
@@ -104,7 +108,7 @@ void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums
   r->ls_window_h = (double)NAN;
   if (s->ls_curve_points == 0u) return;
   const float tr0 = (float)r->tr_s, rs0 = (float)r->rs_ohm, ws = (float)st->slip_rate;
-  const float we = ws + s->n * (float)st->w_mean;
+  const float we = ws + (float)s->n * (float)st->w_mean; /* s->n: float64 in the reference build */
   const float i2 = nreg > 0u ? (float)sm->rw[3][3] / (float)nreg : 0.0f;
   /* The steady-state picture: an estimate, a field, a slip, below the
    * pull-out slip (tr_uncertain's condition). Elsewhere (a run-up, a
@@ -114,10 +118,9 @@ void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums
         fabsf(ws * tr0) * s->sigma < 1.0f))
     return;
   const float sls = s->sigma * s->ls_h;
-  bg_impedance_t z; /* the window's impedance, as the fit saw it (bg_impedance.h): zr, zi */
   const float a0 = ws * tr0, x = we * s->ls_h / (1.0f + a0 * a0);
-  z.zr = rs0 + x * a0 * (1.0f - s->sigma);
-  z.zi = x * (1.0f + s->sigma * a0 * a0);
+  /* the window's impedance, as the fit saw it (bg_impedance.h's Z) */
+  const flux_z_t z = {rs0 + x * a0 * (1.0f - s->sigma), x * (1.0f + s->sigma * a0 * a0)};
   float tr = tr0, rs = rs0, err, lw = s->ls_h, tr_e, rs_e;
   const float l1 = ls_at(s, i2, ws, tr0, &err);
   int ok = refit(&z, we, ws, l1, sls, &tr, &rs) && secant(s->ls_h, l1, ls_at(s, i2, ws, tr, &err), &lw) &&
