@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "bg_flux.h"
 #include "bg_noise.h"
 #include "common/imest_handoff.h"
 #include "common/imest_math.h"
@@ -127,18 +128,21 @@ static int check_ok(const check_t *c, float x, float fs)
 
 /* The magnetising curve: 0 points (none) or 2 .. IMEST_LS_CURVE_POINTS (one
  * point is ls_h), each current and L_S finite and positive, the currents
- * strictly increasing (the interpolation's segments need a positive width).
- * The name of the first bad field, NULL if the curve is usable. */
+ * strictly increasing (the interpolation's segments need a positive width);
+ * none at all in a build without the stage (IMEST_WITH_FLUX 0). The name of
+ * the first bad field, NULL if the curve is usable. */
 static const char *check_ls_curve(const imest_config_t *cfg)
 {
   const unsigned int n = cfg->ls_curve_points;
   if (n == 0u) return NULL;
-  if (n < 2u || n > IMEST_LS_CURVE_POINTS) return "ls_curve_points";
+  if (!IMEST_WITH_FLUX || n < 2u || n > IMEST_LS_CURVE_POINTS) return "ls_curve_points";
+#if IMEST_WITH_FLUX
   for (unsigned int k = 0; k < n; ++k) {
     const float x = cfg->ls_curve_i_a[k], y = cfg->ls_curve_h[k];
     if (!(isfinite(x) && x > 0.0f) || (k > 0u && !(x > cfg->ls_curve_i_a[k - 1u]))) return "ls_curve_i_a";
     if (!(isfinite(y) && y > 0.0f)) return "ls_curve_h";
   }
+#endif
   return NULL;
 }
 
@@ -375,7 +379,7 @@ static void init_background_constants(imest_t *s, const imest_config_t *cfg)
   s->rs_nominal_ohm = cfg->rs_nominal_ohm;
   s->tr_nominal_known = cfg->tr_nominal_known != 0;
   s->ls_curve_points = cfg->ls_curve_points;
-  for (unsigned int k = 0; k < IMEST_LS_CURVE_POINTS; ++k) {
+  for (unsigned int k = 0; IMEST_WITH_FLUX && k < IMEST_LS_CURVE_POINTS; ++k) {
     s->ls_curve_i_a[k] = cfg->ls_curve_i_a[k];
     s->ls_curve_h[k] = cfg->ls_curve_h[k];
   }

@@ -31,6 +31,7 @@
 #define FLUX_PICTURE_SHARE_TR 0.05f
 #define FLUX_PICTURE_SHARE_RS 0.1f
 
+#if IMEST_WITH_FLUX
 static float seg_slope(const float *x, const float *y, uint32_t k)
 {
   return (y[k + 1u] - y[k]) / (x[k + 1u] - x[k]);
@@ -145,3 +146,23 @@ void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums
   r->rs_ohm = (double)rs;
   r->ls_window_h = (double)lw;
 }
+#else  /* IMEST_WITH_FLUX: left out of the build, no curve (imest_config_check() refuses one) */
+float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
+{
+  (void)i_a;
+  *err_h = 0.0f;
+  return s->ls_h;
+}
+
+void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums_t *sm, uint32_t nreg,
+                    imest_result_t *r, bg_flux_t *fx)
+{
+  (void)s;
+  (void)st;
+  (void)sm;
+  (void)nreg;
+  fx->tr_b = 0.0f;
+  fx->rs_b = 0.0f;
+  r->ls_window_h = (double)NAN;
+}
+#endif /* IMEST_WITH_FLUX */

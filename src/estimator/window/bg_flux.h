@@ -8,6 +8,14 @@
 
 #include "bg_window.h"
 
+/* Built in unless the build defines IMEST_WITH_FLUX=0 (CMake: -DIMEST_FLUX=OFF),
+ * for a firmware short of flash: the stage's code is then not linked, a
+ * config with a curve is refused (imest_config_check(): ls_curve_points) and
+ * L_S is flux-independent, as without a curve. */
+#ifndef IMEST_WITH_FLUX
+#define IMEST_WITH_FLUX 1
+#endif
+
 /* What the curve hands to the verdict's bounds (bg_validity.c). */
 typedef struct {
   float tr_b, rs_b; /* the curve's share of T_R's and R_S's relative bounds (0: no curve, not applied) */

@@ -192,8 +192,10 @@ static float gain_mismatch(const imest_window_t *w, const bg_sums_t *sm)
  * *tol: 6 %, plus the curve's own uncertainty there. */
 static float noload_ls_ref(const imest_t *s, const op_point_t *op, float slip_ratio, float *tol)
 {
-  float err_h;
-  const float ls = imest__bg_flux_ls(s, sqrtf(op->i2 / (1.0f + slip_ratio * slip_ratio)), &err_h);
+  float err_h = 0.0f;
+  const float ls = IMEST_WITH_FLUX
+                       ? imest__bg_flux_ls(s, sqrtf(op->i2 / (1.0f + slip_ratio * slip_ratio)), &err_h)
+                       : s->ls_h;
   *tol = LS_NOLOAD_TOL + err_h / ls;
   return ls;
 }
@@ -438,7 +440,7 @@ static void bounds(judge_t *j, const bg_sums_t *sm, int have)
  * computed; nothing without a curve (the outputs stay as without it). */
 static void flux_bounds(judge_t *j, const bg_flux_t *fx)
 {
-  if (fx == NULL || j->s->ls_curve_points == 0u || !isfinite(j->tr_b)) return;
+  if (!IMEST_WITH_FLUX || fx == NULL || j->s->ls_curve_points == 0u || !isfinite(j->tr_b)) return;
   j->tr_b += fx->tr_b;
   j->rs_b += fx->rs_b;
   j->r->tr_bound_rel = (double)j->tr_b;
