@@ -333,7 +333,8 @@ typedef struct {
   /** L_S measured at no load at each of ls_curve_i_a [H], positive (default 0) */
   float ls_curve_h[IMEST_LS_CURVE_POINTS];
   /** points of the curve in use, 2 .. IMEST_LS_CURVE_POINTS (default 0: no curve, L_S is taken as
-   *  flux-independent and every output is as without these fields) */
+   *  flux-independent and every output is as without these fields); a core built with
+   *  IMEST_WITH_FLUX=0 (docs/integrating.md "Flags") refuses any curve */
   unsigned int ls_curve_points;
 
   /* Input plausibility (per sample, ISR). */
