@@ -39,7 +39,11 @@ float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h);
  * slip frequency x T_R x sigma below 1: the condition of tr_uncertain): T_R
  * and R_S moved to L_S at the window's flux, r->ls_window_h set, *fx the
  * curve's share of the bounds. Elsewhere r is left as it is (ls_window_h NaN,
- * *fx 0). Bounded: two passes, no iteration that depends on the data. */
+ * *fx 0). Where the curve and the window disagree (no motor with the curve's
+ * L_S has the window's impedance, or the curve is too steep at this flux for
+ * one secant step) r is left too, and *fx is infinite. Bounded: three
+ * closed-form solves and four curve look-ups, no iteration that depends on
+ * the data. */
 void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums_t *sm, uint32_t nreg,
                     imest_result_t *r, bg_flux_t *fx);
 
