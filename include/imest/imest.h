@@ -228,6 +228,9 @@ typedef struct {
   float uncertainty;
 } imest_inverter_t;
 
+/** Points of the magnetising curve (imest_config_t.ls_curve_i_a, ls_curve_h). */
+#define IMEST_LS_CURVE_POINTS 4
+
 /** Configuration. Fill with imest_config_default(), then set the motor. */
 typedef struct {
   /* Motor constants (known, from the data sheet or a commissioning test). */
@@ -314,6 +317,26 @@ typedef struct {
    *  whose R_S lies outside what heating explains (0.7 .. 1.9 x this) is constants_mismatch */
   float rs_nominal_ohm;
 
+  /* Main-flux saturation: L_S at the window's flux (docs/METHOD.md §18.5). The points of a no-load
+   * test at several voltages (the reactive power over |i|^2 w_e at each, or the no-load windows'
+   * ls_noload_h): L_S against the magnetising current. In a window where the steady-state picture
+   * holds (slip frequency x T_R x sigma below 1, as for tr_uncertain) the estimate is moved to
+   * L_S at the window's flux-producing current i_d = |i| / sqrt(1 + (slip frequency x T_R)^2),
+   * with sigma L_S held (saturation moves the main flux, not the leakage), and the curve's
+   * uncertainty enters tr_bound_rel and rs_bound_rel. ls_h stays what the solve uses, and what the
+   * no-load check compares with when there is no curve. */
+  /** the curve's magnetising currents [A], alpha/beta amplitude (sqrt 3 x the phase rms, the unit
+   *  of i_rms_a), strictly increasing, positive; piecewise linear between the points, clamped
+   *  outside them (the bound then takes as uncertain the whole difference between the clamped
+   *  value and the end segment's straight continuation) (default 0) */
+  float ls_curve_i_a[IMEST_LS_CURVE_POINTS];
+  /** L_S measured at no load at each of ls_curve_i_a [H], positive (default 0) */
+  float ls_curve_h[IMEST_LS_CURVE_POINTS];
+  /** points of the curve in use, 2 .. IMEST_LS_CURVE_POINTS (default 0: no curve, L_S is taken as
+   *  flux-independent and every output is as without these fields); a core built with
+   *  IMEST_WITH_FLUX=0 (docs/integrating.md "Flags") refuses any curve */
+  unsigned int ls_curve_points;
+
   /* Input plausibility (per sample, ISR). */
   float i_limit_a;  /**< |phase current| >= this counts as ADC saturation (default 0 = off) */
   float u_limit_v;  /**< |phase voltage| >= this counts as ADC saturation (default 0 = off) */
@@ -384,7 +407,13 @@ typedef struct {
   double slip_ratio;         /**< slip excitation (slip frequency x tr_nominal_s), see min_slip_ratio */
   double i_rms_a;            /**< rms stator current over the window (alpha/beta amplitude) */
   double ls_noload_h;        /**< L_S measured in a window at no load (NaN: none); more than 6 % from
-                                  the configured L_S is constants_mismatch from then on */
+                                  the configured L_S (with a magnetising curve: the curve's L_S at
+                                  this window's current) is constants_mismatch from then on */
+  double ls_window_h;        /**< L_S at the window's flux from the magnetising curve [H]; T_R and
+                                  R_S are then the estimate with this L_S and sigma x ls_h /
+                                  ls_window_h (sigma L_S held), k1 and k2 the fit's with ls_h.
+                                  NaN: no curve, or a window where the correction does not apply
+                                  (no estimate, beyond the pull-out slip) */
   unsigned int n_roots;      /**< positive roots of the resultant */
   unsigned int n_admissible; /**< roots with K1 > 0 and T_R in band */
   double roots_k2[IMEST_MAX_ROOTS]; /**< the positive roots, ascending */

@@ -123,7 +123,7 @@ typedef struct {
 } imest_combo_t;
 
 /** Estimator instance. All fields are private; sizes are what the ISR needs.
- *  sizeof(imest_t) is 1936 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
+ *  sizeof(imest_t) is 1976 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
  *  fw/README.md) and on an x86-64 host too (every member is 32-bit: no pointers, no padding that
  *  differs); the test tools_documented_defaults checks this figure against the host's sizeof. */
 typedef struct {
@@ -182,6 +182,9 @@ typedef struct {
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
   float rs_tolerance, tr_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
   uint32_t tr_nominal_known;
+  float ls_curve_i_a[IMEST_LS_CURVE_POINTS]; /* the magnetising curve as configured (bg_flux.c) */
+  float ls_curve_h[IMEST_LS_CURVE_POINTS];
+  uint32_t ls_curve_points;  /* 0: no curve */
   uint32_t ls_check;         /* L_S measured at no load: 0 not yet, 1 agrees, 2 differs (latched) */
   imest_inverter_t inverter; /* as configured: the R_S verdict weighs its uncertainty */
   float pwm_hz;

@@ -38,7 +38,9 @@ _lib.lib.imest_py_config_default(_DEFAULTS_ARRAY)
 _DEFAULTS = {name: (float(v) if kind == KIND_FLOAT else int(v))
              for (name, kind), v in zip(_FIELDS, _DEFAULTS_ARRAY)}
 # Python spelling: a nested field's dot as an underscore (inverter.dead_time_s -> inverter_dead_time_s)
-_PY_NAME = {name.replace(".", "_"): name for name, _ in _FIELDS}
+# a nested field's dot and an array element's brackets as underscores: inverter_dead_time_s,
+# ls_curve_h_1 for ls_curve_h[1]
+_PY_NAME = {name.replace(".", "_").replace("[", "_").replace("]", ""): name for name, _ in _FIELDS}
 
 _COLUMNS = _lib.columns()                       # [(name, kind)]
 _REASON_NAMES = {k: _lib.reason_name(k) for k in range(64)}
@@ -68,7 +70,7 @@ def reason_name(code):
 def columns():
     """The names of the result columns: imest-replay's CSV columns in its order, then more of
     imest_result_t (samples, overruns, E, E_I_noise, noise_i_a, noise_u_v, pe_k1, pe_k2,
-    ls_noload_h)."""
+    ls_noload_h, ls_window_h)."""
     return [name for name, _ in _COLUMNS]
 
 
@@ -86,7 +88,7 @@ class Config:
     """An estimator config: every imest_config_t field, with imest_config_default()'s values
     (read from the library, so they cannot drift). Set fields as keywords or attributes; a nested
     field takes an underscore for its dot (inverter_dead_time_s) or its C name as a key
-    (cfg["inverter.dead_time_s"]). pwm_timing takes "next", "centred" or "last"; voltage_kind
+    (cfg["inverter.dead_time_s"]); an array's element likewise (ls_curve_h_1, cfg["ls_curve_h[1]"]). pwm_timing takes "next", "centred" or "last"; voltage_kind
     "staircase" or "smooth" (or IMEST_VOLTAGE_STAIRCASE's 0, IMEST_VOLTAGE_SMOOTH's 1).
 
     Fields you set are "given": run() keeps them as they are. For the others it applies
@@ -455,7 +457,7 @@ def run(cfg, t=None, fs=None, u=None, duty=None, vdc=None, i=None, theta=None, c
     Every input needs one value per sample: different lengths are a ValueError, nothing is cut.
     One record per window, the columns of imest-replay's CSV in its order (t_end_s counts from
     t[0]; status, tr_reason, rs_reason are the reason names), then samples, overruns, E,
-    E_I_noise, noise_i_a, noise_u_v, pe_k1, pe_k2, ls_noload_h. A last partial window of at least
+    E_I_noise, noise_i_a, noise_u_v, pe_k1, pe_k2, ls_noload_h, ls_window_h. A last partial window of at least
     half the length (or a log shorter than one window) is estimated too, as replay does.
     """
     if not isinstance(cfg, Config):

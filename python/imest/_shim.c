@@ -27,7 +27,8 @@
 enum { KIND_FLOAT = 0, KIND_INT = 1, KIND_UINT = 2, KIND_PWM_TIMING = 3, KIND_REASON = 4 };
 
 /* Every field of imest_config_t, by its C name (a nested field as
- * "inverter.dead_time_s", the name imest_config_check() reports). */
+ * "inverter.dead_time_s", the name imest_config_check() reports; an array's
+ * element as "ls_curve_h[1]"). */
 #define IMEST_PY_CONFIG_FIELDS(X)                                                                            \
   X(pole_pairs, KIND_UINT)                                                                                   \
   X(ls_h, KIND_FLOAT)                                                                                        \
@@ -66,6 +67,15 @@ enum { KIND_FLOAT = 0, KIND_INT = 1, KIND_UINT = 2, KIND_PWM_TIMING = 3, KIND_RE
   X(u_uncertainty_v, KIND_FLOAT)                                                                             \
   X(timing_uncertainty_s, KIND_FLOAT)                                                                        \
   X(rs_nominal_ohm, KIND_FLOAT)                                                                              \
+  X(ls_curve_i_a[0], KIND_FLOAT)                                                                             \
+  X(ls_curve_i_a[1], KIND_FLOAT)                                                                             \
+  X(ls_curve_i_a[2], KIND_FLOAT)                                                                             \
+  X(ls_curve_i_a[3], KIND_FLOAT)                                                                             \
+  X(ls_curve_h[0], KIND_FLOAT)                                                                               \
+  X(ls_curve_h[1], KIND_FLOAT)                                                                               \
+  X(ls_curve_h[2], KIND_FLOAT)                                                                               \
+  X(ls_curve_h[3], KIND_FLOAT)                                                                               \
+  X(ls_curve_points, KIND_UINT)                                                                              \
   X(i_limit_a, KIND_FLOAT)                                                                                   \
   X(u_limit_v, KIND_FLOAT)                                                                                   \
   X(i_absurd_a, KIND_FLOAT)                                                                                  \
@@ -128,7 +138,8 @@ _Static_assert(sizeof(imest_config_t) == sizeof k_fields / sizeof k_fields[0] * 
   X(noise_u_v, KIND_FLOAT, r->noise_u_v)                                                                     \
   X(pe_k1, KIND_FLOAT, r->pe_k1)                                                                             \
   X(pe_k2, KIND_FLOAT, r->pe_k2)                                                                             \
-  X(ls_noload_h, KIND_FLOAT, r->ls_noload_h)
+  X(ls_noload_h, KIND_FLOAT, r->ls_noload_h)                                                                 \
+  X(ls_window_h, KIND_FLOAT, r->ls_window_h)
 
 typedef struct {
   const char *name;

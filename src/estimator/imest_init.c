@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "bg_flux.h"
 #include "bg_noise.h"
 #include "common/imest_handoff.h"
 #include "common/imest_math.h"
@@ -56,6 +57,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->u_uncertainty_v = 0.0f;
   cfg->timing_uncertainty_s = 1.0e-6f;
   cfg->rs_nominal_ohm = 0.0f;
+  cfg->ls_curve_points = 0u; /* no magnetising curve (the points are zero) */
 }
 
 /* The config's float fields and their ranges, checked in order by one loop
@@ -124,6 +126,26 @@ static int check_ok(const check_t *c, float x, float fs)
   return !(c->below > 0.0f && !(ax < c->below));
 }
 
+/* The magnetising curve: 0 points (none) or 2 .. IMEST_LS_CURVE_POINTS (one
+ * point is ls_h), each current and L_S finite and positive, the currents
+ * strictly increasing (the interpolation's segments need a positive width);
+ * none at all in a build without the stage (IMEST_WITH_FLUX 0). The name of
+ * the first bad field, NULL if the curve is usable. */
+static const char *check_ls_curve(const imest_config_t *cfg)
+{
+  const unsigned int n = cfg->ls_curve_points;
+  if (n == 0u) return NULL;
+  if (!IMEST_WITH_FLUX || n < 2u || n > IMEST_LS_CURVE_POINTS) return "ls_curve_points";
+#if IMEST_WITH_FLUX
+  for (unsigned int k = 0; k < n; ++k) {
+    const float x = cfg->ls_curve_i_a[k], y = cfg->ls_curve_h[k];
+    if (!(isfinite(x) && x > 0.0f) || (k > 0u && !(x > cfg->ls_curve_i_a[k - 1u]))) return "ls_curve_i_a";
+    if (!(isfinite(y) && y > 0.0f)) return "ls_curve_h";
+  }
+#endif
+  return NULL;
+}
+
 // NOLINTNEXTLINE(readability-function-cognitive-complexity): a flat else-if list, one bound per field
 int imest_config_check(const imest_config_t *cfg, const char **field)
 {
@@ -163,6 +185,8 @@ int imest_config_check(const imest_config_t *cfg, const char **field)
     bad = "inverter.dead_time_s";
   else if (!(cfg->timing_uncertainty_s * fs < 1.0f))
     bad = "timing_uncertainty_s";
+  else
+    bad = check_ls_curve(cfg);
   if (field) *field = bad;
   return bad ? IMEST_ERR_CONFIG : IMEST_OK;
 }
@@ -354,6 +378,11 @@ static void init_background_constants(imest_t *s, const imest_config_t *cfg)
   s->timing_uncertainty_s = cfg->timing_uncertainty_s;
   s->rs_nominal_ohm = cfg->rs_nominal_ohm;
   s->tr_nominal_known = cfg->tr_nominal_known != 0;
+  s->ls_curve_points = cfg->ls_curve_points;
+  for (unsigned int k = 0; IMEST_WITH_FLUX && k < IMEST_LS_CURVE_POINTS; ++k) {
+    s->ls_curve_i_a[k] = cfg->ls_curve_i_a[k];
+    s->ls_curve_h[k] = cfg->ls_curve_h[k];
+  }
   s->inverter = cfg->inverter;
   s->pwm_hz = cfg->pwm_hz > 0.0f ? cfg->pwm_hz : cfg->fs_hz;
   s->t_stair_s[1] = 1.0f / s->pwm_hz;

@@ -413,18 +413,19 @@ constexpr Field field(const char *name, size_t off, size_t size)
 }
 #define IMEST_FIELD(f) field(#f, offsetof(imest_result_t, f), sizeof(imest_result_t::f))
 constexpr Field kFields[] = {
-    IMEST_FIELD(seq),        IMEST_FIELD(samples),      IMEST_FIELD(used_samples),
-    IMEST_FIELD(overruns),   IMEST_FIELD(valid),        IMEST_FIELD(status),
-    IMEST_FIELD(tr_valid),   IMEST_FIELD(tr_reason),    IMEST_FIELD(rs_valid),
-    IMEST_FIELD(rs_reason),  IMEST_FIELD(flags),        IMEST_FIELD(t_end_s),
-    IMEST_FIELD(span_s),     IMEST_FIELD(windows),      IMEST_FIELD(tr_s),
-    IMEST_FIELD(rs_ohm),     IMEST_FIELD(tr_bound_rel), IMEST_FIELD(rs_bound_rel),
-    IMEST_FIELD(k1),         IMEST_FIELD(k2),           IMEST_FIELD(e),
-    IMEST_FIELD(e_i),        IMEST_FIELD(e_i_noise),    IMEST_FIELD(noise_i_a),
-    IMEST_FIELD(noise_u_v),  IMEST_FIELD(hessian),      IMEST_FIELD(pe_k1),
-    IMEST_FIELD(pe_k2),      IMEST_FIELD(pe_k1_rel),    IMEST_FIELD(pe_k2_rel),
-    IMEST_FIELD(slip_ratio), IMEST_FIELD(i_rms_a),      IMEST_FIELD(ls_noload_h),
-    IMEST_FIELD(n_roots),    IMEST_FIELD(n_admissible), IMEST_FIELD(roots_k2),
+    IMEST_FIELD(seq),         IMEST_FIELD(samples),      IMEST_FIELD(used_samples),
+    IMEST_FIELD(overruns),    IMEST_FIELD(valid),        IMEST_FIELD(status),
+    IMEST_FIELD(tr_valid),    IMEST_FIELD(tr_reason),    IMEST_FIELD(rs_valid),
+    IMEST_FIELD(rs_reason),   IMEST_FIELD(flags),        IMEST_FIELD(t_end_s),
+    IMEST_FIELD(span_s),      IMEST_FIELD(windows),      IMEST_FIELD(tr_s),
+    IMEST_FIELD(rs_ohm),      IMEST_FIELD(tr_bound_rel), IMEST_FIELD(rs_bound_rel),
+    IMEST_FIELD(k1),          IMEST_FIELD(k2),           IMEST_FIELD(e),
+    IMEST_FIELD(e_i),         IMEST_FIELD(e_i_noise),    IMEST_FIELD(noise_i_a),
+    IMEST_FIELD(noise_u_v),   IMEST_FIELD(hessian),      IMEST_FIELD(pe_k1),
+    IMEST_FIELD(pe_k2),       IMEST_FIELD(pe_k1_rel),    IMEST_FIELD(pe_k2_rel),
+    IMEST_FIELD(slip_ratio),  IMEST_FIELD(i_rms_a),      IMEST_FIELD(ls_noload_h),
+    IMEST_FIELD(ls_window_h), IMEST_FIELD(n_roots),      IMEST_FIELD(n_admissible),
+    IMEST_FIELD(roots_k2),
 };
 #undef IMEST_FIELD
 // kFields in declaration order with nothing between two but padding

@@ -5,6 +5,7 @@
 // against the default nominal at random.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 
 extern "C" {
@@ -34,4 +35,77 @@ TEST(ConfigDefault, EstimatorWritesEveryField)
 TEST(ConfigDefault, CommissioningWritesEveryField)
 {
   expect_every_field_written<imest_comm_config_t>(imest_comm_config_default);
+}
+
+// The magnetising curve (ls_curve_*): 0 points is none; 2 to IMEST_LS_CURVE_POINTS points, each
+// current and L_S finite and positive, the currents strictly increasing. Each bad curve is
+// refused naming its field, and imest_init() refuses it too.
+namespace {
+imest_config_t curve_config(unsigned int n)
+{
+  imest_config_t c;
+  imest_config_default(&c);
+  c.pole_pairs = 2;
+  c.ls_h = 0.1735f;
+  c.sigma = 0.066f;
+  const float i_a[IMEST_LS_CURVE_POINTS] = {3.3f, 5.1f, 6.6f, 8.1f};
+  const float l_h[IMEST_LS_CURVE_POINTS] = {0.230f, 0.206f, 0.181f, 0.160f};
+  for (int k = 0; k < IMEST_LS_CURVE_POINTS; ++k) {
+    c.ls_curve_i_a[k] = i_a[k];
+    c.ls_curve_h[k] = l_h[k];
+  }
+  c.ls_curve_points = n;
+  return c;
+}
+
+const char *curve_field(const imest_config_t &c)
+{
+  const char *field = nullptr;
+  const int rc = imest_config_check(&c, &field);
+  static imest_t s;
+  EXPECT_EQ(imest_init(&s, &c), rc) << "imest_init() agrees with imest_config_check()";
+  return rc == IMEST_OK ? "" : field;
+}
+} // namespace
+
+TEST(ConfigCurve, UsableCurvesPass)
+{
+  for (unsigned int n : {0u, 2u, 3u, 4u}) EXPECT_STREQ(curve_field(curve_config(n)), "") << n;
+  imest_config_t c = curve_config(0u); // no curve: whatever the points hold is not judged
+  c.ls_curve_i_a[0] = -1.0f;
+  c.ls_curve_h[1] = NAN;
+  EXPECT_STREQ(curve_field(c), "");
+}
+
+TEST(ConfigCurve, BadCurvesAreRefusedNamingTheField)
+{
+  EXPECT_STREQ(curve_field(curve_config(1u)), "ls_curve_points") << "one point is ls_h";
+  EXPECT_STREQ(curve_field(curve_config(IMEST_LS_CURVE_POINTS + 1u)), "ls_curve_points");
+  imest_config_t c = curve_config(4u);
+  c.ls_curve_i_a[2] = 5.0f; // below the point before: unsorted
+  EXPECT_STREQ(curve_field(c), "ls_curve_i_a");
+  c = curve_config(4u);
+  c.ls_curve_i_a[2] = c.ls_curve_i_a[1]; // equal: a segment of zero width
+  EXPECT_STREQ(curve_field(c), "ls_curve_i_a");
+  c = curve_config(3u);
+  c.ls_curve_i_a[0] = 0.0f;
+  EXPECT_STREQ(curve_field(c), "ls_curve_i_a");
+  c = curve_config(3u);
+  c.ls_curve_i_a[1] = NAN;
+  EXPECT_STREQ(curve_field(c), "ls_curve_i_a");
+  c = curve_config(3u);
+  c.ls_curve_i_a[2] = INFINITY;
+  EXPECT_STREQ(curve_field(c), "ls_curve_i_a");
+  c = curve_config(2u);
+  c.ls_curve_h[1] = -0.1f;
+  EXPECT_STREQ(curve_field(c), "ls_curve_h");
+  c = curve_config(2u);
+  c.ls_curve_h[0] = 0.0f;
+  EXPECT_STREQ(curve_field(c), "ls_curve_h");
+  c = curve_config(4u);
+  c.ls_curve_h[3] = NAN;
+  EXPECT_STREQ(curve_field(c), "ls_curve_h");
+  c = curve_config(3u);
+  c.ls_curve_h[3] = NAN; // beyond the points in use: not judged
+  EXPECT_STREQ(curve_field(c), "");
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "motor_ref.hpp"
@@ -18,7 +19,8 @@ struct RunOut {
 };
 
 // Runs the motor for `seconds`, feeding exact samples at fs from t_start on.
-RunOut run(MotorRef &mot, double seconds, double t_start, bool at_rest, float window_s = 1.0f)
+RunOut run(MotorRef &mot, double seconds, double t_start, bool at_rest, float window_s = 1.0f,
+           void (*edit)(imest_config_t *) = nullptr)
 {
   const double fs = 4000.0;
   const int sub = 16;
@@ -30,6 +32,7 @@ RunOut run(MotorRef &mot, double seconds, double t_start, bool at_rest, float wi
   cfg.fs_hz = (float)fs;
   cfg.window_s = window_s;
   cfg.start_at_rest = at_rest ? 1 : 0;
+  if (edit) edit(&cfg);
   static imest_t s;
   EXPECT_EQ(imest_init(&s, &cfg), IMEST_OK);
   RunOut out;
@@ -74,6 +77,45 @@ TEST(EndToEnd, LoadedSteadyStateRecoversTrAndRs)
     EXPECT_NEAR(w.rs_ohm, 5.04, 5.04 * 5e-3) << k;
     EXPECT_LT(w.pe_k2_rel, 0.04);
     EXPECT_TRUE(w.flags & IMEST_FLAG_HESSIAN_PD);
+  }
+}
+
+// The magnetising curve's fields change nothing until ls_curve_points says there is a curve:
+// every result byte for byte as without them. A flat curve at the motor's own L_S (a motor that
+// does not saturate) moves nothing either, beyond float32 rounding, and reports that L_S.
+TEST(EndToEnd, NoCurveIsByteIdenticalAndAFlatCurveMovesNothing)
+{
+  MotorRef m0, m1, m2;
+  for (MotorRef *m : {&m0, &m1, &m2}) {
+    m->vll = 115;
+    m->f = 30;
+    m->load = 2.064;
+  }
+  const RunOut plain = run(m0, 4.0, 1.5, false);
+  const RunOut none = run(m1, 4.0, 1.5, false, 1.0f, [](imest_config_t *c) {
+    for (int k = 0; k < IMEST_LS_CURVE_POINTS; ++k) {
+      c->ls_curve_i_a[k] = 1.0f + (float)k; // values without a count: no curve
+      c->ls_curve_h[k] = 0.5f;
+    }
+  });
+  const RunOut flat = run(m2, 4.0, 1.5, false, 1.0f, [](imest_config_t *c) {
+    c->ls_curve_i_a[0] = 0.5f;
+    c->ls_curve_i_a[1] = 10.0f;
+    c->ls_curve_h[0] = c->ls_curve_h[1] = c->ls_h;
+    c->ls_curve_points = 2u;
+  });
+  ASSERT_EQ(plain.res.size(), 4u);
+  ASSERT_EQ(none.res.size(), plain.res.size());
+  ASSERT_EQ(flat.res.size(), plain.res.size());
+  for (size_t k = 0; k < plain.res.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_EQ(std::memcmp(&plain.res[k], &none.res[k], sizeof(imest_result_t)), 0);
+    EXPECT_TRUE(std::isnan(plain.res[k].ls_window_h));
+    if (!plain.res[k].valid) continue;
+    EXPECT_NEAR(flat.res[k].tr_s, plain.res[k].tr_s, 2e-6 * plain.res[k].tr_s);
+    EXPECT_NEAR(flat.res[k].rs_ohm, plain.res[k].rs_ohm, 2e-5 * plain.res[k].rs_ohm);
+    EXPECT_FLOAT_EQ((float)flat.res[k].ls_window_h, 0.2908f);
+    EXPECT_EQ(flat.res[k].tr_valid, 1);
   }
 }
 

@@ -8,7 +8,7 @@
 
 #include "imest/imest.h"
 
-_Static_assert(sizeof(imest_config_t) == 42 * sizeof(float),
+_Static_assert(sizeof(imest_config_t) == 51 * sizeof(float),
                "imest_config_t changed: list the new field below");
 
 #define F(name) printf(#name " %a\n", (double)cfg.name)
@@ -55,6 +55,15 @@ int main(void)
   F(u_uncertainty_v);
   F(timing_uncertainty_s);
   F(rs_nominal_ohm);
+  F(ls_curve_i_a[0]);
+  F(ls_curve_i_a[1]);
+  F(ls_curve_i_a[2]);
+  F(ls_curve_i_a[3]);
+  F(ls_curve_h[0]);
+  F(ls_curve_h[1]);
+  F(ls_curve_h[2]);
+  F(ls_curve_h[3]);
+  I(ls_curve_points);
   F(i_limit_a);
   F(u_limit_v);
   F(i_absurd_a);

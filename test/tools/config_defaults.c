@@ -6,6 +6,7 @@
  * that every field the header declares is listed here; likewise the T_R
  * tracker's imest_tracker_config_default() (tracker.NAME) and the temperature module's
  * imest_temperature_config_default() (temperature.NAME). */
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 
@@ -69,6 +70,15 @@ int main(void)
     const float v = *(const float *)(const void *)((const char *)&c + k_float[k].offset);
     printf("%s %.9g\n", k_float[k].name, (double)v);
   }
+  /* an array field: the largest |element| (every one is the documented default, or this differs) */
+  float ci = 0.0f, ch = 0.0f;
+  for (int k = 0; k < IMEST_LS_CURVE_POINTS; ++k) {
+    ci = fabsf(c.ls_curve_i_a[k]) > ci ? fabsf(c.ls_curve_i_a[k]) : ci;
+    ch = fabsf(c.ls_curve_h[k]) > ch ? fabsf(c.ls_curve_h[k]) : ch;
+  }
+  printf("ls_curve_i_a %.9g\n", (double)ci);
+  printf("ls_curve_h %.9g\n", (double)ch);
+  printf("ls_curve_points %u\n", c.ls_curve_points);
   printf("pole_pairs %u\n", c.pole_pairs);
   printf("start_at_rest %d\n", c.start_at_rest);
   printf("tr_nominal_known %d\n", c.tr_nominal_known);

@@ -59,7 +59,7 @@ def header_fields(text, struct="imest_config_t"):
 
     def parse(src, prefix=""):
         out, pending = [], ""
-        tok = re.compile(r"/\*\*<(.*?)\*/|/\*\*(.*?)\*/|/\*(.*?)\*/|([A-Za-z_][\w ]*?)\s+(\w+)\s*;", re.S)
+        tok = re.compile(r"/\*\*<(.*?)\*/|/\*\*(.*?)\*/|/\*(.*?)\*/|([A-Za-z_][\w ]*?)\s+(\w+)\s*(?:\[\w+\])?\s*;", re.S)
         for m in tok.finditer(src):
             if m.group(1) is not None:  # trailing: the previous field's
                 if out:

@@ -165,7 +165,7 @@ bool is_reason(int v)
 imest_result_t judge(Win &x)
 {
   imest_result_t r = x.r;
-  imest__bg_judge(&x.s, &x.w, &x.st, &x.sm, &x.so, x.steady, &r);
+  imest__bg_judge(&x.s, &x.w, &x.st, &x.sm, &x.so, NULL, x.steady, &r);
   EXPECT_EQ(r.valid, r.tr_valid && r.rs_valid);
   EXPECT_EQ(r.status, r.tr_valid ? r.rs_reason : r.tr_reason);
   EXPECT_TRUE(is_reason(r.tr_reason)) << r.tr_reason;
@@ -519,6 +519,32 @@ TEST(Verdict, ConstantsMismatchNoLoadLsBoundaryIsSixPercent)
     EXPECT_TR_REASON(judge(sc), IMEST_REASON_ZERO_SLIP);
     sc.cfg.ls_h = (float)(ls_meas / (1.0 + sign * 0.061));
     EXPECT_TR_REASON(judge(sc), IMEST_REASON_CONSTANTS_MISMATCH);
+  }
+}
+
+TEST(Verdict, NoLoadLsComparedWithTheMagnetisingCurve)
+{
+  // A saturating motor at no load at a lower voltage than ls_h came from: its L_S there is 10 %
+  // above ls_h. Without a curve that is constants_mismatch; with a curve through the motor's L_S
+  // at this window's current it agrees, and a curve 8 % off there still disagrees.
+  Scene sc = paper_scene();
+  sc.a = 0.05;
+  sc.cfg.ls_h = (float)(sc.m.ls / 1.10);
+  EXPECT_TR_REASON(judge(sc), IMEST_REASON_CONSTANTS_MISMATCH);
+  const double i_m = build(sc).i_amp / std::sqrt(1.0 + sc.a * sc.a); // the magnetising current
+  const double ls_meas = sc.m.ls * (1.0 + sc.m.sigma * sc.a * sc.a) / (1.0 + sc.a * sc.a);
+  for (double off : {0.0, 0.08}) {
+    SCOPED_TRACE(off);
+    // three points, the window's current on the middle one (no interpolation error there)
+    const float l = (float)(ls_meas * (1.0 + off));
+    const float i_a[3] = {(float)(0.5 * i_m), (float)i_m, (float)(1.5 * i_m)};
+    const float l_h[3] = {1.02f * l, l, 0.9f * l};
+    for (int k = 0; k < 3; ++k) {
+      sc.cfg.ls_curve_i_a[k] = i_a[k];
+      sc.cfg.ls_curve_h[k] = l_h[k];
+    }
+    sc.cfg.ls_curve_points = 3u;
+    EXPECT_TR_REASON(judge(sc), off == 0.0 ? IMEST_REASON_ZERO_SLIP : IMEST_REASON_CONSTANTS_MISMATCH);
   }
 }
 

@@ -157,13 +157,14 @@ static int can_log_close(can_log_t *c)
 
 /* The columns up to flags keep their places (tools/studies/accuracy reads them by
  * position); the per-parameter verdicts and bounds came later and follow. */
-static void print_header(int temperatures)
+static void print_header(int temperatures, int ls_curve)
 {
   printf("t_end_s,T_R_s,R_S_ohm,E_I,valid,status,seq,K1,K2,pe_k1_rel,pe_k2_rel,"
          "H11,H12,H22,hessian_pd,n_roots,n_admissible,slip_ratio,i_rms_a,used_samples,flags,"
-         "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel%s\n",
+         "tr_valid,rs_valid,tr_reason,rs_reason,span_s,windows,tr_bound_rel,rs_bound_rel%s%s\n",
          temperatures ? ",stator_c,stator_uncert_k,stator_valid,rr_ohm,rotor_c,rotor_uncert_k,rotor_valid"
-                      : "");
+                      : "",
+         ls_curve ? ",ls_window_h" : "");
 }
 
 /* A bound that was not computed is NaN: printed as "nan" whatever its sign bit. */
@@ -179,6 +180,7 @@ typedef struct {
   double t0_s; /* the record's first t [s] */
   can_log_t *can;
   imest_temperature_t *temp; /* --temperatures: its columns follow the others (NULL: none) */
+  int ls_curve;              /* --ls-curve: ls_window_h is the last column */
 } row_ctx_t;
 
 /* drive_window_fn: the window's frames to the CAN log, one output row. */
@@ -207,6 +209,7 @@ static void print_row(void *ctx, const imest_result_t *r)
     print_bound((double)t->rotor_uncert_k);
     printf(",%d", t->rotor_valid);
   }
+  if (x->ls_curve) print_bound(r->ls_window_h);
   printf("\n");
 }
 
@@ -250,7 +253,7 @@ static int run(csv_reader_t *r, const replay_opts_t *o, const replay_scan_t *s, 
     fprintf(stderr, "%s: %s: cannot read the file a second time\n", k_prog, r->name);
     return TOOL_EXIT_DATA;
   }
-  print_header(o->temperatures);
+  print_header(o->temperatures, o->cfg.ls_curve_points > 0u);
   double v[CSV_MAX_NEED], tprev = 0, qprev = 0;
   replay_sample_t x;
   long k = 0;
@@ -392,7 +395,7 @@ int main(int argc, char **argv)
   can_log_t can;
   drive_t d;
   static imest_temperature_t temp;
-  row_ctx_t row = {0, &can, NULL};
+  row_ctx_t row = {0, &can, NULL, o.cfg.ls_curve_points > 0u};
   if (o.temperatures) {
     (void)imest_temperature_init(&temp, &o.temp_cfg); /* checked by replay_parse() */
     row.temp = &temp;

@@ -91,6 +91,12 @@ static void usage(FILE *o)
              "  --angle-observer-hz HZ  natural frequency of the angle observer between the\n"
              "                      encoder and the rotation (default 0: filter-hz / 4;\n"
              "                      negative: off)\n"
+             "  --ls-curve I1:L1,I2:L2,...  the magnetising curve: L_S [H] measured at no load\n"
+             "                      at 2 to 4 magnetising currents I [A], given as the alpha/beta\n"
+             "                      amplitude (sqrt 3 x the phase rms current, the unit of\n"
+             "                      i_rms_a), increasing; T_R and R_S are then moved to L_S at\n"
+             "                      each window's flux, and a column ls_window_h [H] is appended\n"
+             "                      (docs/feeding-logs.md; default none: L_S = --ls at any flux)\n"
              "  --tr-nominal S      nominal T_R for scaling (default 0.1)\n"
              "  --tr-min S --tr-max S   admissible T_R band (default 0.001 .. 10)\n"
              "  --max-pe-k2 X       validity threshold on the relative PE index of K2\n"
@@ -221,6 +227,10 @@ const char *replay_option_of(const replay_opts_t *o, const char *field, int *is_
     *is_given = o->speed_limit > 0;
     return "--speed-limit";
   }
+  if (strncmp(field, "ls_curve_", 9) == 0) {
+    *is_given = o->cfg.ls_curve_points > 0u;
+    return "--ls-curve";
+  }
   if (strcmp(field, "pole_pairs") == 0) {
     *is_given = 1;
     return "--pole-pairs";
@@ -299,6 +309,37 @@ static int limit_value(tool_args_t *a, double *out)
   }
   *out = x;
   return 0;
+}
+
+/* --ls-curve I1:L1,I2:L2,...: the magnetising curve's points (2 .. IMEST_LS_CURVE_POINTS), in
+   the config as given (imest_config_check() judges their order and signs). 0, or -1 after a
+   message. */
+static int parse_ls_curve(const char *v, replay_opts_t *o)
+{
+  const char *p = v;
+  unsigned int n = 0;
+  for (;;) {
+    char *end = NULL;
+    const double i = strtod(p, &end);
+    if (end == p || *end != ':' || n >= IMEST_LS_CURVE_POINTS) break;
+    p = end + 1;
+    const double l = strtod(p, &end);
+    if (end == p || !isfinite(i) || !isfinite(l)) break;
+    o->cfg.ls_curve_i_a[n] = (float)i;
+    o->cfg.ls_curve_h[n] = (float)l;
+    n++;
+    if (*end == '\0') {
+      o->cfg.ls_curve_points = n;
+      return 0;
+    }
+    if (*end != ',') break;
+    p = end + 1;
+  }
+  fprintf(stderr,
+          "%s: --ls-curve takes I1:L1,I2:L2,... (2 to %d points: current [A] alpha/beta amplitude, "
+          "L_S [H]), not '%s'\n",
+          k_prog, IMEST_LS_CURVE_POINTS, v);
+  return -1;
 }
 
 /* --temperatures T_REF_C,RS_REF_OHM,TR_REF_S: three numbers into the temperature module's config
@@ -439,6 +480,10 @@ int replay_parse(int argc, char **argv, replay_opts_t *o)
       }
     } else if (tool_args_is(&a, "-o") || tool_args_is(&a, "--output")) {
       if ((o->output_path = tool_args_value(&a)) == NULL) return TOOL_EXIT_USAGE;
+    } else if (tool_args_is(&a, "--ls-curve")) {
+      const char *v = tool_args_value(&a);
+      if (v == NULL) return TOOL_EXIT_USAGE;
+      if (parse_ls_curve(v, o) != 0) return TOOL_EXIT_USAGE;
     } else if (tool_args_is(&a, "--temperatures")) {
       const char *v = tool_args_value(&a);
       if (v == NULL) return TOOL_EXIT_USAGE;

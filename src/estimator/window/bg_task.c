@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "bg_combine.h"
+#include "bg_flux.h"
 #include "common/imest_handoff.h"
 #include "bg_noise.h"
 #include "bg_validity.h"
@@ -195,13 +196,20 @@ int imest_background(imest_t *s, imest_result_t *out)
   const double m = (double)s->m;
   bg_step_t x;
   bg_solve_out_t so = {0};
+  bg_flux_t fx;
 
   result_header(s, w, out);
   window_sums(s, w, m, &x, out);
   combine_join(s, w, m, &x, out);
   solve(s, w, &x, &so);
   result_from_solve(&x, s, &so, out);
-  imest__bg_judge(s, w, &x.st, &x.sums, &so, x.steady, out);
+#if IMEST_WITH_FLUX
+  imest__bg_flux(s, &x.st, &x.sums, w->nreg, out, &fx); /* L_S at the window's flux (a curve given) */
+#else
+  fx.tr_b = fx.rs_b = 0.0f;
+  out->ls_window_h = (double)NAN;
+#endif
+  imest__bg_judge(s, w, &x.st, &x.sums, &so, &fx, x.steady, out);
   combine_after(s, w, &x, out);
   release_window(s, w, m, out);
   return 1;

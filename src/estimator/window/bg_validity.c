@@ -9,6 +9,7 @@
  * valid" and docs/METHOD.md §13 give the measurements behind the defaults.
  * Every evidence is dimensionless: the same rule holds for any motor size. */
 #include <math.h>
+#include <stddef.h>
 
 #include "bg_impedance.h"
 #include "bg_validity.h"
@@ -186,12 +187,28 @@ static float gain_mismatch(const imest_window_t *w, const bg_sums_t *sm)
   return IMEST_SQRT3_2_F * sqrtf(ca * ca + cb * cb) / s2;
 }
 
+/* The L_S a no-load window is compared with: ls_h, or the magnetising
+ * curve's at the window's flux-producing current |i| / sqrt(1 + slip ratio^2);
+ * *tol: 6 %, plus the curve's own uncertainty there. */
+static float noload_ls_ref(const imest_t *s, const op_point_t *op, float slip_ratio, float *tol)
+{
+  float err_h = 0.0f;
+  const float ls = IMEST_WITH_FLUX
+                       ? imest__bg_flux_ls(s, sqrtf(op->i2 / (1.0f + slip_ratio * slip_ratio)), &err_h)
+                       : s->ls_h;
+  *tol = LS_NOLOAD_TOL + err_h / ls;
+  return ls;
+}
+
 /* L_S at no load: the reactance the motor shows with (nearly) no rotor
  * current is w_e L_S (slip ratio 0.1: 1 % lower), the reactive power over
  * |i|^2. A configured L_S that differs by more than 6 % cannot be the motor's:
  * at one operating point the estimator absorbs it in T_R and R_S (L_S 10 %
  * high: T_R +11 %, R_S -42 %, residual unchanged), so this is the only place
- * it shows. Latched: every later window is constants_mismatch. */
+ * it shows. Latched: every later window is constants_mismatch. With a
+ * magnetising curve the configured L_S is the curve's at this window's
+ * current (noload_ls_ref): a saturating motor at no load at another voltage
+ * than ls_h's is not a mismatch. */
 static void noload_ls_check(imest_t *s, const op_point_t *op, float slip_ratio, int steady, imest_result_t *r)
 {
   const float we = fabsf(op->we);
@@ -201,8 +218,9 @@ static void noload_ls_check(imest_t *s, const op_point_t *op, float slip_ratio, 
   const float q = sqrtf(fmaxf(0.0f, op->s_va * op->s_va - op->p_w * op->p_w));
   const float ls_meas = q / op->i2 / we;
   r->ls_noload_h = (double)ls_meas;
-  const float dev = ls_meas / s->ls_h - 1.0f;
-  s->ls_check = (fabsf(dev) > LS_NOLOAD_TOL) ? 2u : (s->ls_check == 2u ? 2u : 1u);
+  float tol;
+  const float dev = ls_meas / noload_ls_ref(s, op, slip_ratio, &tol) - 1.0f;
+  s->ls_check = (fabsf(dev) > tol) ? 2u : (s->ls_check == 2u ? 2u : 1u);
 }
 
 /* Everything a check reads: the window, its statistics and sums, the solve,
@@ -418,8 +436,19 @@ static void bounds(judge_t *j, const bg_sums_t *sm, int have)
   }
 }
 
+/* The magnetising curve's share of the bounds (bg_flux.c), where they are
+ * computed; nothing without a curve (the outputs stay as without it). */
+static void flux_bounds(judge_t *j, const bg_flux_t *fx)
+{
+  if (!IMEST_WITH_FLUX || fx == NULL || j->s->ls_curve_points == 0u || !isfinite(j->tr_b)) return;
+  j->tr_b += fx->tr_b;
+  j->rs_b += fx->rs_b;
+  j->r->tr_bound_rel = (double)j->tr_b;
+  j->r->rs_bound_rel = (double)(j->rs_b + j->g_b);
+}
+
 void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, const bg_sums_t *sm,
-                     const bg_solve_out_t *so, int steady, imest_result_t *r)
+                     const bg_solve_out_t *so, const bg_flux_t *fx, int steady, imest_result_t *r)
 {
   judge_t j = {.s = s, .w = w, .st = st, .so = so, .r = r, .steady = steady};
   operating_point(s, st, sm, w->nreg, &j.op);
@@ -434,6 +463,7 @@ void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_
   r->slip_ratio = (double)(fabsf((float)st->slip_rate) * (have ? (float)r->tr_s : s->tr_nominal_s));
   r->ls_noload_h = (double)NAN; /* the no-load check fills it where it runs */
   bounds(&j, sm, have);
+  flux_bounds(&j, fx);
   const int status = tr_verdict(&j);
   const int rs_status = status != IMEST_REASON_NONE ? status : rs_verdict(&j);
   r->tr_reason = status;

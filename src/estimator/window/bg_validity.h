@@ -4,11 +4,13 @@
 #ifndef IMEST_BG_VALIDITY_H
 #define IMEST_BG_VALIDITY_H
 
+#include "bg_flux.h"
 #include "bg_window.h"
 
 /* Fills valid/status and the per-parameter verdicts of r from the window
- * flags, the window's statistics and the solve. */
+ * flags, the window's statistics and the solve; fx: the magnetising curve's
+ * share of the bounds (bg_flux.h; NULL: none). */
 void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, const bg_sums_t *sm,
-                     const bg_solve_out_t *so, int steady, imest_result_t *r);
+                     const bg_solve_out_t *so, const bg_flux_t *fx, int steady, imest_result_t *r);
 
 #endif /* IMEST_BG_VALIDITY_H */

@@ -1,0 +1,168 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Background stage: L_S at the window's flux (main-flux saturation) from the
+ * configured magnetising curve, and T_R and R_S moved to it (docs/METHOD.md
+ * §18.5). Saturation moves the main inductance, not the leakage: the window's
+ * motor has L_w = L_S(i_d) and sigma_w = sigma ls_h / L_w (sigma L_S held),
+ * where the solve assumed ls_h and sigma. In steady state the fit matches the
+ * window's impedance Z (bg_impedance.h) with the configured constants, so Z
+ * follows from the estimate, and the estimate with L_w, sigma_w is the one
+ * that gives the same Z: solved in closed form (no linearisation), twice,
+ * because i_d = |i| / sqrt(1 + a^2) depends on a = slip frequency x T_R
+ * (a secant step on L_w, FLUX_MAX_CONTRACTION).
+ * float32: every figure is relative, as in bg_validity.c. */
+#include <math.h>
+
+#include "bg_flux.h"
+
+/* The fixed point L = curve(i_d(T_R(L))) is solved by one secant step: the
+ * fit's T_R gives L_1 = curve(i_d), the estimate with L_1 gives L_2; the
+ * fixed point of the straight line through (ls_h, L_1), (L_1, L_2) is L_w,
+ * and the estimate with L_w is the result (two estimates in all). The step's
+ * contraction k = (L_2 - L_1) / (L_1 - ls_h) must be below this (4 kW, rated
+ * load: k about 0.3): beyond it the curve is too steep at this flux for the
+ * step to be trusted, and the window's bounds say so. */
+#define FLUX_MAX_CONTRACTION  0.5f
+/* The steady-state picture against the estimator: moved to L_w, the estimate
+ * is the one re-estimating with L_S = L_w gives to within these shares of the
+ * move (measured, tools/studies/saturation: 4 and 11 kW motors, 25-100 % load
+ * at 50 Hz and field weakening at 75 Hz; T_R within 5 % of its move (11 kW at
+ * 25 % load: +0.50 % moved, +0.41 % re-estimated, from -1.34 % without), R_S
+ * within 8 % (the same window); docs/METHOD.md §18.5). */
+#define FLUX_PICTURE_SHARE_TR 0.05f
+#define FLUX_PICTURE_SHARE_RS 0.1f
+
+#if IMEST_WITH_FLUX
+static float seg_slope(const float *x, const float *y, uint32_t k)
+{
+  return (y[k + 1u] - y[k]) / (x[k + 1u] - x[k]);
+}
+
+float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
+{
+  const uint32_t n = s->ls_curve_points;
+  const float *x = s->ls_curve_i_a, *y = s->ls_curve_h;
+  *err_h = 0.0f;
+  if (n < 2u) return s->ls_h;
+  uint32_t k = 0u; /* the segment [x_k, x_k+1]: the first, the last, or the one holding i_a */
+  while (k + 2u < n && i_a > x[k + 1u]) ++k;
+  const float h = x[k + 1u] - x[k], slope = seg_slope(x, y, k);
+  if (!(i_a > x[0])) {
+    *err_h = fabsf(slope) * (x[0] - i_a);
+    return y[0];
+  }
+  if (!(i_a < x[n - 1u])) {
+    *err_h = fabsf(slope) * (i_a - x[n - 1u]);
+    return y[n - 1u];
+  }
+  const float t = (i_a - x[k]) / h;
+  float dslope = n == 2u ? fabsf(slope) : 0.0f; /* the slope's change at the segment's ends */
+  if (k >= 1u) dslope = fabsf(slope - seg_slope(x, y, k - 1u));
+  if (k + 2u < n) dslope = fmaxf(dslope, fabsf(seg_slope(x, y, k + 1u) - slope));
+  *err_h = t * (1.0f - t) * h * dslope;
+  return y[k] + t * (y[k + 1u] - y[k]);
+}
+
+/* A window's impedance Z = zr + j zi [ohm]. */
+typedef struct {
+  float zr, zi;
+} flux_z_t;
+
+/* The T_R and R_S that give the impedance z with L_S = ls and sigma L_S =
+ * sls: Im Z / (we ls) = (1 + sg a^2) / (1 + a^2) gives a^2, Re Z gives R_S.
+ * 0 if no such motor exists (Im Z outside (sg, 1) x we ls). */
+static int refit(const flux_z_t *z, float we, float ws, float ls, float sls, float *tr, float *rs)
+{
+  const float sg = sls / ls, q = z->zi / (we * ls);
+  if (!(q > sg && q < 1.0f)) return 0;
+  const float a2 = (1.0f - q) / (q - sg), a = copysignf(sqrtf(a2), ws);
+  *tr = fabsf(a / ws);
+  *rs = z->zr - we * ls * a * (1.0f - sg) / (1.0f + a2);
+  return 1;
+}
+
+/* L_S of the curve at the flux-producing current of the estimate with T_R tr:
+ * i_d = |i| / sqrt(1 + a^2), a = ws tr. */
+static float ls_at(const imest_t *s, float i2, float ws, float tr, float *err)
+{
+  const float a = ws * tr;
+  return imest__bg_flux_ls(s, sqrtf(i2 / (1.0f + a * a)), err);
+}
+
+/* The secant step of FLUX_MAX_CONTRACTION: L_w from ls_h and the two curve
+ * values; 0 if the step cannot be trusted. */
+static int secant(float l0, float l1, float l2, float *lw)
+{
+  const float f0 = l1 - l0, f1 = l2 - l1;
+  *lw = l1;
+  if (f0 == 0.0f || f1 == 0.0f) return 1; /* on the fixed point already */
+  const float k = f1 / f0;
+  if (!(fabsf(k) < FLUX_MAX_CONTRACTION)) return 0;
+  *lw = l1 + f1 / (1.0f - k);
+  return 1;
+}
+
+void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums_t *sm, uint32_t nreg,
+                    imest_result_t *r, bg_flux_t *fx)
+{
+  fx->tr_b = 0.0f;
+  fx->rs_b = 0.0f;
+  r->ls_window_h = (double)NAN;
+  if (s->ls_curve_points == 0u) return;
+  const float tr0 = (float)r->tr_s, rs0 = (float)r->rs_ohm, ws = (float)st->slip_rate;
+  const float we = ws + (float)s->n * (float)st->w_mean; /* s->n: float64 in the reference build */
+  const float i2 = nreg > 0u ? (float)sm->rw[3][3] / (float)nreg : 0.0f;
+  /* The steady-state picture: an estimate, a field, a slip, below the
+   * pull-out slip (tr_uncertain's condition). Elsewhere (a run-up, a
+   * transient, no estimate) the dynamics determine T_R: the estimate stays
+   * the fit's with ls_h, and nothing is added to its bounds. */
+  if (!(tr0 > 0.0f && isfinite(tr0) && isfinite(rs0) && i2 > 0.0f && fabsf(we) > 0.0f && ws != 0.0f &&
+        fabsf(ws * tr0) * s->sigma < 1.0f))
+    return;
+  const float sls = s->sigma * s->ls_h;
+  const float a0 = ws * tr0, x = we * s->ls_h / (1.0f + a0 * a0);
+  /* the window's impedance, as the fit saw it (bg_impedance.h's Z) */
+  const flux_z_t z = {rs0 + x * a0 * (1.0f - s->sigma), x * (1.0f + s->sigma * a0 * a0)};
+  float tr = tr0, rs = rs0, err, lw = s->ls_h, tr_e, rs_e;
+  const float l1 = ls_at(s, i2, ws, tr0, &err);
+  int ok = refit(&z, we, ws, l1, sls, &tr, &rs) && secant(s->ls_h, l1, ls_at(s, i2, ws, tr, &err), &lw) &&
+           refit(&z, we, ws, lw, sls, &tr, &rs);
+  /* The curve's share of the bounds: L_w's uncertainty, i.e. its distance
+   * from the curve at the result's own i_d (the step's remainder) plus the
+   * curve's uncertainty there, taken through the same closed form (the
+   * estimate with L_w that much higher); and the picture's share of the move. */
+  const float dl = fabsf(ls_at(s, i2, ws, tr, &err) - lw) + err;
+  ok = ok && refit(&z, we, ws, lw + dl, sls, &tr_e, &rs_e);
+  if (!ok) {
+    /* no motor with the curve's L_S gives this impedance, or the curve is too
+     * steep here: the curve and the window disagree. The estimate stays the
+     * fit's, and its bounds say that it is not known. */
+    fx->tr_b = INFINITY;
+    fx->rs_b = INFINITY;
+    return;
+  }
+  fx->tr_b = (fabsf(tr_e - tr) + FLUX_PICTURE_SHARE_TR * fabsf(tr0 - tr)) / tr;
+  fx->rs_b = (fabsf(rs_e - rs) + FLUX_PICTURE_SHARE_RS * fabsf(rs0 - rs)) / fabsf(rs);
+  r->tr_s = (double)tr;
+  r->rs_ohm = (double)rs;
+  r->ls_window_h = (double)lw;
+}
+#else  /* IMEST_WITH_FLUX: left out of the build, no curve (imest_config_check() refuses one) */
+float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
+{
+  (void)i_a;
+  *err_h = 0.0f;
+  return s->ls_h;
+}
+
+void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums_t *sm, uint32_t nreg,
+                    imest_result_t *r, bg_flux_t *fx)
+{
+  (void)s;
+  (void)st;
+  (void)sm;
+  (void)nreg;
+  fx->tr_b = 0.0f;
+  fx->rs_b = 0.0f;
+  r->ls_window_h = (double)NAN;
+}
+#endif /* IMEST_WITH_FLUX */

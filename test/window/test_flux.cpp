@@ -1,0 +1,279 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+// L_S at the window's flux (src/estimator/window/bg_flux.c): the magnetising
+// curve's interpolation, clamping and stated uncertainty; the estimate moved
+// to L_w against the exact steady-state answer and against the first-order
+// move of bg_impedance.h; no curve, no change.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <cstring>
+
+extern "C" {
+#include "imest/imest.h"
+#include "bg_flux.h"
+#include "bg_impedance.h"
+}
+
+namespace {
+
+using cplx = std::complex<double>;
+
+// The 4 kW motor of the simulator (sim/src/motors.c), configured with its L_S at rated no-load
+// flux: ls_h, sigma; sigma L_S is the leakage, which saturation leaves.
+constexpr double kLs = 0.17349, kSigma = 0.06618, kRs = 1.405, kNp = 2.0;
+
+imest_config_t base_config()
+{
+  imest_config_t c;
+  imest_config_default(&c);
+  c.pole_pairs = 2;
+  c.ls_h = (float)kLs;
+  c.sigma = (float)kSigma;
+  c.fs_hz = 8000.0f;
+  return c;
+}
+
+void set_curve(imest_config_t &c, std::initializer_list<std::pair<double, double>> pts)
+{
+  unsigned int n = 0;
+  for (const auto &p : pts) {
+    c.ls_curve_i_a[n] = (float)p.first;
+    c.ls_curve_h[n] = (float)p.second;
+    n++;
+  }
+  c.ls_curve_points = n;
+}
+
+// A window of a motor with L_w, sigma_w = sigma ls_h / L_w, T_R, R_S in the
+// steady state at field frequency f and a = slip frequency x T_R, current
+// amplitude i_amp, and what the fit with the configured constants makes of it:
+// the T_R and R_S that give the same impedance with ls_h and sigma.
+struct Window {
+  imest_t s;
+  bg_window_stats_t st;
+  bg_sums_t sm;
+  uint32_t nreg = 4000u;
+  imest_result_t r;
+  double tr_true, rs_true, tr_fit, rs_fit;
+};
+
+cplx impedance(double we, double ws, double ls, double sg, double tr, double rs)
+{
+  const double a = ws * tr;
+  return rs + cplx(0.0, we * ls) * cplx(1.0, sg * a) / cplx(1.0, a);
+}
+
+// The exact fit: Im Z / (we ls) = (1 + sg a^2) / (1 + a^2), then R_S from Re Z.
+void exact_fit(cplx z, double we, double ws, double ls, double sg, double *tr, double *rs)
+{
+  const double q = z.imag() / (we * ls), a2 = (1.0 - q) / (q - sg), a = std::sqrt(a2);
+  *tr = a / ws;
+  *rs = z.real() - we * ls * a * (1.0 - sg) / (1.0 + a2);
+}
+
+Window make_window(const imest_config_t &cfg, double lw, double tr, double a, double i_amp,
+                   double f_hz = 50.0)
+{
+  Window x;
+  std::memset(&x.s, 0, sizeof x.s);
+  std::memset(&x.st, 0, sizeof x.st);
+  std::memset(&x.sm, 0, sizeof x.sm);
+  std::memset(&x.r, 0, sizeof x.r);
+  EXPECT_EQ(imest_init(&x.s, &cfg), IMEST_OK);
+  const double we = 2.0 * M_PI * f_hz, ws = a / tr, sgw = kSigma * kLs / lw;
+  x.st.slip_rate = ws;
+  x.st.w_mean = (we - ws) / kNp;
+  x.st.i_rms_a = i_amp;
+  x.sm.rw[3][3] = (double)x.nreg * i_amp * i_amp;
+  const cplx z = impedance(we, ws, lw, sgw, tr, kRs);
+  exact_fit(z, we, ws, kLs, kSigma, &x.tr_fit, &x.rs_fit);
+  x.tr_true = tr;
+  x.rs_true = kRs;
+  x.r.tr_s = x.tr_fit;
+  x.r.rs_ohm = x.rs_fit;
+  x.r.k1 = 1.0;
+  x.r.k2 = 1.0 / x.tr_fit;
+  return x;
+}
+
+float curve_ls(const imest_config_t &cfg, float i_a, float *err)
+{
+  imest_t s;
+  std::memset(&s, 0, sizeof s);
+  EXPECT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  return imest__bg_flux_ls(&s, i_a, err);
+}
+
+TEST(FluxCurve, PiecewiseLinearWithItsStatedError)
+{
+  imest_config_t c = base_config();
+  set_curve(c, {{3.0, 0.23}, {5.0, 0.21}, {7.0, 0.17}});
+  float err = -1.0f;
+  EXPECT_FLOAT_EQ(curve_ls(c, 5.0f, &err), 0.21f) << "on a point";
+  EXPECT_NEAR(err, 0.0f, 1e-9f);
+  EXPECT_FLOAT_EQ(curve_ls(c, 4.0f, &err), 0.22f) << "half-way: the chord";
+  // slopes -0.01 and -0.02 H/A: the slope changes by 0.01 H/A at 5 A; t (1 - t) h D
+  EXPECT_NEAR(err, 0.25f * 2.0f * 0.01f, 1e-6f);
+  EXPECT_FLOAT_EQ(curve_ls(c, 6.5f, &err), 0.18f);
+  EXPECT_NEAR(err, 0.75f * 0.25f * 2.0f * 0.01f, 1e-6f);
+}
+
+TEST(FluxCurve, ClampedOutsideWithTheStraightContinuationAsItsError)
+{
+  imest_config_t c = base_config();
+  set_curve(c, {{3.0, 0.23}, {5.0, 0.21}, {7.0, 0.17}});
+  float err = -1.0f;
+  EXPECT_FLOAT_EQ(curve_ls(c, 1.0f, &err), 0.23f);
+  EXPECT_NEAR(err, 0.01f * 2.0f, 1e-6f); // first segment's slope x 2 A
+  EXPECT_FLOAT_EQ(curve_ls(c, 8.0f, &err), 0.17f);
+  EXPECT_NEAR(err, 0.02f * 1.0f, 1e-6f); // last segment's slope x 1 A
+  EXPECT_FLOAT_EQ(curve_ls(c, 7.0f, &err), 0.17f) << "the last point itself";
+  EXPECT_NEAR(err, 0.0f, 1e-9f);
+}
+
+TEST(FluxCurve, TwoPointsTakeAQuarterOfTheStepAtMidSegment)
+{
+  imest_config_t c = base_config();
+  set_curve(c, {{4.0, 0.22}, {8.0, 0.16}});
+  float err = -1.0f;
+  EXPECT_FLOAT_EQ(curve_ls(c, 6.0f, &err), 0.19f);
+  EXPECT_NEAR(err, 0.25f * 0.06f, 1e-6f);
+}
+
+TEST(FluxCurve, NoCurveIsLsH)
+{
+  imest_config_t c = base_config();
+  c.ls_curve_i_a[0] = 3.0f; // values without a count are not a curve
+  c.ls_curve_h[0] = 0.3f;
+  float err = -1.0f;
+  EXPECT_EQ(curve_ls(c, 5.0f, &err), (float)kLs);
+  EXPECT_EQ(err, 0.0f);
+}
+
+TEST(FluxCorrection, NoCurveLeavesTheResultAsItIs)
+{
+  imest_config_t c = base_config();
+  Window x = make_window(c, 1.05 * kLs, 0.13, 1.2, 12.0);
+  imest_result_t before = x.r;
+  bg_flux_t fx;
+  imest__bg_flux(&x.s, &x.st, &x.sm, x.nreg, &x.r, &fx);
+  EXPECT_TRUE(std::isnan(x.r.ls_window_h));
+  before.ls_window_h = x.r.ls_window_h;
+  EXPECT_EQ(std::memcmp(&before, &x.r, sizeof before), 0);
+  EXPECT_EQ(fx.tr_b, 0.0f);
+  EXPECT_EQ(fx.rs_b, 0.0f);
+}
+
+// A flat curve at L_w (no interpolation error, no dependence on i_d): the moved estimate is the
+// motor's, to float32 precision, from 3.5 % (rated load under V/f) to 40 % (field weakening).
+TEST(FluxCorrection, ExactForAFlatCurve)
+{
+  for (double rel : {1.035, 1.10, 1.40, 0.97}) {
+    for (double a : {0.5, 1.0, 1.8}) {
+      SCOPED_TRACE(testing::Message() << "L_w / ls_h " << rel << ", a " << a);
+      imest_config_t c = base_config();
+      const double lw = rel * kLs;
+      set_curve(c, {{2.0, lw}, {20.0, lw}});
+      Window x = make_window(c, lw, 0.13 * rel, a, 10.0);
+      if (std::isnan(x.tr_fit)) {
+        // at light load a large L_S error leaves the fit no T_R at all (the window is no_root)
+        EXPECT_TRUE(rel > 1.3 && a < 1.0);
+        continue;
+      }
+      bg_flux_t fx;
+      imest__bg_flux(&x.s, &x.st, &x.sm, x.nreg, &x.r, &fx);
+      EXPECT_NEAR(x.r.ls_window_h, lw, 1e-6 * lw);
+      EXPECT_NEAR(x.r.tr_s / x.tr_true - 1.0, 0.0, 2e-5)
+          << "the fit's T_R was off by " << x.tr_fit / x.tr_true - 1.0;
+      EXPECT_NEAR(x.r.rs_ohm / x.rs_true - 1.0, 0.0, 2e-4)
+          << "the fit's R_S was off by " << x.rs_fit / x.rs_true - 1.0;
+      EXPECT_GE(fx.tr_b, 0.0f);
+      EXPECT_LT(fx.tr_b, 0.06 * std::fabs(x.tr_fit / x.tr_true - 1.0) + 1e-4) << "the picture's share only";
+    }
+  }
+}
+
+// A saturating curve: the motor's L_w is the curve's at its own i_d = |i| / sqrt(1 + a^2). The
+// secant step reaches it, and what is left is within the bound the stage hands on.
+TEST(FluxCorrection, ReachesTheCurvesFluxWithinItsBound)
+{
+  imest_config_t c = base_config();
+  set_curve(c, {{3.0, 0.230}, {4.5, 0.215}, {6.0, 0.193}, {8.0, 0.160}});
+  for (double a : {0.6, 1.2, 1.8}) {
+    SCOPED_TRACE(a);
+    const double i_amp = 12.0, i_d = i_amp / std::sqrt(1.0 + a * a);
+    float err;
+    const double lw = curve_ls(c, (float)i_d, &err);
+    Window x = make_window(c, lw, 0.13, a, i_amp);
+    bg_flux_t fx;
+    imest__bg_flux(&x.s, &x.st, &x.sm, x.nreg, &x.r, &fx);
+    const double e_tr = x.r.tr_s / x.tr_true - 1.0, e_rs = x.r.rs_ohm / x.rs_true - 1.0;
+    EXPECT_LT(std::fabs(e_tr), 0.1 * std::fabs(x.tr_fit / x.tr_true - 1.0)) << "most of T_R's error is gone";
+    EXPECT_LE(std::fabs(e_tr), (double)fx.tr_b) << "what is left is within the bound";
+    EXPECT_LE(std::fabs(e_rs), (double)fx.rs_b);
+    EXPECT_NEAR(x.r.ls_window_h, lw, 0.01 * lw);
+  }
+}
+
+// To first order the move is bg_impedance.h's imest__bg_constants_shift() with e_ls = ls_h / L_w
+// - 1 and e_sg = L_w / ls_h - 1: within 5 % of the move for L_w 1 % off.
+TEST(FluxCorrection, FirstOrderIsTheConstantsShift)
+{
+  for (double a : {0.5, 1.0, 1.8}) {
+    SCOPED_TRACE(a);
+    imest_config_t c = base_config();
+    const double lw = 1.01 * kLs, sgw = kSigma * kLs / lw, we = 2.0 * M_PI * 50.0;
+    set_curve(c, {{2.0, lw}, {20.0, lw}});
+    Window x = make_window(c, lw, 0.13, a, 10.0);
+    bg_flux_t fx;
+    imest__bg_flux(&x.s, &x.st, &x.sm, x.nreg, &x.r, &fx);
+    bg_impedance_t z;
+    imest__bg_impedance((float)we, (float)(a / 0.13), (float)lw, (float)sgw, 0.13f, (float)kRs, &z);
+    float d_tr, d_rs;
+    imest__bg_constants_shift(&z, (float)sgw, (float)(kLs / lw - 1.0), (float)(lw / kLs - 1.0), 0.13f,
+                              (float)kRs, &d_tr, &d_rs);
+    const double move_tr = x.tr_fit / x.r.tr_s - 1.0, move_rs = x.rs_fit / x.r.rs_ohm - 1.0;
+    EXPECT_NEAR(move_tr, (double)d_tr, 0.05 * std::fabs((double)d_tr));
+    EXPECT_NEAR(move_rs, (double)d_rs, 0.05 * std::fabs((double)d_rs));
+  }
+}
+
+TEST(FluxCorrection, OnlyWhereTheSteadyStatePictureHolds)
+{
+  imest_config_t c = base_config();
+  set_curve(c, {{2.0, 1.1 * kLs}, {20.0, 1.1 * kLs}});
+  // beyond the pull-out slip (a sigma >= 1: a run-up): the fit's estimate stays
+  Window x = make_window(c, kLs, 0.13, 1.5 / kSigma, 10.0);
+  ASSERT_NEAR(x.tr_fit, 0.13, 1e-9);
+  const imest_result_t before = x.r;
+  bg_flux_t fx;
+  imest__bg_flux(&x.s, &x.st, &x.sm, x.nreg, &x.r, &fx);
+  EXPECT_EQ(x.r.tr_s, before.tr_s);
+  EXPECT_EQ(x.r.rs_ohm, before.rs_ohm);
+  EXPECT_TRUE(std::isnan(x.r.ls_window_h));
+  EXPECT_EQ(fx.tr_b, 0.0f);
+  // no estimate
+  x = make_window(c, 1.1 * kLs, 0.13, 1.0, 10.0);
+  x.r.tr_s = NAN;
+  imest__bg_flux(&x.s, &x.st, &x.sm, x.nreg, &x.r, &fx);
+  EXPECT_TRUE(std::isnan(x.r.ls_window_h));
+  EXPECT_EQ(fx.rs_b, 0.0f);
+}
+
+TEST(FluxCorrection, ACurveNoMotorFitsIsRefusedNotUsed)
+{
+  // a curve at 0.4 x the motor's L_S: at a = 1 the window's reactance is about 0.53 we L_S, more
+  // than any T_R gives with L_w (at most we L_w, at no slip)
+  imest_config_t c = base_config();
+  set_curve(c, {{2.0, 0.4 * kLs}, {20.0, 0.4 * kLs}});
+  Window x = make_window(c, kLs, 0.13, 1.0, 10.0);
+  const imest_result_t before = x.r;
+  bg_flux_t fx;
+  imest__bg_flux(&x.s, &x.st, &x.sm, x.nreg, &x.r, &fx);
+  EXPECT_EQ(x.r.tr_s, before.tr_s);
+  EXPECT_TRUE(std::isinf(fx.tr_b));
+  EXPECT_TRUE(std::isinf(fx.rs_b));
+}
+
+} // namespace
