@@ -178,11 +178,16 @@ static void systematic_bounds(const imest_t *s, const imest_window_t *w, const o
   const float harm = 0.5f * FOUR_OVER_PI_F * harm_v / op->i_pk;
   const float dzi = fabsf(we) * tau * fabsf(zr) + eps * fabsf(zr * zr - zi * zi) + harm;
   const float dt = fabsf(di) > 0.0f ? dzi / fabsf(di) : INFINITY;
-  float t_ls, r_ls, t_sg, r_sg;
-  imest__bg_constants_shift(&z, sg, s->ls_shift_e, 0.0f, tr, rs, &t_ls, &r_ls);
-  imest__bg_constants_shift(&z, sg, 0.0f, s->sigma_shift_e, tr, rs, &t_sg, &r_sg);
-  *c_tr_rel = fabsf(t_ls) + fabsf(t_sg);
-  *c_rs_rel = fabsf(r_ls) + fabsf(r_sg);
+  /* L_S's move, then sigma's (one copy of the shift in the code) */
+  *c_tr_rel = 0.0f;
+  *c_rs_rel = 0.0f;
+  for (int k = 0; k < 2; ++k) {
+    float t, r;
+    imest__bg_constants_shift(&z, sg, k == 0 ? s->ls_shift_e : 0.0f, k == 0 ? 0.0f : s->sigma_shift_e, tr, rs,
+                              &t, &r);
+    *c_tr_rel += fabsf(t);
+    *c_rs_rel += fabsf(r);
+  }
   *tr_rel = dt / tr + *c_tr_rel;
   const float dr_volt = dv_v < 0.0f ? INFINITY : FOUR_OVER_PI_F * dv_v / op->i_pk;
   *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs + *c_rs_rel;
@@ -232,6 +237,10 @@ typedef struct {
   int steady;
   float tr_b, rs_b, g_b; /* T_R's and R_S's systematic bounds, the gain mismatch's share */
   float c_tr, c_rs;      /* the constants' share of tr_b and rs_b (in them) */
+  /* The bounds are steady-state figures: T_R's is judged only below the
+   * pull-out slip (a sigma < 1), where a drive runs steadily; beyond it the
+   * window is a transient (a run-up) whose dynamics determine T_R. */
+  int tr_judged;
 } judge_t;
 
 static inline int input_fault(judge_t *j)
@@ -343,22 +352,16 @@ static inline int not_finite(judge_t *j)
 {
   return !(isfinite(j->r->tr_s) && isfinite(j->r->rs_ohm) && isfinite(j->r->e_i));
 }
-/* The bounds are steady-state figures: T_R's is judged only below the
- * pull-out slip (a sigma < 1), where a drive runs steadily; beyond it the
- * window is a transient (a run-up) whose dynamics determine T_R. */
-static inline int below_pull_out(judge_t *j)
-{
-  return (float)j->st->slip_rate * (float)j->r->tr_s * j->s->sigma < 1.0f;
-}
-/* tr_tolerance, ls_uncertainty, sigma_uncertainty: the constants' share alone */
+/* tr_tolerance, ls_uncertainty, sigma_uncertainty: the constants' share alone
+ * (judged where T_R's bound is: j->tr_judged) */
 static inline int tr_constants_uncertain(judge_t *j)
 {
-  return below_pull_out(j) && !(j->c_tr <= j->s->tr_tolerance);
+  return j->tr_judged && !(j->c_tr <= j->s->tr_tolerance);
 }
 /* tr_tolerance */
 static inline int tr_uncertain(judge_t *j)
 {
-  return below_pull_out(j) && !(j->tr_b <= j->s->tr_tolerance);
+  return j->tr_judged && !(j->tr_b <= j->s->tr_tolerance);
 }
 /* rs_tolerance: the current sensors' gain mismatch takes most of R_S's bound */
 static inline int rs_gain_mismatch(judge_t *j)
@@ -469,6 +472,7 @@ void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_
   r->slip_ratio = (double)(fabsf((float)st->slip_rate) * (have ? (float)r->tr_s : s->tr_nominal_s));
   r->ls_noload_h = (double)NAN; /* the no-load check fills it where it runs */
   bounds(&j, sm, have);
+  j.tr_judged = (float)st->slip_rate * (float)r->tr_s * s->sigma < 1.0f;
   const int status = tr_verdict(&j);
   const int rs_status = status != IMEST_REASON_NONE ? status : rs_verdict(&j);
   r->tr_reason = status;
