@@ -44,6 +44,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
   cfg.pole_pairs = 1u + (mode & 3u);
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   cfg.fs_hz = 4000.0f;
   cfg.window_s = 0.05f; // 200 samples
   cfg.start_at_rest = (mode >> 2) & 1;

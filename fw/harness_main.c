@@ -45,6 +45,8 @@ int main(void)
   cfg.pole_pairs = 2u;
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   cfg.fs_hz = FW_FS_HZ;
   cfg.window_s = FW_WINDOW_S;
   /* The recording is in steady state and has no sensor offsets: the default

@@ -148,7 +148,11 @@ typedef enum {
   /** T_R's error bound (the PWM staircase, timing, with the duty-cycle input the inverter
    *  model's uncertainty) exceeds tr_tolerance: light load, where T_R is weakly coupled to the
    *  data (R_S then refused too) */
-  IMEST_REASON_TR_UNCERTAIN = 27
+  IMEST_REASON_TR_UNCERTAIN = 27,
+  /** the constants' stated uncertainty (ls_uncertainty, sigma_uncertainty) alone moves T_R (or
+   *  R_S) by more than its tolerance: commission the motor (imest_commission.h) or state what the
+   *  constants are known to */
+  IMEST_REASON_CONSTANTS_UNCERTAIN = 28
 } imest_reason_t;
 
 /** Short lower-case name of a reason ("ok", "warmup", "zero_slip", ...). */
@@ -237,6 +241,23 @@ typedef struct {
   unsigned int pole_pairs; /**< n_p */
   float ls_h;              /**< stator inductance L_S [H] */
   float sigma;             /**< total leakage factor 1 - M^2/(L_S L_R) */
+  /** largest relative error of ls_h, e.g. 0.1 for 10 % (default 0.1: L_S typed from a data sheet
+   *  or derived from its equivalent circuit, where 10 % is usual; 0 = exact, e.g. a simulator's
+   *  own constants). At one operating point the fit absorbs a wrong L_S in T_R and R_S without
+   *  raising the residual (4 kW at rated load: L_S 10 % high gives T_R +8 %, R_S -80 %), so the
+   *  move this uncertainty can cause at the window's operating point (docs/METHOD.md §18.1: the
+   *  first-order move for a motor's L_S up to u / (1 - u) from ls_h, times 1 + u for the second
+   *  order; measured 1.1 to 1.9 times the actual move) is added to tr_bound_rel and
+   *  rs_bound_rel. With the default T_R is refused as constants_uncertain at loaded operating
+   *  points, where a data-sheet L_S moves it by more than tr_tolerance: commission the motor
+   *  (imest_comm_apply() states what commissioning measured: 0.2 % on the simulator's motors)
+   *  or state what L_S is known to. In [0, 1) */
+  float ls_uncertainty;
+  /** largest relative error of sigma (default 0.2: a data-sheet leakage factor; 0 = exact;
+   *  commissioning: 0.5 %). Its move of T_R and R_S adds to the bounds as ls_uncertainty's does,
+   *  the two summed (not in quadrature: sigma is sigma L_S / L_S, so the two errors are
+   *  correlated). In [0, 1) */
+  float sigma_uncertainty;
 
   /* Sampling. */
   float fs_hz;    /**< sample rate of the ISR call [Hz] (default 4000) */
@@ -390,8 +411,8 @@ typedef struct {
   unsigned int windows;      /**< windows combined into this estimate (1: this one alone) */
   double tr_s;               /**< rotor time constant T_R [s] (NaN if no candidate) */
   double rs_ohm;             /**< stator resistance R_S [ohm] */
-  double tr_bound_rel;       /**< error bound of T_R, relative (NaN if not computed) */
-  double rs_bound_rel;       /**< error bound of R_S, relative (NaN if not computed) */
+  double tr_bound_rel;       /**< error bound of T_R, relative, constants' share in (NaN: none) */
+  double rs_bound_rel;       /**< error bound of R_S, relative, constants' share in (NaN: none) */
   double k1;                 /**< K1 = gamma [1/s] */
   double k2;                 /**< K2 = 1/T_R [1/s] */
   double e;                  /**< E_p^2 at the minimum (units of y^2 * samples) */

@@ -33,6 +33,8 @@ enum { KIND_FLOAT = 0, KIND_INT = 1, KIND_UINT = 2, KIND_PWM_TIMING = 3, KIND_RE
   X(pole_pairs, KIND_UINT)                                                                                   \
   X(ls_h, KIND_FLOAT)                                                                                        \
   X(sigma, KIND_FLOAT)                                                                                       \
+  X(ls_uncertainty, KIND_FLOAT)                                                                              \
+  X(sigma_uncertainty, KIND_FLOAT)                                                                           \
   X(fs_hz, KIND_FLOAT)                                                                                       \
   X(window_s, KIND_FLOAT)                                                                                    \
   X(filter_hz, KIND_FLOAT)                                                                                   \

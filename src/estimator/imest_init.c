@@ -19,6 +19,8 @@ void imest_config_default(imest_config_t *cfg)
   cfg->pole_pairs = 0; /* motor constants: the caller must set them */
   cfg->ls_h = 0.0f;
   cfg->sigma = 0.0f;
+  cfg->ls_uncertainty = 0.1f;    /* a data sheet's L_S */
+  cfg->sigma_uncertainty = 0.2f; /* a data sheet's sigma */
   cfg->fs_hz = 4000.0f;
   cfg->window_s = 1.0f;
   cfg->filter_hz = 100.0f;
@@ -79,6 +81,8 @@ typedef struct {
 static const check_t k_checks[] = {
     CHK(ls_h, C_POS, 0.0f, 0.0f),
     CHK(sigma, C_POS, 0.0f, 1.0f),
+    CHK(ls_uncertainty, C_NONNEG, 0.0f, 1.0f),
+    CHK(sigma_uncertainty, C_NONNEG, 0.0f, 1.0f),
     CHK(fs_hz, C_POS, 0.0f, 1.000001e6f),
     CHK(window_s, C_POS, 0.0f, 0.0f),
     CHK(filter_hz, C_POS, 0.4f, 0.0f),
@@ -374,6 +378,15 @@ static void init_background_constants(imest_t *s, const imest_config_t *cfg)
   s->min_slip_ratio = cfg->min_slip_ratio;
   s->rs_tolerance = cfg->rs_tolerance;
   s->tr_tolerance = cfg->tr_tolerance;
+  /* the constants' errors the bounds take (bg_validity.c, systematic_bounds):
+   * configured = (1 + e) x the motor's with |e| <= u puts the motor's value
+   * up to u / (1 - u) from the configured one; the first-order move of that,
+   * and (1 + u) for the second-order terms (measured: the move is up to u
+   * larger, relative, than first order where the motor's constant is the
+   * higher one) */
+  s->ls_shift_e = cfg->ls_uncertainty * (1.0f + cfg->ls_uncertainty) / (1.0f - cfg->ls_uncertainty);
+  s->sigma_shift_e =
+      cfg->sigma_uncertainty * (1.0f + cfg->sigma_uncertainty) / (1.0f - cfg->sigma_uncertainty);
   s->u_uncertainty_v = cfg->u_uncertainty_v;
   s->timing_uncertainty_s = cfg->timing_uncertainty_s;
   s->rs_nominal_ohm = cfg->rs_nominal_ohm;
@@ -451,6 +464,7 @@ const char *imest_reason_name(int reason)
   case IMEST_REASON_RS_UNCERTAIN: return "rs_uncertain";
   case IMEST_REASON_GAIN_MISMATCH: return "gain_mismatch";
   case IMEST_REASON_TR_UNCERTAIN: return "tr_uncertain";
+  case IMEST_REASON_CONSTANTS_UNCERTAIN: return "constants_uncertain";
   default: return "unknown";
   }
 }

@@ -18,6 +18,8 @@ int main(void)
   cfg.pole_pairs = 2u;
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   cfg.window_s = 0.25f;
   if (imest_init(&est, &cfg) != IMEST_OK) return 1;
   for (int n = 0; n < 4000; n++) {

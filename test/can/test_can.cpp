@@ -189,7 +189,7 @@ TEST(CanCodec, SignalTableIsConsistent)
     case IMEST_CAN_SCALED: EXPECT_GT(t[k].scale, 1u) << k; break;
     case IMEST_CAN_COUNT: EXPECT_LE(t[k].len, 16u) << k << ": unsigned int has 16 bits on C2000"; break;
     case IMEST_CAN_ENUM:
-      EXPECT_GE(1u << t[k].len, IMEST_REASON_RS_OUT_OF_RANGE + 2u) << k << ": every reason must fit";
+      EXPECT_GE(1u << t[k].len, IMEST_REASON_CONSTANTS_UNCERTAIN + 2u) << k << ": every reason must fit";
       break;
     case IMEST_CAN_BOOL:
     case IMEST_CAN_FLAG:
@@ -385,7 +385,7 @@ TEST(CanCodec, VerdictsReasonsFlagsAndCounts)
   r.windows = 1000; // saturates at 255
   EXPECT_EQ(roundtrip(r).result.windows, 255u);
   // every reason travels as its stable number
-  for (int reason = IMEST_REASON_WARMUP; reason <= IMEST_REASON_RS_OUT_OF_RANGE; reason++) {
+  for (int reason = IMEST_REASON_WARMUP; reason <= IMEST_REASON_CONSTANTS_UNCERTAIN; reason++) {
     r.status = r.tr_reason = r.rs_reason = reason;
     w = roundtrip(r);
     EXPECT_EQ(w.result.status, reason);
@@ -1113,6 +1113,8 @@ TEST(CanPublish, ApplicationPublishesEveryBackgroundResult)
   cfg.pole_pairs = 2;
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   cfg.window_s = 0.25f;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   FakePort p;

@@ -38,7 +38,7 @@ with open(rec, "w") as f:
         i = [8 * math.cos(w * t - 0.6 - p) for p in (0, 2 * math.pi / 3, 4 * math.pi / 3)]
         f.write("%.6f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.6f\n" % (t, *u, *i, 0.97 * w * t / 2))
 
-MOTOR = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--quiet"]
+MOTOR = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--ls-uncertainty", "0", "--sigma-uncertainty", "0", "--quiet"]
 log = os.path.join(work, "ids.log")
 
 

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 
@@ -89,6 +90,17 @@ TEST_P(CommissionMotor, ClosedLoopWithinTheIssuesAccuracy)
   EXPECT_FLOAT_EQ(cfg.inverter.dead_time_s, out.r.inverter.dead_time_s);
   EXPECT_GT(cfg.inverter.uncertainty, 0.0f);
   EXPECT_GT(cfg.inverter.i_band_a, 0.0f);
+  // the stated uncertainty of L_S and sigma: the rule's floors (rotating), and it covers
+  // what commissioning is actually off by
+  EXPECT_GE(cfg.ls_uncertainty, IMEST_COMM_LS_FLOOR);
+  EXPECT_LT(cfg.ls_uncertainty, 0.01f);
+  EXPECT_GE(cfg.sigma_uncertainty, IMEST_COMM_SIGMA_FLOOR);
+  EXPECT_LT(cfg.sigma_uncertainty, 0.02f);
+  EXPECT_GT(cfg.ls_uncertainty, std::fabs(rel(out.r.ls_h.value, out.ls_h)));
+  EXPECT_GT(cfg.sigma_uncertainty, std::fabs(rel(out.r.sigma.value, out.sigma)));
+  std::printf("%s: L_S %+.3f %% (stated %.2f %%), sigma %+.3f %% (stated %.2f %%)\n", GetParam(),
+              100.0 * rel(out.r.ls_h.value, out.ls_h), 100.0 * cfg.ls_uncertainty,
+              100.0 * rel(out.r.sigma.value, out.sigma), 100.0 * cfg.sigma_uncertainty);
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, CommissionMotor, ::testing::Values("exp1", "4kw", "11kw", "37kw"),
@@ -128,6 +140,69 @@ TEST(Commission, StandstillOnlyFillsLsFromTheFluxTails)
   imest_config_t cfg;
   imest_config_default(&cfg);
   EXPECT_EQ(imest_comm_apply(&out.r, &cfg), 5); // all but n_p
+  // standstill only: the larger floors, covering the actual error
+  EXPECT_GE(cfg.ls_uncertainty, IMEST_COMM_LS_FLOOR_STANDSTILL);
+  EXPECT_GE(cfg.sigma_uncertainty, IMEST_COMM_SIGMA_FLOOR_STANDSTILL);
+  EXPECT_GT(cfg.ls_uncertainty, std::fabs(rel(out.r.ls_h.value, out.ls_h)));
+  EXPECT_GT(cfg.sigma_uncertainty, std::fabs(rel(out.r.sigma.value, out.sigma)));
+  cfg.pole_pairs = 2; // not identified at standstill: the user's
+  EXPECT_EQ(imest_config_check(&cfg, nullptr), IMEST_OK);
+  std::printf("4kw standstill: L_S %+.3f %% (stated %.2f %%), sigma %+.3f %% (stated %.2f %%)\n",
+              100.0 * rel(out.r.ls_h.value, out.ls_h), 100.0 * cfg.ls_uncertainty,
+              100.0 * rel(out.r.sigma.value, out.sigma), 100.0 * cfg.sigma_uncertainty);
+}
+
+// imest_comm_apply()'s rule for ls_uncertainty and sigma_uncertainty (imest_commission.h), on
+// hand-made results: the floors, 3 standard errors, the axes' spread, sigma's sum, the cap.
+TEST(Commission, ApplyStatesTheConstantsUncertaintyByItsRule)
+{
+  imest_comm_result_t r;
+  std::memset(&r, 0, sizeof r);
+  r.valid = 1;
+  r.rs_ohm.value = 1.4f;
+  r.tr_s.value = NAN;
+  r.inverter.uncertainty = -1.0f;
+  const auto set = [](imest_comm_value_t &v, float value, float std_rel, float spread_rel) {
+    v.value = value;
+    v.std_rel = std_rel;
+    v.spread_rel = spread_rel;
+  };
+  set(r.ls_h, 0.178f, NAN, NAN);
+  set(r.sigma, 0.0645f, NAN, NAN);
+  set(r.sigma_ls_h, 0.0115f, NAN, NAN);
+  set(r.ls_standstill_h, 0.178f, NAN, NAN);
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  ASSERT_GE(imest_comm_apply(&r, &cfg), 3);
+  EXPECT_FLOAT_EQ(cfg.ls_uncertainty, IMEST_COMM_LS_FLOOR); // nothing known: the floors
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, IMEST_COMM_SIGMA_FLOOR);
+  set(r.ls_h, 0.178f, 0.004f, 0.002f);        // 3 standard errors
+  set(r.sigma_ls_h, 0.0115f, 0.001f, 0.009f); // the spread, plus L_S's
+  ASSERT_GE(imest_comm_apply(&r, &cfg), 3);
+  EXPECT_FLOAT_EQ(cfg.ls_uncertainty, 0.012f);
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, 0.009f + 0.012f);
+  set(r.sigma, 0.0645f, 0.01f, NAN); // sigma's own quality when larger
+  ASSERT_GE(imest_comm_apply(&r, &cfg), 3);
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, 0.03f);
+  set(r.ls_h, 0.178f, NAN, 0.9f); // at most IMEST_COMM_UNCERTAINTY_MAX
+  ASSERT_GE(imest_comm_apply(&r, &cfg), 3);
+  EXPECT_FLOAT_EQ(cfg.ls_uncertainty, IMEST_COMM_UNCERTAINTY_MAX);
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, IMEST_COMM_UNCERTAINTY_MAX);
+  EXPECT_EQ(imest_config_check(&cfg, nullptr), IMEST_ERR_CONFIG); // pole_pairs not set
+  cfg.pole_pairs = 2;
+  EXPECT_EQ(imest_config_check(&cfg, nullptr), IMEST_OK);
+  // standstill only: its floors, and the standstill L_S's spread
+  set(r.ls_h, 0.178f, NAN, NAN);
+  set(r.sigma, 0.0645f, NAN, NAN);
+  set(r.sigma_ls_h, 0.0115f, NAN, NAN);
+  r.flags = IMEST_COMM_FLAG_LS_STANDSTILL;
+  ASSERT_GE(imest_comm_apply(&r, &cfg), 3);
+  EXPECT_FLOAT_EQ(cfg.ls_uncertainty, IMEST_COMM_LS_FLOOR_STANDSTILL);
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, IMEST_COMM_SIGMA_FLOOR_STANDSTILL);
+  set(r.ls_standstill_h, 0.178f, NAN, 0.03f);
+  ASSERT_GE(imest_comm_apply(&r, &cfg), 3);
+  EXPECT_FLOAT_EQ(cfg.ls_uncertainty, 0.03f);
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, 0.03f);
 }
 
 TEST(Commission, EncoderCountingBackwardsIsFound)

@@ -128,6 +128,8 @@ Recording make_recording(bool duty, uint64_t seed)
   cfg.pole_pairs = (unsigned int)sc.pole_pairs;
   cfg.ls_h = (float)sc.ls_h;
   cfg.sigma = (float)sc.sigma;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   cfg.fs_hz = (float)kFsHz;
   cfg.window_s = kWindowS;
   if (duty) {

@@ -29,6 +29,8 @@ RunOut run(MotorRef &mot, double seconds, double t_start, bool at_rest, float wi
   cfg.pole_pairs = 2;
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   cfg.fs_hz = (float)fs;
   cfg.window_s = window_s;
   cfg.start_at_rest = at_rest ? 1 : 0;

@@ -17,6 +17,8 @@ imest_config_t small_config()
   cfg.pole_pairs = 2;
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   cfg.fs_hz = 4000.0f;
   cfg.window_s = 0.1f; // 400 samples
   // the filter warm-up alone (123 samples); the offset tracker's longer
@@ -65,6 +67,32 @@ TEST(Handoff, InitRejectsBadConfigNamingTheField)
   cfg.voltage_kind = (imest_voltage_kind_t)-1;
   EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_ERR_CONFIG);
   EXPECT_STREQ(field, "voltage_kind");
+}
+
+// The constants' stated uncertainties: relative, in [0, 1); the defaults a data sheet's.
+TEST(Handoff, ConstantsUncertaintyIsRangeChecked)
+{
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  EXPECT_FLOAT_EQ(cfg.ls_uncertainty, 0.1f);
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, 0.2f);
+  const char *field = nullptr;
+  for (const float good : {0.0f, 0.05f, 0.99f}) {
+    cfg = small_config();
+    cfg.ls_uncertainty = good;
+    cfg.sigma_uncertainty = good;
+    EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_OK) << good;
+  }
+  for (const float bad : {-0.01f, 1.0f, 1.5f, NAN, INFINITY}) {
+    cfg = small_config();
+    cfg.ls_uncertainty = bad;
+    EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_ERR_CONFIG) << bad;
+    EXPECT_STREQ(field, "ls_uncertainty");
+    cfg = small_config();
+    cfg.sigma_uncertainty = bad;
+    EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_ERR_CONFIG) << bad;
+    EXPECT_STREQ(field, "sigma_uncertainty");
+  }
 }
 
 TEST(Handoff, IsrSignalsExactlyAtWindowEnds)

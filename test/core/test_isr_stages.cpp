@@ -57,6 +57,8 @@ static void check_design(double fc, const double b[4], const double a[4])
   cfg.pole_pairs = 2;
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   cfg.filter_hz = (float)fc;
   static imest_t s;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
@@ -96,6 +98,8 @@ TEST(IsrFilter, DerivativesAreTimeAlignedCentralDifferences)
   cfg.pole_pairs = 2;
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   static imest_t s;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   imest_chan_t c = {};
@@ -137,6 +141,8 @@ TEST(IsrRegressor, MatchesMathMdFormulas)
   cfg.pole_pairs = 2;
   cfg.ls_h = 0.2908f;
   cfg.sigma = 0.096f;
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   static imest_t s;
   ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   const double n = 2, m = (1 - 0.096) / 0.096, sl = (double)(0.096f * 0.2908f);

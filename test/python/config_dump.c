@@ -8,7 +8,7 @@
 
 #include "imest/imest.h"
 
-_Static_assert(sizeof(imest_config_t) == 51 * sizeof(float),
+_Static_assert(sizeof(imest_config_t) == 53 * sizeof(float),
                "imest_config_t changed: list the new field below");
 
 #define F(name) printf(#name " %a\n", (double)cfg.name)
@@ -21,6 +21,8 @@ int main(void)
   I(pole_pairs);
   F(ls_h);
   F(sigma);
+  F(ls_uncertainty);
+  F(sigma_uncertainty);
   F(fs_hz);
   F(window_s);
   F(filter_hz);

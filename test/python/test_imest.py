@@ -20,8 +20,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "python"))
 
 ARGS = None
-MOTOR = ["--pole-pairs", "2", "--ls", "0.178039", "--sigma", "0.0645168"]  # the 4 kW preset (sim/README.md)
-MOTOR_CFG = dict(pole_pairs=2, ls_h=0.178039, sigma=0.0645168)
+# the 4 kW preset (sim/README.md): the simulator's own constants, exact
+MOTOR = ["--pole-pairs", "2", "--ls", "0.178039", "--sigma", "0.0645168", "--ls-uncertainty", "0", "--sigma-uncertainty", "0"]
+MOTOR_CFG = dict(pole_pairs=2, ls_h=0.178039, sigma=0.0645168, ls_uncertainty=0.0, sigma_uncertainty=0.0)
 
 # imest-replay's format of each column (tools/replay/replay.c print_row)
 FORMATS = {
@@ -178,9 +179,10 @@ class Replay(unittest.TestCase):
         # finds the start at rest, lowers the speed limit to 2 fs, and estimates the last 0.6 s
         path = sim("exp1_1k.csv", "--preset", "exp1", "--duration", "1.6", "--fs", "1000")
         d = read_csv(path)
-        motor = dict(pole_pairs=2, ls_h=0.2908, sigma=0.096)
+        motor = dict(pole_pairs=2, ls_h=0.2908, sigma=0.096, ls_uncertainty=0.0, sigma_uncertainty=0.0)
         w = self.imest.run(self.imest.Config(**motor), **self.arrays(d, False))
-        out = sh([ARGS.replay, "--quiet", "--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", path])
+        out = sh([ARGS.replay, "--quiet", "--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--ls-uncertainty", "0",
+                  "--sigma-uncertainty", "0", path])
         lines = out.strip().split("\n")
         header = lines[0].split(",")
         self.same(path, (header, [dict(zip(header, l.split(","))) for l in lines[1:]]), w, "exp1 at 1 kHz", least=2)

@@ -81,6 +81,8 @@ struct Rig {
     cfg.pole_pairs = (unsigned)sc.pole_pairs;
     cfg.ls_h = (float)sc.ls_h;
     cfg.sigma = (float)sc.sigma;
+    cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+    cfg.sigma_uncertainty = 0.0f;
     cfg.fs_hz = (float)sc.fs_hz;
     cfg.window_s = window_s;
   }

@@ -25,6 +25,8 @@ static const struct {
 } k_float[] = {
     F(ls_h),
     F(sigma),
+    F(ls_uncertainty),
+    F(sigma_uncertainty),
     F(fs_hz),
     F(window_s),
     F(filter_hz),

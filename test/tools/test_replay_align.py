@@ -95,7 +95,7 @@ def main():
                 "--load-nm", "10", "--load-on", "3", "--load-ramp", "5", "--duration", "32",
                 "--dead-time", "2e-6"]
         rows = simulate(sim, d, "duty", ramp, duty)
-        m4 = ["--pole-pairs", "2", "--ls", "0.178039", "--sigma", "0.064463", "--from-rest", "no"]
+        m4 = ["--pole-pairs", "2", "--ls", "0.178039", "--sigma", "0.064463", "--ls-uncertainty", "0", "--sigma-uncertainty", "0", "--from-rest", "no"]
         case(replay, d, "duty", duty, rows, [1, 2, 3, 4], m4 + ["--voltage", "duty", "--dead-time", "2e-6"],
              "--u-delay -0.000125", "--pwm-timing last")
         # measured phase voltages: the paper's motor on an ideal V/f source (4 kHz), ramp to 60 Hz
@@ -104,7 +104,7 @@ def main():
                                           "--vll", "230", "--vf-boost", "10", "--load-on", "0",
                                           "--load-ramp", "3", "--load-nm", "1.5", "--duration", "24",
                                           "--no-thermal"], phase)
-        mp = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--from-rest", "no"]
+        mp = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--ls-uncertainty", "0", "--sigma-uncertainty", "0", "--from-rest", "no"]
         case(replay, d, "phase", phase, rows, [1, 2, 3], mp, "--u-delay -0.00025", "--u-delay 0.00025")
         # one operating point (the 4 kW drive steady at rated load): nothing to tell, no note
         rows = simulate(sim, d, "steady", ["--preset", "4kw", "--duration", "6"], duty)

@@ -21,7 +21,8 @@ const std::string kSim =
     "--preset 4kw --pole-pairs 2 --ls 0.2908 --lr 0.2908 --sigma 0.096 --rs 5.04 --tr 0.12 "
     "--j 1.2e-3 --b 1e-4 --i-range 6 --u-range 250 --no-thermal --start steady --vdc 340 "
     "--freq 60 --vll 230 --duration 4 --ideal-sensors --encoder-counts 16384 --no-progress";
-const std::string kReplay = " --pole-pairs 2 --ls 0.2908 --sigma 0.096 --from-rest no --u-delay 62.5e-6 ";
+const std::string kReplay = " --pole-pairs 2 --ls 0.2908 --sigma 0.096 --ls-uncertainty 0 "
+                            "--sigma-uncertainty 0 --from-rest no --u-delay 62.5e-6 ";
 
 struct Tally {
   int windows = 0, tr_valid = 0, tr_valid_wrong = 0, tr_uncertain = 0;
@@ -83,9 +84,10 @@ TEST(ReplayBounds, FarCentringStillFindsTheRoot)
       sim_csv("11kw_f80.csv", "--preset 11kw --no-thermal --start steady --vdc 560 --freq 40 "
                               "--vll 312 --load-nm 54 --duration 4 --encoder-counts 16384 "
                               "--no-progress");
-  const Out o =
-      run(std::string(REPLAY_BIN) + " --pole-pairs 2 --ls 0.078331 --sigma 0.05518 --from-rest no " +
-          "--u-delay 62.5e-6 " + csv);
+  const Out o = run(std::string(REPLAY_BIN) +
+                    " --pole-pairs 2 --ls 0.078331 --sigma 0.05518 --ls-uncertainty 0 --sigma-uncertainty 0 "
+                    "--from-rest no " +
+                    "--u-delay 62.5e-6 " + csv);
   ASSERT_EQ(o.code, 0) << o.err;
   const auto r = rows(o.out);
   const int tr = col(r, "T_R_s"), v = col(r, "tr_valid");
@@ -161,7 +163,9 @@ TEST(ReplayBounds, GainMismatchRefusesRsNotTr)
 {
   const std::string &csv =
       sim_csv("exp2_gain.csv", "--preset exp2 --duration 6 --supply vf --seed 5 --i-gain-err 0.02,0,0");
-  const Out o = run(std::string(REPLAY_BIN) + " --pole-pairs 2 --ls 0.2908 --sigma 0.096 " + csv);
+  const Out o =
+      run(std::string(REPLAY_BIN) +
+          " --pole-pairs 2 --ls 0.2908 --sigma 0.096 --ls-uncertainty 0 --sigma-uncertainty 0 " + csv);
   ASSERT_EQ(o.code, 0) << o.err;
   const auto r = rows(o.out);
   const int tr = col(r, "T_R_s"), tv = col(r, "tr_valid"), rv = col(r, "rs_valid"), why = col(r, "rs_reason");
@@ -187,7 +191,8 @@ const std::string kDuty22 =
     "--j 0.015 --b 9.7e-4 --i-range 18 --no-thermal --start steady --vdc 560 --duration 7 "
     "--encoder-counts 16384 --no-progress --v-switch 1 --r-switch 0.0727117 --v-diode 1 "
     "--r-diode 0.0727117 ";
-const std::string kDutyReplay = " --pole-pairs 2 --ls 0.245 --sigma 0.085714 --from-rest no --voltage duty ";
+const std::string kDutyReplay = " --pole-pairs 2 --ls 0.245 --sigma 0.085714 --ls-uncertainty 0 "
+                                "--sigma-uncertainty 0 --from-rest no --voltage duty ";
 
 struct DutyTally {
   int windows = 0, tr_valid = 0, tr_valid_off = 0, tr_uncertain = 0, combined_refused = 0;
@@ -276,7 +281,8 @@ const std::string kSine4kw =
     "--no-thermal --no-progress";
 const std::string kPwm4kw =
     "--preset 4kw --fs 4000 --carrier-hz 4000 --start steady --duration 5 --no-thermal --no-progress";
-const std::string kReplay4kw = " --pole-pairs 2 --ls 0.178039 --sigma 0.0645168 ";
+const std::string kReplay4kw =
+    " --pole-pairs 2 --ls 0.178039 --sigma 0.0645168 --ls-uncertainty 0 --sigma-uncertainty 0 ";
 const double kRs4kw = 1.405;
 
 struct RsTally {

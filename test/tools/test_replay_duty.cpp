@@ -13,7 +13,8 @@ using namespace tool_run;
 
 namespace {
 // The 4 kW preset's motor (sim/README.md, Presets): L_S = L_m + L_ls, sigma = 1 - L_m^2 / L_S^2.
-const std::string kMotor4kw = " --pole-pairs 2 --ls 0.178039 --sigma 0.0645168 ";
+const std::string kMotor4kw =
+    " --pole-pairs 2 --ls 0.178039 --sigma 0.0645168 --ls-uncertainty 0 --sigma-uncertainty 0 ";
 
 // 3 s steady at rated load, 50 Hz, 8 kHz, 12-bit sensors, 16384 counts.
 const std::string &ideal()

@@ -190,10 +190,11 @@ TEST(ReplayInput, OptionEqualsValueAndStdin)
 {
   const Out ref = replay(base(), "--window 1 --filter-hz 100");
   ASSERT_EQ(ref.code, 0) << ref.err;
-  const Out eq = run(std::string(REPLAY_BIN) +
-                     " --pole-pairs=2 --ls=0.2908 --sigma=0.096 --window=1 "
-                     "--filter-hz=100 " +
-                     base());
+  const Out eq =
+      run(std::string(REPLAY_BIN) +
+          " --pole-pairs=2 --ls=0.2908 --sigma=0.096 --ls-uncertainty=0 --sigma-uncertainty=0 --window=1 "
+          "--filter-hz=100 " +
+          base());
   EXPECT_EQ(eq.code, 0) << eq.err;
   EXPECT_EQ(eq.out, ref.out);
   const Out in = replay("- < " + base());
@@ -331,7 +332,7 @@ TEST(ReplayInput, ExtendedCanIdIsAccepted)
 // the cause, or every window is refused (wiring_mismatch for most).
 TEST(ReplayInput, WiringMistakesNeverGiveAValidWindow)
 {
-  const std::string m = " --pole-pairs 2 --ls 0.2908 --sigma 0.096 ";
+  const std::string m = " --pole-pairs 2 --ls 0.2908 --sigma 0.096 --ls-uncertainty 0 --sigma-uncertainty 0 ";
   struct Case {
     const char *name;
     std::function<bool(std::vector<std::string> &, long)> edit;
@@ -370,7 +371,7 @@ TEST(ReplayInput, WiringMistakesNeverGiveAValidWindow)
        },
        m},
       {"pole_pairs_1.csv", [](std::vector<std::string> &, long) { return true; },
-       " --pole-pairs 1 --ls 0.2908 --sigma 0.096 "},
+       " --pole-pairs 1 --ls 0.2908 --sigma 0.096 --ls-uncertainty 0 --sigma-uncertainty 0 "},
   };
   for (const Case &c : cases) {
     SCOPED_TRACE(c.name);
@@ -389,7 +390,9 @@ TEST(ReplayInput, WiringMistakesNeverGiveAValidWindow)
 TEST(ReplayInput, LsTenPercentHighIsConstantsMismatchGivenTheNominalRs)
 {
   const Out o =
-      run(std::string(REPLAY_BIN) + " --pole-pairs 2 --ls 0.3199 --sigma 0.096 --rs 5.04 " + base8());
+      run(std::string(REPLAY_BIN) +
+          " --pole-pairs 2 --ls 0.3199 --sigma 0.096 --ls-uncertainty 0 --sigma-uncertainty 0 --rs 5.04 " +
+          base8());
   EXPECT_EQ(o.code, 0) << o.err;
   EXPECT_EQ(tr_valid_windows(o), 0) << o.out;
   EXPECT_TRUE(has(o, "most are constants_mismatch")) << o.err;

@@ -16,7 +16,7 @@ import subprocess
 import sys
 import tempfile
 
-MOTOR = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096"]
+MOTOR = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--ls-uncertainty", "0", "--sigma-uncertainty", "0"]
 NAMES = ["t", "u_a", "u_b", "u_c", "i_a", "i_b", "i_c", "theta"]
 FAILS = []
 

@@ -31,7 +31,7 @@ def main():
         print(__doc__, file=sys.stderr)
         return 2
     replay, sim = sys.argv[1:3]
-    motor = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--quiet"]
+    motor = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--ls-uncertainty", "0", "--sigma-uncertainty", "0", "--quiet"]
     with tempfile.TemporaryDirectory() as d:
         rec = os.path.join(d, "sim.csv")
         subprocess.run([sim, "--preset", "exp2", "--duration", "20", "--supply", "vf", "--seed", "5",

@@ -57,7 +57,8 @@ inline std::string write(const std::string &name, const std::string &text)
   return p;
 }
 
-const std::string kMotor = " --pole-pairs 2 --ls 0.2908 --sigma 0.096 ";
+const std::string kMotor =
+    " --pole-pairs 2 --ls 0.2908 --sigma 0.096 --ls-uncertainty 0 --sigma-uncertainty 0 ";
 
 inline Out replay(const std::string &file, const std::string &extra = "")
 {

@@ -42,6 +42,8 @@ Scene paper_scene()
   sc.cfg.pole_pairs = 2;
   sc.cfg.ls_h = 0.2908f;
   sc.cfg.sigma = 0.096f;
+  sc.cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  sc.cfg.sigma_uncertainty = 0.0f;
   sc.cfg.fs_hz = 4000.0f;
   return sc;
 }
@@ -157,7 +159,7 @@ void set_gain_mismatch(Win &x, double mism)
 
 bool is_reason(int v)
 {
-  return v == IMEST_REASON_NONE || (v >= IMEST_REASON_WARMUP && v <= IMEST_REASON_TR_UNCERTAIN);
+  return v == IMEST_REASON_NONE || (v >= IMEST_REASON_WARMUP && v <= IMEST_REASON_CONSTANTS_UNCERTAIN);
 }
 
 // Runs the judge on the fixture (on a copy of its result; the instance keeps
@@ -821,6 +823,147 @@ TEST(Verdict, GainMismatchAgainstRsUncertain)
   EXPECT_VALID(judge(y));
   set_gain_mismatch(y, 0.51 * rs_b / z_over_rs);
   EXPECT_RS_REASON(judge(y), IMEST_REASON_RS_UNCERTAIN);
+}
+
+// The constants' stated uncertainty (ls_uncertainty, sigma_uncertainty) in the bounds.
+// The reference: the exact solution of the impedance equations. The window's Z is the
+// motor's (the fixture's constants are exact); were the motor's L_S (or sigma) k times the
+// configured one, the (T_R, R_S) that give the same Z with it are
+//   q = Im Z / (w_e L_S'), a'^2 = (1 - q) / (q - sigma'), T_R' = a' / w_s,
+//   R_S' = Re Z - w_e L_S' a' (1 - sigma') / (1 + a'^2),
+// and the estimate is off by |T_R' / T_R - 1| (relative to the estimate, as the bound is).
+namespace {
+struct Move {
+  double tr, rs;
+};
+Move exact_move(const Win &x, const Motor &m, double k_ls, double k_sg)
+{
+  const double ls = m.ls * k_ls, sg = m.sigma * k_sg;
+  const double q = x.z.imag() / (x.we * ls);
+  const double a = std::sqrt((1.0 - q) / (q - sg));
+  const double tr = a / x.ws, rs = x.z.real() - x.we * ls * a * (1.0 - sg) / (1.0 + a * a);
+  return {std::fabs(tr / m.tr - 1.0), std::fabs(rs / m.rs - 1.0)};
+}
+// the larger move of the two sides: configured = (1 + e) x the motor's, e = +-u
+Move worst_move(const Win &x, const Motor &m, double u_ls, double u_sg)
+{
+  Move w = {0.0, 0.0};
+  for (const double sgn : {1.0, -1.0}) {
+    const Move v = exact_move(x, m, 1.0 / (1.0 + sgn * u_ls), 1.0 / (1.0 + sgn * u_sg));
+    w.tr = std::fmax(w.tr, v.tr);
+    w.rs = std::fmax(w.rs, v.rs);
+  }
+  return w;
+}
+} // namespace
+
+// Each constant's share covers the exact move its stated uncertainty can cause, and is not
+// more than twice it: L_S 10 %, sigma 20 %, light to heavy load.
+TEST(Verdict, ConstantsShareCoversTheExactMove)
+{
+  for (const double a : {0.3, 0.6, 1.0, 2.0}) {
+    Scene sc = paper_scene();
+    sc.a = a;
+    Win x = build(sc);
+    const imest_result_t r0 = judge(x);
+    for (const int which : {0, 1}) {
+      Scene su = sc;
+      su.cfg.ls_uncertainty = which == 0 ? 0.1f : 0.0f;
+      su.cfg.sigma_uncertainty = which == 1 ? 0.2f : 0.0f;
+      Win y = build(su);
+      const imest_result_t r = judge(y);
+      const Move share = {r.tr_bound_rel - r0.tr_bound_rel, r.rs_bound_rel - r0.rs_bound_rel};
+      const Move m = worst_move(x, sc.m, su.cfg.ls_uncertainty, su.cfg.sigma_uncertainty);
+      EXPECT_GE(share.tr, m.tr) << "a " << a << (which ? " sigma" : " L_S");
+      EXPECT_LE(share.tr, 2.0 * m.tr) << "a " << a << (which ? " sigma" : " L_S");
+      EXPECT_GE(share.rs, m.rs) << "a " << a << (which ? " sigma" : " L_S");
+      EXPECT_LE(share.rs, 2.0 * m.rs) << "a " << a << (which ? " sigma" : " L_S");
+    }
+  }
+}
+
+// The two shares add (linear sum, not quadrature).
+TEST(Verdict, ConstantsSharesAdd)
+{
+  Scene sc = paper_scene();
+  const imest_result_t r0 = judge(sc);
+  sc.cfg.ls_uncertainty = 0.05f;
+  const imest_result_t rl = judge(sc);
+  sc.cfg.ls_uncertainty = 0.0f;
+  sc.cfg.sigma_uncertainty = 0.1f;
+  const imest_result_t rs = judge(sc);
+  sc.cfg.ls_uncertainty = 0.05f;
+  const imest_result_t rb = judge(sc);
+  EXPECT_NEAR(rb.tr_bound_rel - r0.tr_bound_rel,
+              (rl.tr_bound_rel - r0.tr_bound_rel) + (rs.tr_bound_rel - r0.tr_bound_rel), 1e-5);
+  EXPECT_NEAR(rb.rs_bound_rel - r0.rs_bound_rel,
+              (rl.rs_bound_rel - r0.rs_bound_rel) + (rs.rs_bound_rel - r0.rs_bound_rel), 1e-4);
+}
+
+// The defaults (a data sheet's L_S 10 %, sigma 20 %) refuse T_R at load: the constants alone
+// move it by more than tr_tolerance. With both 0 the verdict is today's.
+TEST(Verdict, DefaultConstantsUncertaintyRefusesTrAtLoad)
+{
+  Scene sc = paper_scene();
+  EXPECT_VALID(judge(sc));
+  imest_config_t d;
+  imest_config_default(&d);
+  sc.cfg.ls_uncertainty = d.ls_uncertainty;
+  sc.cfg.sigma_uncertainty = d.sigma_uncertainty;
+  for (const double a : {0.3, 0.6, 1.0}) {
+    sc.a = a;
+    const imest_result_t r = judge(sc);
+    EXPECT_TR_REASON(r, IMEST_REASON_CONSTANTS_UNCERTAIN);
+    EXPECT_GT(r.tr_bound_rel, 0.05) << a;
+  }
+}
+
+// T_R: constants_uncertain where the constants' share alone exceeds tr_tolerance,
+// tr_uncertain where only the total does.
+TEST(Verdict, ConstantsUncertainAgainstTrUncertain)
+{
+  Scene sc = paper_scene();
+  const double b0 = judge(sc).tr_bound_rel; // the other terms
+  sc.cfg.ls_uncertainty = 0.01f;
+  const double b = judge(sc).tr_bound_rel, share = b - b0;
+  ASSERT_GT(share, b0);
+  sc.cfg.tr_tolerance = (float)(0.99 * share);
+  EXPECT_TR_REASON(judge(sc), IMEST_REASON_CONSTANTS_UNCERTAIN);
+  sc.cfg.tr_tolerance = (float)(1.01 * share);
+  EXPECT_TR_REASON(judge(sc), IMEST_REASON_TR_UNCERTAIN);
+  sc.cfg.tr_tolerance = (float)(1.01 * b);
+  sc.cfg.rs_tolerance = 10.0f;
+  EXPECT_VALID(judge(sc));
+  // beyond pull-out T_R's bound is not judged, the constants' share neither
+  sc.f_hz = 60.0;
+  sc.cfg.tr_tolerance = 1.0e-6f;
+  sc.a = 1.01 / sc.m.sigma;
+  EXPECT_EQ(judge(sc).tr_reason, IMEST_REASON_NONE);
+}
+
+// R_S: after the gain mismatch, constants_uncertain where the constants' share alone exceeds
+// rs_tolerance (T_R valid), rs_uncertain where only the total does.
+TEST(Verdict, ConstantsUncertainForRsOnly)
+{
+  Scene sc = paper_scene();
+  const double b0 = judge(sc).rs_bound_rel;
+  sc.cfg.sigma_uncertainty = 0.02f;
+  const imest_result_t r1 = judge(sc);
+  const double share = r1.rs_bound_rel - b0;
+  ASSERT_EQ(r1.tr_valid, 1);
+  sc.cfg.rs_tolerance = (float)(0.99 * share);
+  imest_result_t r = judge(sc);
+  EXPECT_EQ(r.tr_valid, 1);
+  EXPECT_RS_REASON(r, IMEST_REASON_CONSTANTS_UNCERTAIN);
+  sc.cfg.rs_tolerance = (float)(1.01 * share);
+  EXPECT_RS_REASON(judge(sc), IMEST_REASON_RS_UNCERTAIN);
+  sc.cfg.rs_tolerance = (float)(1.01 * r1.rs_bound_rel);
+  EXPECT_VALID(judge(sc));
+  // a gain mismatch that takes most of the bound is named first
+  sc.cfg.rs_tolerance = (float)(0.99 * share);
+  Win y = build(sc);
+  set_gain_mismatch(y, 1.5 * r1.rs_bound_rel / (std::abs(y.z) / sc.m.rs));
+  EXPECT_RS_REASON(judge(y), IMEST_REASON_GAIN_MISMATCH);
 }
 
 TEST(Verdict, GainMismatchFlagBoundaryIsPointTwoPercent)

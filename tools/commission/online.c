@@ -36,6 +36,8 @@ int comm_online_run(const comm_sim_opts_t *o, double load_frac, double duration_
     cfg.pole_pairs = (unsigned int)sc.pole_pairs;
     cfg.ls_h = (float)sc.ls_h;
     cfg.sigma = (float)sc.sigma;
+    cfg.ls_uncertainty = 0.0f; /* exact */
+    cfg.sigma_uncertainty = 0.0f;
     cfg.tr_nominal_s = (float)sc.tr_s;
     cfg.inverter.dead_time_s = (float)sc.dead_time_s;
     cfg.inverter.v_switch_v = (float)sc.v_switch_v;

@@ -57,6 +57,8 @@ static int run_one(const comm_sens_opts_t *o, double ls_k, double sig_k, double 
   cfg.pole_pairs = (unsigned int)sc.pole_pairs;
   cfg.ls_h = (float)(sc.ls_h * ls_k);
   cfg.sigma = (float)(sc.sigma * sig_k);
+  cfg.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg.sigma_uncertainty = 0.0f;
   cfg.fs_hz = (float)sc.fs_hz;
   cfg.tr_nominal_s = (float)sc.tr_s;
   if (sc.supply == IMSIM_SUPPLY_PWM && !o->duty) cfg.u_delay_s = (float)(0.5 / sc.fs_hz); /* last period's */

@@ -6,7 +6,7 @@
 
 #define TWO_PI 6.283185307179586476925
 
-_Static_assert(IMEST_REASON_TR_UNCERTAIN < DRIVE_NSTATUS, "drive_t.by_status too small");
+_Static_assert(IMEST_REASON_CONSTANTS_UNCERTAIN < DRIVE_NSTATUS, "drive_t.by_status too small");
 
 void drive_init(drive_t *d, imest_t *est, drive_window_fn on_window, void *ctx)
 {
@@ -36,6 +36,7 @@ static int drain(drive_t *d)
     d->tr_valid += r.tr_valid ? 1 : 0;
     d->rs_valid += r.rs_valid ? 1 : 0;
     if (r.status >= 0 && r.status < DRIVE_NSTATUS) d->by_status[r.status]++;
+    d->tr_constants += r.tr_reason == IMEST_REASON_CONSTANTS_UNCERTAIN ? 1 : 0;
     if (d->on_window) d->on_window(d->ctx, &r);
     n++;
   }

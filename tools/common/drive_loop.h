@@ -22,7 +22,8 @@ typedef struct {
   long windows, valid;
   long tr_valid, rs_valid; /* windows whose T_R, R_S alone is valid */
   long by_status[DRIVE_NSTATUS];
-  int error; /* first negative return of imest_background(), 0 = none */
+  long tr_constants; /* windows whose T_R is constants_uncertain */
+  int error;         /* first negative return of imest_background(), 0 = none */
 } drive_t;
 
 void drive_init(drive_t *d, imest_t *est, drive_window_fn on_window, void *ctx);

@@ -285,8 +285,11 @@ static void est_config(const imsim_config_t *c, const demo_constants_t *k, imest
   cfg->pole_pairs = (unsigned int)c->pole_pairs; /* the paper's motor: 2, 0.2908 H, 0.096, 4 kHz */
   cfg->ls_h = (float)c->ls_h;
   cfg->sigma = (float)c->sigma;
+  cfg->ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg->sigma_uncertainty = 0.0f;
   cfg->fs_hz = (float)c->fs_hz;
   if (k != NULL && k->commissioned) {
+    /* and the uncertainty commissioning states for L_S and sigma */
     /* n_p, L_S, sigma, the nominal R_S and T_R as identified; its inverter model is for the
        duty-cycle input, which these runs (measured phase voltages) do not use */
     const float fs = cfg->fs_hz;
@@ -519,6 +522,8 @@ static int duty_setup(job_t *j, const char *dir, imsim_config_t *c, imest_config
   cfg_true->pole_pairs = (unsigned int)c->pole_pairs;
   cfg_true->ls_h = (float)c->ls_h;
   cfg_true->sigma = (float)c->sigma;
+  cfg_true->ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  cfg_true->sigma_uncertainty = 0.0f;
   cfg_true->tr_nominal_s = (float)c->tr_s;
   cfg_true->rs_nominal_ohm = (float)c->rs_ohm;
   cfg_true->inverter.dead_time_s = (float)c->dead_time_s;

@@ -319,6 +319,10 @@ static void summary(const drive_t *d, const replay_scan_t *s, const imest_config
   if (what)
     fprintf(stderr, "%s: no window is valid, most are %s: %s (docs/feeding-logs.md)\n", k_prog,
             imest_reason_name(most), what);
+  /* T_R refused for the constants' stated uncertainty in most windows: say what to do */
+  if (2 * d->tr_constants > d->windows && !(what && most == IMEST_REASON_CONSTANTS_UNCERTAIN))
+    fprintf(stderr, "%s: T_R is constants_uncertain in %ld of %ld windows: %s (docs/feeding-logs.md)\n",
+            k_prog, d->tr_constants, d->windows, replay_remedy(IMEST_REASON_CONSTANTS_UNCERTAIN));
 }
 
 /* --require-valid: TOOL_EXIT_NOT_VALID when no window has the column asked for at 1. */

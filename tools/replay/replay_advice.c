@@ -145,6 +145,11 @@ const char *replay_remedy(int status)
            "load, or a smaller error (shorter dead time, lower drops), gives valid windows. "
            "With measured voltages from a PWM faster than the samples give its rate with "
            "--pwm-hz; from a sine source or a filtered channel, --voltage-kind smooth";
+  case IMEST_REASON_CONSTANTS_UNCERTAIN:
+    return "the stated uncertainty of the motor constants alone (--ls-uncertainty, default "
+           "0.1, and --sigma-uncertainty, default 0.2: data-sheet values) moves T_R or R_S by "
+           "more than their tolerance: commission the motor and give its constants with the "
+           "uncertainty it states, or state how well --ls and --sigma are known";
   case IMEST_REASON_GAIN_MISMATCH:
     return "the three current sensors' gains differ by more than R_S tolerates: calibrate them";
   default: return NULL;

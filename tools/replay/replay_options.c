@@ -36,6 +36,11 @@ static void usage(FILE *o)
              "  --pole-pairs N      pole pairs n_p\n"
              "  --ls H              stator inductance L_S [H]\n"
              "  --sigma X           total leakage factor (0 < sigma < 1)\n"
+             "  --ls-uncertainty X  largest relative error of --ls (default 0.1: a data\n"
+             "                      sheet's; 0 = exact, e.g. a simulator's own constants);\n"
+             "                      what it can move T_R and R_S by is in their error bounds\n"
+             "  --sigma-uncertainty X  the same for --sigma (default 0.2). Commissioned\n"
+             "                      constants: what imest-commission states (imest_comm_apply)\n"
              "time base:\n"
              "  --fs HZ             sample rate; t then only orders the rows and may be in any\n"
              "                      unit (ms, a sample index) or too coarse (default: from t,\n"
@@ -185,6 +190,8 @@ static const struct {
     {"--max-pe-k2", "max_pe_k2_rel", offsetof(imest_config_t, max_pe_k2_rel), FOR_ANY},
     {"--ls", "ls_h", offsetof(imest_config_t, ls_h), FOR_ANY},
     {"--sigma", "sigma", offsetof(imest_config_t, sigma), FOR_ANY},
+    {"--ls-uncertainty", "ls_uncertainty", offsetof(imest_config_t, ls_uncertainty), FOR_ANY},
+    {"--sigma-uncertainty", "sigma_uncertainty", offsetof(imest_config_t, sigma_uncertainty), FOR_ANY},
     {"--angle-observer-hz", "angle_observer_hz", offsetof(imest_config_t, angle_observer_hz), FOR_ANY},
     {"--rs", "rs_nominal_ohm", offsetof(imest_config_t, rs_nominal_ohm), FOR_ANY},
     {"--rs-tolerance", "rs_tolerance", offsetof(imest_config_t, rs_tolerance), FOR_ANY},

@@ -151,11 +151,21 @@ static float voltage_uncertainty(const imest_t *s, const imest_window_t *w, cons
  *   to 0.45 times what the in-phase term (4/pi) dV / I would move it taken in
  *   quadrature (largest at 25 % load, where dZ/dT_R is small). The bound
  *   takes 0.5 times it, in Im Z.
+ * - the constants' stated uncertainty (ls_uncertainty, sigma_uncertainty):
+ *   the fit matches the measured Z with the configured L_S and sigma, so an
+ *   error of theirs moves T_R and R_S (imest__bg_constants_shift, first
+ *   order: within 25 % of the exact move for L_S, 3 % for sigma), taken at
+ *   e = u (1 + u) / (1 - u) of the stated u (imest_init.c: the motor's value
+ *   up to u / (1 - u) away, and the second order). |move| for
+ *   L_S plus |move| for sigma, not in quadrature: commissioning's sigma is
+ *   sigma L_S / L_S, its two errors are correlated. *c_tr_rel, *c_rs_rel:
+ *   this share alone (the reason constants_uncertain); it is also in the
+ *   totals *tr_rel, *rs_rel.
  * dv_v: the voltage uncertainty [V] (negative: unknown); harm_v: the
  * uncertainty whose harmonics T_R sees (duty input; 0 otherwise). */
 static void systematic_bounds(const imest_t *s, const imest_window_t *w, const op_point_t *op,
                               float slip_rate, float tr, float rs, float dv_v, float harm_v, float *tr_rel,
-                              float *rs_rel)
+                              float *rs_rel, float *c_tr_rel, float *c_rs_rel)
 {
   const float we = op->we, ls = s->ls_h, sg = s->sigma;
   bg_impedance_t z;
@@ -169,9 +179,19 @@ static void systematic_bounds(const imest_t *s, const imest_window_t *w, const o
   const float harm = 0.5f * FOUR_OVER_PI_F * harm_v / op->i_pk;
   const float dzi = fabsf(we) * tau * fabsf(zr) + eps * fabsf(zr * zr - zi * zi) + harm;
   const float dt = fabsf(di) > 0.0f ? dzi / fabsf(di) : INFINITY;
-  *tr_rel = dt / tr;
+  /* L_S's move, then sigma's (one copy of the shift in the code) */
+  *c_tr_rel = 0.0f;
+  *c_rs_rel = 0.0f;
+  for (int k = 0; k < 2; ++k) {
+    float t, r;
+    imest__bg_constants_shift(&z, sg, k == 0 ? s->ls_shift_e : 0.0f, k == 0 ? 0.0f : s->sigma_shift_e, tr, rs,
+                              &t, &r);
+    *c_tr_rel += fabsf(t);
+    *c_rs_rel += fabsf(r);
+  }
+  *tr_rel = dt / tr + *c_tr_rel;
   const float dr_volt = dv_v < 0.0f ? INFINITY : FOUR_OVER_PI_F * dv_v / op->i_pk;
-  *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs;
+  *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs + *c_rs_rel;
 }
 
 /* The current sensors' gain mismatch from the zero sequence (three sensors:
@@ -234,6 +254,11 @@ typedef struct {
   op_point_t op;
   int steady;
   float tr_b, rs_b, g_b; /* T_R's and R_S's systematic bounds, the gain mismatch's share */
+  float c_tr, c_rs;      /* the constants' share of tr_b and rs_b (in them) */
+  /* The bounds are steady-state figures: T_R's is judged only below the
+   * pull-out slip (a sigma < 1), where a drive runs steadily; beyond it the
+   * window is a transient (a run-up) whose dynamics determine T_R. */
+  int tr_judged;
 } judge_t;
 
 static inline int input_fault(judge_t *j)
@@ -345,18 +370,26 @@ static inline int not_finite(judge_t *j)
 {
   return !(isfinite(j->r->tr_s) && isfinite(j->r->rs_ohm) && isfinite(j->r->e_i));
 }
-/* tr_tolerance. The bounds are steady-state figures: T_R's is judged only
- * below the pull-out slip (a sigma < 1), where a drive runs steadily; beyond
- * it the window is a transient (a run-up) whose dynamics determine T_R. */
+/* tr_tolerance, ls_uncertainty, sigma_uncertainty: the constants' share alone
+ * (judged where T_R's bound is: j->tr_judged) */
+static inline int tr_constants_uncertain(judge_t *j)
+{
+  return j->tr_judged && !(j->c_tr <= j->s->tr_tolerance);
+}
+/* tr_tolerance */
 static inline int tr_uncertain(judge_t *j)
 {
-  const float a_slip = (float)j->st->slip_rate * (float)j->r->tr_s * j->s->sigma;
-  return a_slip < 1.0f && !(j->tr_b <= j->s->tr_tolerance);
+  return j->tr_judged && !(j->tr_b <= j->s->tr_tolerance);
 }
 /* rs_tolerance: the current sensors' gain mismatch takes most of R_S's bound */
 static inline int rs_gain_mismatch(judge_t *j)
 {
   return !(j->rs_b + j->g_b <= j->s->rs_tolerance) && j->g_b > j->rs_b;
+}
+/* rs_tolerance, ls_uncertainty, sigma_uncertainty: the constants' share alone */
+static inline int rs_constants_uncertain(judge_t *j)
+{
+  return !(j->c_rs <= j->s->rs_tolerance);
 }
 /* rs_tolerance */
 static inline int rs_uncertain(judge_t *j)
@@ -388,11 +421,13 @@ static inline int rs_uncertain(judge_t *j)
   X(IMEST_REASON_CONSTANTS_MISMATCH, rs_off_nominal)                                                         \
   X(IMEST_REASON_CONSTANTS_MISMATCH, tr_off_nominal)                                                         \
   X(IMEST_REASON_NUMERIC, not_finite)                                                                        \
+  X(IMEST_REASON_CONSTANTS_UNCERTAIN, tr_constants_uncertain)                                                \
   X(IMEST_REASON_TR_UNCERTAIN, tr_uncertain)
 
 /* R_S's own checks, once T_R's verdict is valid. */
 #define RS_CHECKS(X)                                                                                         \
   X(IMEST_REASON_GAIN_MISMATCH, rs_gain_mismatch)                                                            \
+  X(IMEST_REASON_CONSTANTS_UNCERTAIN, rs_constants_uncertain)                                                \
   X(IMEST_REASON_RS_UNCERTAIN, rs_uncertain)
 
 #define RETURN_IF_FAILS(reason, fails)                                                                       \
@@ -414,7 +449,8 @@ static int rs_verdict(judge_t *j)
  * model's harmonics) and R_S's: the voltage's uncertainty (the inverter
  * model's, or none known), the timing's, the staircase's, the current
  * sensors' gain mismatch (|E| |Z| / R_S, measured: the paper motor, 1 %
- * between two sensors, R_S -3.5 %). Infinite without an estimate (have: the
+ * between two sensors, R_S -3.5 %); both with the constants' share
+ * (ls_uncertainty, sigma_uncertainty). Infinite without an estimate (have: the
  * solve gave a positive, finite T_R). */
 static void bounds(judge_t *j, const bg_sums_t *sm, int have)
 {
@@ -424,12 +460,14 @@ static void bounds(judge_t *j, const bg_sums_t *sm, int have)
   j->tr_b = INFINITY;
   j->rs_b = INFINITY;
   j->g_b = 0.0f;
+  j->c_tr = 0.0f; /* without an estimate the total's INFINITY says tr_uncertain */
+  j->c_rs = 0.0f;
   if (have && isfinite(r->rs_ohm) && r->rs_ohm > 0.0) {
     const float rs = (float)r->rs_ohm;
     float harm_v;
     const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &harm_v);
     systematic_bounds(j->s, j->w, &j->op, (float)j->st->slip_rate, (float)r->tr_s, rs, dv_v, harm_v, &j->tr_b,
-                      &j->rs_b);
+                      &j->rs_b, &j->c_tr, &j->c_rs);
     j->g_b = mism * j->op.z_ohm / rs;
     r->tr_bound_rel = (double)j->tr_b;
     r->rs_bound_rel = (double)(j->rs_b + j->g_b);
@@ -464,6 +502,7 @@ void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_
   r->ls_noload_h = (double)NAN; /* the no-load check fills it where it runs */
   bounds(&j, sm, have);
   flux_bounds(&j, fx);
+  j.tr_judged = (float)st->slip_rate * (float)r->tr_s * s->sigma < 1.0f;
   const int status = tr_verdict(&j);
   const int rs_status = status != IMEST_REASON_NONE ? status : rs_verdict(&j);
   r->tr_reason = status;

@@ -27,6 +27,8 @@ int main(void)
   c.pole_pairs = 2;
   c.ls_h = 0.29f;
   c.sigma = 0.1f;
+  c.ls_uncertainty = 0.0f; /* the simulator's own constants: exact */
+  c.sigma_uncertainty = 0.0f;
   static imest_t s;
   const int rc = imest_init(&s, &c);
 

@@ -13,7 +13,7 @@ sim=$build/bin/imest-sim
 rep=$build/bin/imest-replay
 [ -x "$sim" ] && [ -x "$rep" ] || { echo "build first: cmake --build $build --target imest-sim imest-replay" >&2; exit 2; }
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-motor="--pole-pairs 2 --ls 0.2908 --sigma 0.096"
+motor="--pole-pairs 2 --ls 0.2908 --sigma 0.096 --ls-uncertainty 0 --sigma-uncertainty 0"  # exact
 printf '| recording | windows | valid | invalid (reasons) | T_R error %% valid: mean / max abs | R_S error %% valid: mean / max abs |\n|---|---|---|---|---|---|\n'
 run() { # name, sim args, replay args
   local name=$1 sargs=$2 rargs=${3:-}

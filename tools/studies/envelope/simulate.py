@@ -57,12 +57,23 @@ def inverter_flags(inv):
             "--r-diode", f"{inv['r_diode']:.6g}"]
 
 
+def constants_uncertainty(p):
+    """--ls-uncertainty, --sigma-uncertainty: 0 for the simulator's own constants (exact); for
+    commissioned ones what imest_comm_apply() states for a rotating commissioning
+    (imest_commission.h: its floors, 0.2 % and 0.5 %; motors.commissioning reports no fit quality
+    or spread that would raise them)."""
+    if p.get("consts"):
+        return ["--ls-uncertainty", "0.002", "--sigma-uncertainty", "0.005"]
+    return ["--ls-uncertainty", "0", "--sigma-uncertainty", "0"]
+
+
 def replay_args(p, extra=()):
     """The estimator's options: the motor's constants (with `consts` in the point, the
-    commissioned ones of motors.commissioning, with R_S and T_R nominal), the input."""
+    commissioned ones of motors.commissioning, with R_S and T_R nominal), how well they are
+    known (constants_uncertainty), the input."""
     c = p.get("consts") or motors.constants(motor_of(p))
     a = ["--pole-pairs", str(c["np"]), "--ls", f"{c['ls']:.7g}", "--sigma", f"{c['sigma']:.7g}",
-         "--from-rest", "no", "--quiet"]
+         "--from-rest", "no", "--quiet"] + constants_uncertainty(p)
     if p.get("consts"):
         a += ["--rs", f"{c['rs']:.7g}", "--tr-nominal", f"{c['tr']:.7g}"]
     if p["input"] == "phase":

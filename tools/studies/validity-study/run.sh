@@ -22,9 +22,10 @@ fi
 rm -rf "$OUT/cases" "$OUT/tmp"
 mkdir -p "$OUT"
 
-M1="--pole-pairs 2 --ls 0.2908 --sigma 0.096"               # paper motor (sim default)
+EXACT="--ls-uncertainty 0 --sigma-uncertainty 0"            # the simulator's own constants
+M1="--pole-pairs 2 --ls 0.2908 --sigma 0.096 $EXACT"        # paper motor (sim default)
 M2S="--pole-pairs 4 --ls 0.05 --lr 0.05 --rs 0.5 --tr 0.3"  # second motor (sigma 0.096)
-M2R="--pole-pairs 4 --ls 0.05 --sigma 0.096"
+M2R="--pole-pairs 4 --ls 0.05 --sigma 0.096 $EXACT"
 RATED=2.064
 
 cases() {
