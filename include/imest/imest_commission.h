@@ -324,8 +324,15 @@ typedef struct {
   float slip;               /**< slip of the rotating run (no load: ~1e-4) */
   float neg_seq_rel;        /**< |negative-sequence current| / |positive|, rotating (wiring check) */
   float rotating_r_ohm;     /**< resistive part of the impedance rotating (R_S + losses) [ohm] */
-  float rotating_i_a;       /**< magnetising current of the rotating run (alpha/beta amplitude) [A] */
+  float rotating_i_a;       /**< magnetising current at rated flux (alpha/beta amplitude) [A] */
   float rotating_f_hz;      /**< electrical frequency of the rotating run [Hz] */
+  /** the magnetising curve (rotating; 0 points otherwise): L_S at no load against the
+   *  magnetising current, in increasing current: 0.7 and 0.85 of rotating_i_a, the rated point
+   *  (= ls_h) and, if the first level ran above 1.05 rotating_i_a, that level. 2 to 4 points */
+  unsigned int ls_curve_points;
+  float ls_curve_i_a[4];  /**< magnetising current of each point (alpha/beta amplitude) [A] */
+  float ls_curve_h[4];    /**< L_S at that current [H] */
+  float ls_curve_std_rel; /**< relative standard error of each point (the largest) */
 } imest_comm_result_t;
 
 /** Progress, readable from any context. */
