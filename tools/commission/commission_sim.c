@@ -94,8 +94,10 @@ int comm_sim_true_at(const imsim_config_t *sc, double i_a, double *ls_h, double 
     for (int it = 0; it < 200; ++it) {
       const double psi = 0.5 * (lo + hi), q = psi / p.psi_n_wb;
       const double im = psi / p.lm0_h * (1.0 + p.sat_a * q * q * q * q * q * q);
-      if (im > i_a) hi = psi;
-      else lo = psi;
+      if (im > i_a)
+        hi = psi;
+      else
+        lo = psi;
     }
     lm = 0.5 * (lo + hi) / i_a;
   } else if (p.lm0_h > 0.0) {
@@ -119,8 +121,10 @@ double comm_sim_current_at_flux(const imsim_config_t *sc, double psi_wb)
     const double i = 0.5 * (lo + hi);
     double ls = sc->ls_h;
     (void)comm_sim_true_at(sc, i, &ls, NULL, NULL);
-    if (ls * i > psi_wb) hi = i;
-    else lo = i;
+    if (ls * i > psi_wb)
+      hi = i;
+    else
+      lo = i;
   }
   return 0.5 * (lo + hi);
 }

@@ -92,77 +92,70 @@ static double slip_corrected(double lx, double x, double sl)
   return ls;
 }
 
-/* The rated point from the search levels 0..ns-1: the current i* where L_S(i) i = psi and L_S
-   there, interpolated (linearly in the current) between the two levels nearest psi in flux; with
-   one level, the fixed-point step i = psi / L_S from it (it was within 1 %). Within the current
-   limit: there the flux stays below psi. Also the rated point's uncertainty: the interpolation's
-   correction to the nearest level, at least the measurement's 0.1 %. */
-static void rated_point(imest_comm_t *c, uint32_t ns, double psi, double *i_out, double *ls_out, double *std_out)
+/* The levels' arithmetic is float32 (a few ratios of values measured to 0.1 %; float64 would
+   cost the M4F's soft-double calls in flash). */
+static float absf(float x)
 {
-  const imest_comm_block_t *lv = c->blk;
-  uint32_t a = 0u, b = 0u;
-  double da = 1e30, db = 1e30;
-  for (uint32_t k = 0u; k < ns; ++k) {
-    const double d = fabs((double)lv[k].s[CM_LV_LS] * (double)lv[k].s[CM_LV_I] - psi);
-    if (d < da) {
-      b = a;
-      db = da;
-      a = k;
-      da = d;
-    } else if (d < db) {
-      b = k;
-      db = d;
-    }
-  }
-  const double ia = (double)lv[a].s[CM_LV_I], la = (double)lv[a].s[CM_LV_LS];
-  const double ib = (double)lv[b].s[CM_LV_I], lb = (double)lv[b].s[CM_LV_LS];
-  const double pa = ia * la, pb = ib * lb;
-  /* two levels whose flux increases with the current: L_S linear in the current between them */
-  const int two = ns >= 2u && fabs(ib - ia) > 1e-6 * ia && (pb - pa) / (ib - ia) > 0.0;
-  double is = psi / la;
-  if (two) {
+  return x < 0.0f ? -x : x;
+}
+
+/* The rated point from the search levels 0..ns-1: the current i* where L_S(i) i = psi and L_S
+   there, interpolated (linearly in the current) between the last two levels (the search's
+   nearest to psi); with one level, the fixed-point step i = psi / L_S from it (it was within
+   1 %). Within the current limit: there the flux stays below psi. Into st[CM_LB_I], st[CM_LB_LS]
+   and st[CM_LB_STD], the rated point's uncertainty: the interpolation's correction to the last
+   level, at least the measurement's 0.1 %. */
+static void rated_point(imest_comm_t *c, uint32_t ns, float psi, float *st)
+{
+  const float *a = c->blk[ns - 1u].s, *b = c->blk[ns >= 2u ? ns - 2u : 0u].s;
+  const float ia = a[CM_LV_I], la = a[CM_LV_LS], ib = b[CM_LV_I], lb = b[CM_LV_LS];
+  const float pa = ia * la, pb = ib * lb;
+  float is = psi / la, ls = la;
+  /* two levels whose flux increases with the current: L_S linear in the current between them,
+     no further than half their distance beyond them */
+  if (absf(ib - ia) > 1e-6f * ia && (pb - pa) / (ib - ia) > 0.0f) {
+    const float h = 0.5f * absf(ib - ia);
+    const float lo = (ia < ib ? ia : ib) - h, hi = (ia < ib ? ib : ia) + h;
     is = ia + (psi - pa) * (ib - ia) / (pb - pa);
-    /* no extrapolation beyond half the levels' distance */
-    const double lo = fmin(ia, ib) - 0.5 * fabs(ib - ia), hi = fmax(ia, ib) + 0.5 * fabs(ib - ia);
     is = is < lo ? lo : (is > hi ? hi : is);
+    if (is > c->psi_im) is = c->psi_im;
+    ls = la + (is - ia) * (lb - la) / (ib - ia);
+  } else if (is > c->psi_im) {
+    is = c->psi_im;
   }
-  if (is > (double)c->psi_im) is = (double)c->psi_im;
-  const double ls = two ? la + (is - ia) * (lb - la) / (ib - ia) : la;
-  *i_out = is;
-  *ls_out = ls;
-  const double corr = fabs(ls - la) / ls;
-  *std_out = corr > 1e-3 ? corr : 1e-3;
+  const float corr = absf(ls - la) / ls;
+  st[CM_LB_I] = is;
+  st[CM_LB_LS] = ls;
+  st[CM_LB_STD] = corr > 1e-3f ? corr : 1e-3f;
 }
 
 /* The next level's current after level k (0: the run is complete): the search's fixed-point or
    secant step, or the curve's lower levels once the rated point is known. */
-static double next_level(imest_comm_t *c, uint32_t k)
+static float next_level(imest_comm_t *c, uint32_t k)
 {
-  imest_comm_block_t *lv = c->blk;
+  const imest_comm_block_t *lv = c->blk;
   float *st = c->blk[CM_ROT_LEVELS].s;
   const uint32_t ns = (uint32_t)st[CM_LB_NSEARCH];
-  const double psi = (double)c->psi, i_lim = (double)c->psi_im;
-  if (k > ns) return 0.0; /* the second curve level: done */
-  if (k == ns && st[CM_LB_I] > 0.0f && ns > 0u) return 0.7 * (double)st[CM_LB_I];
+  const float psi = c->psi, i_lim = c->psi_im;
+  if (k > ns) return 0.0f; /* the second curve level: done */
+  if (k == ns && st[CM_LB_I] > 0.0f && ns > 0u) return 0.7f * st[CM_LB_I];
   /* a search level */
-  const double ik = (double)lv[k].s[CM_LV_I], lk = (double)lv[k].s[CM_LV_LS];
-  double in = psi / lk;
+  const float ik = lv[k].s[CM_LV_I], lk = lv[k].s[CM_LV_LS];
+  float in = psi / lk;
   if (k > 0u) {
-    const double ip = (double)lv[k - 1u].s[CM_LV_I], lp = (double)lv[k - 1u].s[CM_LV_LS];
-    const double slope = (ik * lk - ip * lp) / (ik - ip);
-    if (fabs(ik - ip) > 1e-6 * ik && slope > 0.0) in = ik + (psi - ik * lk) / slope;
+    const float ip = lv[k - 1u].s[CM_LV_I], lp = lv[k - 1u].s[CM_LV_LS];
+    if (absf(ik - ip) > 1e-6f * ik) {
+      const float slope = (ik * lk - ip * lp) / (ik - ip);
+      if (slope > 0.0f) in = ik + (psi - ik * lk) / slope;
+    }
   }
-  in = in < 0.5 * ik ? 0.5 * ik : (in > 1.5 * ik ? 1.5 * ik : in);
+  in = in < 0.5f * ik ? 0.5f * ik : (in > 1.5f * ik ? 1.5f * ik : in);
   if (in > i_lim) in = i_lim;
   st[CM_LB_NSEARCH] = (float)(k + 1u);
-  const int at_limit = ik >= 0.999 * i_lim && in >= 0.999 * i_lim;
-  if (fabs(in - ik) < 0.01 * ik || at_limit || k + 1u >= CM_ROT_SEARCH) {
-    double is = 0.0, ls = 0.0, sd = 0.0;
-    rated_point(c, k + 1u, psi, &is, &ls, &sd);
-    st[CM_LB_I] = (float)is;
-    st[CM_LB_LS] = (float)ls;
-    st[CM_LB_STD] = (float)sd;
-    return 0.85 * is;
+  const int at_limit = ik >= 0.999f * i_lim && in >= 0.999f * i_lim;
+  if (absf(in - ik) < 0.01f * ik || at_limit || k + 1u >= CM_ROT_SEARCH) {
+    rated_point(c, k + 1u, psi, st);
+    return 0.85f * st[CM_LB_I];
   }
   return in;
 }
@@ -176,23 +169,21 @@ static int report(imest_comm_t *c, uint32_t last)
   const imest_comm_block_t *lv = c->blk;
   const float *st = c->blk[CM_ROT_LEVELS].s;
   const uint32_t ns = (uint32_t)st[CM_LB_NSEARCH];
-  const double ls = (double)st[CM_LB_LS], is = (double)st[CM_LB_I], sl = (double)r->sigma_ls_h.value;
-  /* the curve */
+  const float ls = st[CM_LB_LS], is = st[CM_LB_I], sl = r->sigma_ls_h.value, sd = st[CM_LB_STD];
+  /* the curve: the two lower levels (measured last), the rated point, the top level */
   unsigned int n = 0u;
   for (uint32_t k = last; k >= ns && k < CM_ROT_LEVELS && n < 2u; --k) {
     r->ls_curve_i_a[n] = lv[k].s[CM_LV_I];
     r->ls_curve_h[n] = lv[k].s[CM_LV_LS];
     n++;
   }
-  r->ls_curve_i_a[n] = (float)is;
-  r->ls_curve_h[n] = (float)ls;
+  r->ls_curve_i_a[n] = is;
+  r->ls_curve_h[n] = ls;
   n++;
-  uint32_t top = 0u, nearest = 0u;
-  for (uint32_t k = 0u; k < ns; ++k) {
+  uint32_t top = 0u;
+  for (uint32_t k = 1u; k < ns; ++k)
     if (lv[k].s[CM_LV_I] > lv[top].s[CM_LV_I]) top = k;
-    if (fabs((double)lv[k].s[CM_LV_I] - is) < fabs((double)lv[nearest].s[CM_LV_I] - is)) nearest = k;
-  }
-  if ((double)lv[top].s[CM_LV_I] > 1.05 * is) {
+  if (lv[top].s[CM_LV_I] > 1.05f * is) {
     r->ls_curve_i_a[n] = lv[top].s[CM_LV_I];
     r->ls_curve_h[n] = lv[top].s[CM_LV_LS];
     n++;
@@ -203,28 +194,27 @@ static int report(imest_comm_t *c, uint32_t last)
     if (r->ls_curve_h[j] < lo) lo = r->ls_curve_h[j];
     if (r->ls_curve_h[j] > hi) hi = r->ls_curve_h[j];
   }
-  const double dep = (double)(hi - lo) / ls; /* L_S's change over the curve: its flux dependence */
-  const double sd = (double)st[CM_LB_STD];
-  r->ls_curve_std_rel = (float)sd;
-  r->rotating_i_a = (float)is;
-  r->rotating_r_ohm = lv[nearest].s[CM_LV_ZR];
-  r->ls_h.value = (float)ls;
-  r->ls_h.std_rel = (float)sd;
-  r->ls_h.spread_rel = (float)dep;
-  r->sigma.value = (float)(sl / ls);
+  const float dep = (hi - lo) / ls; /* L_S's change over the curve: its flux dependence */
+  r->ls_curve_std_rel = sd;
+  r->rotating_i_a = is;
+  r->rotating_r_ohm = lv[ns - 1u].s[CM_LV_ZR]; /* the level nearest rated flux */
+  r->ls_h.value = ls;
+  r->ls_h.std_rel = sd;
+  r->ls_h.spread_rel = dep;
+  r->sigma.value = sl / ls;
   {
-    const double s1 = (double)r->sigma_ls_h.std_rel, s2 = (double)r->sigma_ls_h.spread_rel;
-    r->sigma.std_rel = (float)sqrt(s1 * s1 + sd * sd);
-    r->sigma.spread_rel = (float)(s2 > dep ? s2 : dep);
+    const float s1 = r->sigma_ls_h.std_rel, s2 = r->sigma_ls_h.spread_rel;
+    r->sigma.std_rel = s1 + sd; /* at most sqrt(2) x their root sum of squares */
+    r->sigma.spread_rel = s2 > dep ? s2 : dep;
   }
   /* T_R is the standstill flux tails' (at the staircase's currents): on a saturating motor the
      standstill L_S differs from the rated-flux one, and T_R at rated flux by a similar share */
   {
-    const double ls_ss = (double)r->ls_standstill_h.value, d = fabs(ls - ls_ss) / ls;
-    if (ls_ss > 0.0 && !(r->tr_s.spread_rel >= (float)d)) r->tr_s.spread_rel = (float)d;
+    const float ls_ss = r->ls_standstill_h.value, d = absf(ls - ls_ss) / ls;
+    if (ls_ss > 0.0f && !(r->tr_s.spread_rel >= d)) r->tr_s.spread_rel = d;
   }
   r->flags |= IMEST_COMM_FLAG_ROTATED;
-  if (!(ls > 0.0 && ls < 100.0 && sl < ls)) return IMEST_COMM_REASON_IMPLAUSIBLE;
+  if (!(ls > 0.0f && ls < 100.0f && sl < ls)) return IMEST_COMM_REASON_IMPLAUSIBLE;
   return IMEST_COMM_REASON_NONE;
 }
 
@@ -283,9 +273,9 @@ void imest__cm_fit_rotation(imest_comm_t *c)
   lv->s[CM_LV_I] = r->rotating_i_a;
   lv->s[CM_LV_LS] = (float)slip_corrected(lx, x, sl);
   lv->s[CM_LV_ZR] = (float)zr;
-  const double in = next_level(c, level);
-  if (in > 0.0) {
-    *next = (float)in;
+  const float in = next_level(c, level);
+  if (in > 0.0f) {
+    *next = in;
     return;
   }
   fail = report(c, level);

@@ -81,6 +81,29 @@ static float leg_error(const imest_comm_t *c, float i, float d, float vdc)
   return s * (c->inv_td_f * vdc + c->inv_v + c->inv_rd * ai + dc * (c->inv_rsw - c->inv_rd) * ai);
 }
 
+/* A level measured: it holds until the background has set the next level's current from this
+   one's L_S (0: it was the last); then that level settles, or the run ramps down. 1 if the run
+   stopped, 0 if the field control runs. */
+static inline int next_level(imest_comm_t *c)
+{
+  if (!imest__cm_job_done(c)) {
+    if (c->cnt <= (uint32_t)(10.0f * c->cfg.fs_hz)) return 0;
+    imest__cm_fail(c, IMEST_COMM_REASON_BACKGROUND);
+    return 1;
+  }
+  c->cnt = 0u;
+  const float next = c->blk[CM_ROT_LEVELS].s[CM_LB_NEXT];
+  if (next > 0.0f) {
+    c->i_ref = next;
+    c->plateau++;
+    c->step = CM_ROT_SETTLE;
+    for (int j = 0; j < 10; ++j) c->rot_sum[j] = 0.0f;
+  } else {
+    c->step = CM_ROT_DOWN;
+  }
+  return 0;
+}
+
 /* The run's steps (magnetise, ramp, settle, measure, down, stop): their counters and
    transitions. 1 if the sample is done (the duties set or the run stopped), 0 if the field
    control runs. (static inline, as the helpers below: one call each, inlined into the stage.) */
@@ -122,25 +145,7 @@ static inline int rotate_steps(imest_comm_t *c, int limited, float ia, float vdc
     }
     break;
   case CM_ROT_MEASURE: break;
-  case CM_ROT_NEXT:
-    /* the background sets the next level's current from this one's L_S (0: the last) */
-    if (!imest__cm_job_done(c)) {
-      if (c->cnt > (uint32_t)(10.0f * c->cfg.fs_hz)) {
-        imest__cm_fail(c, IMEST_COMM_REASON_BACKGROUND);
-        return 1;
-      }
-      break;
-    }
-    c->cnt = 0u;
-    if (c->blk[CM_ROT_LEVELS].s[CM_LB_NEXT] > 0.0f) {
-      c->i_ref = c->blk[CM_ROT_LEVELS].s[CM_LB_NEXT];
-      c->plateau++;
-      c->step = CM_ROT_SETTLE;
-      for (int j = 0; j < 10; ++j) c->rot_sum[j] = 0.0f;
-    } else {
-      c->step = CM_ROT_DOWN;
-    }
-    break;
+  case CM_ROT_NEXT: return next_level(c);
   case CM_ROT_DOWN:
     c->we = c->we_test * (1.0f - (float)c->cnt / (float)c->n_ramp);
     if (c->cnt >= c->n_ramp) {
