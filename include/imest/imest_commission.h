@@ -330,9 +330,8 @@ typedef struct {
    *  magnetising current, in increasing current: 0.7 and 0.85 of rotating_i_a, the rated point
    *  (= ls_h) and, if the first level ran above 1.05 rotating_i_a, that level. 2 to 4 points */
   unsigned int ls_curve_points;
-  float ls_curve_i_a[4];  /**< magnetising current of each point (alpha/beta amplitude) [A] */
-  float ls_curve_h[4];    /**< L_S at that current [H] */
-  float ls_curve_std_rel; /**< relative standard error of each point (the largest) */
+  float ls_curve_i_a[4]; /**< magnetising current of each point (alpha/beta amplitude) [A] */
+  float ls_curve_h[4];   /**< L_S at that current [H] (each point's uncertainty: ls_h.std_rel) */
 } imest_comm_result_t;
 
 /** Progress, readable from any context. */
@@ -400,8 +399,8 @@ typedef struct {
   uint32_t pulse_n, pulse_tries, pulse_nk[3];
   imest_comm_block_t cur; /* block being accumulated */
   /* rotation */
-  float we, we_test, psi, psi_im, ls_ss, rs_ff, ph_c, ph_s, if_d, if_q;
-  float rot_sum[10]; /* I_sync d/q, I_neg d/q, U d/q, |i|^2, n, w_e, samples limited */
+  float we, we_test, psi, psi_im, ls_ss, rs_ff, ph_c, ph_s;
+  float rot_sum[9]; /* I_sync d/q, I_neg d/q, U d/q, |i|^2, n, w_e */
   float rot_th0, rot_th1;
   int32_t rot_w0, rot_wraps;
   float inv_td_f, inv_v, inv_rsw, inv_rd, inv_band; /* inverter feed-forward model */

@@ -140,7 +140,6 @@ int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
   c->res.rotating_i_a = nanf_;
   c->res.rotating_f_hz = nanf_;
   c->res.ls_curve_points = 0u;
-  c->res.ls_curve_std_rel = nanf_;
   for (int x = 0; x < 4; ++x) c->res.ls_curve_i_a[x] = c->res.ls_curve_h[x] = nanf_;
   c->res.dc_fit_rms_v = nanf_;
   for (int x = 0; x < 3; ++x) c->res.rs_axis_ohm[x] = nanf_;

@@ -68,7 +68,7 @@ enum { CM_LV_I = 0, CM_LV_LS, CM_LV_ZR };
 enum { CM_LB_NEXT = 0, CM_LB_NSEARCH, CM_LB_I, CM_LB_LS, CM_LB_STD };
 
 /* rot_sum[] */
-enum { CM_R_ID = 0, CM_R_IQ, CM_R_ND, CM_R_NQ, CM_R_UD, CM_R_UQ, CM_R_I2, CM_R_N, CM_R_WE, CM_R_LIM };
+enum { CM_R_ID = 0, CM_R_IQ, CM_R_ND, CM_R_NQ, CM_R_UD, CM_R_UQ, CM_R_I2, CM_R_N, CM_R_WE, CM_R_COUNT };
 
 /* Level of plateau p as a fraction of the top (1/3, 2/3, 1, 2/3, 1/3). */
 static inline float cm_level(uint32_t p)

@@ -400,7 +400,7 @@ int main(int argc, char **argv)
     }
     printf("\n    points' uncertainty %.2g %%; L_S over the curve %.2g %% (its flux dependence); rated flux "
            "at %.4f A (true %.4f A)",
-           100.0 * (double)r->ls_curve_std_rel, 100.0 * (double)r->ls_h.spread_rel, (double)r->rotating_i_a,
+           100.0 * (double)r->ls_h.std_rel, 100.0 * (double)r->ls_h.spread_rel, (double)r->rotating_i_a,
            out.i_rated_flux_a);
   }
   printf(

@@ -195,7 +195,6 @@ static int report(imest_comm_t *c, uint32_t last)
     if (r->ls_curve_h[j] > hi) hi = r->ls_curve_h[j];
   }
   const float dep = (hi - lo) / ls; /* L_S's change over the curve: its flux dependence */
-  r->ls_curve_std_rel = sd;
   r->rotating_i_a = is;
   r->rotating_r_ohm = lv[ns - 1u].s[CM_LV_ZR]; /* the level nearest rated flux */
   r->ls_h.value = ls;

@@ -48,9 +48,8 @@ void imest__cm_rotate_begin(imest_comm_t *c)
   c->plateau = 0u; /* the level */
   c->ph_c = 1.0f;
   c->ph_s = 0.0f;
-  c->if_d = c->if_q = 0.0f;
   c->lim_cnt = 0u;
-  for (int j = 0; j < 10; ++j) c->rot_sum[j] = 0.0f;
+  for (int j = 0; j < CM_R_COUNT; ++j) c->rot_sum[j] = 0.0f;
   c->blk[CM_ROT_LEVELS].s[CM_LB_NSEARCH] = 0.0f;
   c->blk[CM_ROT_LEVELS].s[CM_LB_I] = 0.0f;
   /* measure over whole electrical periods, at least 1 s */
@@ -97,7 +96,7 @@ static inline int next_level(imest_comm_t *c)
     c->i_ref = next;
     c->plateau++;
     c->step = CM_ROT_SETTLE;
-    for (int j = 0; j < 10; ++j) c->rot_sum[j] = 0.0f;
+    for (int j = 0; j < CM_R_COUNT; ++j) c->rot_sum[j] = 0.0f;
   } else {
     c->step = CM_ROT_DOWN;
   }
@@ -239,7 +238,6 @@ void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
   float ia, ib;
   imest__clarke(m, &ia, &ib);
   if (rotate_steps(c, limited, ia, vdc)) return;
-  if (limited && c->step == CM_ROT_MEASURE) c->rot_sum[CM_R_LIM] += 1.0f;
   advance_field(c, ts);
 
   /* current in the field frame, its control (the rated magnetising current on d; ramping down,
