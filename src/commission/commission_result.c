@@ -45,5 +45,9 @@ int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)
     cfg->inverter = r->inverter;
     n++;
   }
+  /* The magnetising curve (r->ls_curve_points, ls_curve_i_a, ls_curve_h) is for the estimator's
+     config fields of the same names (L_S followed with the flux); imest_config_t does not have
+     them yet. When it does: copy the three here when r->ls_curve_points > 0 and count one field
+     (the header's "filled" list and count with it). */
   return n;
 }
