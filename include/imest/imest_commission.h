@@ -156,8 +156,10 @@
  * static, inductance): tr_s.spread_rel is at least the standstill L_S's departure from the
  * rated-flux one (41 % and 53 % on these motors), and T_R at rated flux may be off by as much.
  * A double-cage rotor's sigma*L_S at the square wave's fs/8 is its outer cage's leakage, not
- * the leakage at slip frequency the estimator needs (sigma -44 % on the 4 kW real motor): no
- * figure of the result shows it; give sigma from the data sheet for such a rotor.
+ * the leakage at slip frequency the estimator needs (sigma -44 % on the 4 kW real motor): the
+ * square wave's resistance shows such a rotor (IMEST_COMM_FLAG_ROTOR_HF: 6 to 37 x R_R' on the
+ * simulator's double cages, at most 2.2 x on its single cages, saturating or not), and
+ * imest_comm_apply then leaves sigma to the data sheet.
  *
  * Limits: the current never exceeds i_max_a in any phase (the routine stops with
  * IMEST_COMM_REASON_OVERCURRENT if it does: the firmware's own protection stays in charge); the
@@ -307,6 +309,12 @@ const char *imest_comm_state_name(int state);
 /** dead time and threshold voltages not separable (the clamped patterns' pulses were too short):
  *  the whole error is in dead_time_s */
 #define IMEST_COMM_FLAG_INVERTER_LUMPED 0x1000u
+/** the rotor's resistance at the square wave's frequency (fs/8) is over 3 x R_R' from the flux
+ *  tails: deep bars or a double cage. Its sigma*L_S there (the one measured) is below the one at
+ *  slip frequency the estimator needs (44 % below on the simulator's double cages), so
+ *  sigma_ls_h.spread_rel is at least 0.5 and imest_comm_apply does not fill sigma: give it from
+ *  the data sheet (its equivalent circuit at rated slip) */
+#define IMEST_COMM_FLAG_ROTOR_HF        0x2000u
 
 /** One identified value with its quality. */
 typedef struct {
@@ -511,7 +519,8 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r);
 
 /**
  * Fill an estimator config from a result: pole_pairs, ls_h, sigma, rs_nominal_ohm, tr_nominal_s
- * and inverter (with i_band_a and uncertainty) - each only if the result holds it. The sample
+ * and inverter (with i_band_a and uncertainty) - each only if the result holds it (sigma not with
+ * IMEST_COMM_FLAG_ROTOR_HF: the config's stays, and imest_config_check() names it if unset). The sample
  * rate, window and the other fields stay as they are; set pwm_hz to the carrier.
  * @return the number of fields filled (0..6), or
  * @retval IMEST_ERR_NULL  a pointer is NULL

@@ -34,9 +34,12 @@ int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)
     n++;
   }
   cfg->ls_h = r->ls_h.value;
-  cfg->sigma = r->sigma.value;
   cfg->rs_nominal_ohm = r->rs_ohm.value;
-  n += 3;
+  n += 2;
+  if (!(r->flags & IMEST_COMM_FLAG_ROTOR_HF)) { /* else its sigma is the high-frequency one */
+    cfg->sigma = r->sigma.value;
+    n++;
+  }
   if (isfinite(r->tr_s.value) && r->tr_s.value > 0.0f) {
     cfg->tr_nominal_s = r->tr_s.value;
     n++;

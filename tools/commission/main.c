@@ -328,7 +328,9 @@ int main(int argc, char **argv)
   if (fabs(out.ls_preset_h - out.ls_h) > 1e-9 * out.ls_h)
     printf("  %-26s %s %.5g mH (the preset's, at rated load's main flux)\n", "",
            "true values at the rated V/f flux at no load; L_S", 1e3 * out.ls_preset_h);
-  row("sigma", 1.0, (double)r->sigma.value, out.sigma, NULL);
+  row("sigma", 1.0, (double)r->sigma.value, out.sigma,
+      (r->flags & IMEST_COMM_FLAG_ROTOR_HF) ? "rotor_hf: sigma*L_S at fs/8 is the rotor's high-frequency one"
+                                            : NULL);
   row("T_R [ms]", 1e3, (double)r->tr_s.value, out.tr_s, "flux tails");
   row("R_R' [ohm]", 1.0, (double)r->rr_ohm.value, out.rr_ohm, "(1-sigma) L_S / T_R");
   {
