@@ -71,14 +71,22 @@
  *      Clamped legs do not switch, so they lose no dead time and conduct one device type only.
  *      Then, at 1/3 level, a square-wave voltage (fs/8) on top of the DC current (0.2 s): the
  *      current's slope gives sigma*L_S. Then zero current until the rotor flux has decayed.
- *   5. With cc.allow_rotation only: a current-fed rotating field at the rated magnetising
- *      current (rated V/f flux with the standstill L_S), the identified inverter model as
- *      feed-forward: magnetise on the a axis (1 s + 3 T_R), ramp to speed_frac of rated
- *      frequency (ramp_s), settle (1 s + 3 T_R), measure (>= 1 s, whole electrical periods),
- *      ramp down. (A voltage-fed V/f run oscillates at no load on a low-inertia motor.)
+ *   5. With cc.allow_rotation only: a current-fed rotating field at no load, the identified
+ *      inverter model as feed-forward: magnetise on the a axis (1 s + 3 T_R), ramp to
+ *      speed_frac of rated frequency (ramp_s), then levels of magnetising current, each settled
+ *      (1 s + 3 T_R) and measured (>= 1 s, whole electrical periods); ramp down. The first level
+ *      is the rated V/f flux's current with the standstill L_S (within 80 % of the staircase's
+ *      top); each measured level's L_S sets the next (the background computes it while the ISR
+ *      holds the level): the search for the current i* at which the no-load stator flux
+ *      L_S(i) i is psi = V_rated / w_rated (at most 4 levels, until a step changes the current
+ *      by < 1 %), then 0.85 i* and 0.7 i* for the magnetising curve. On a linear motor the first
+ *      level is i* (3 levels in all); on a saturating one, whose standstill L_S is about half
+ *      the rated-flux one, 4 to 6. (A voltage-fed V/f run oscillates at no load on a
+ *      low-inertia motor.)
  *   The routine ends with zero voltage; its ISR call then returns 0 and the background call
  *   completes the result. Measured totals: 8.4 s at standstill for a 4 kW motor (T_R 128 ms),
- *   30 s for 37 kW (T_R 553 ms), plus 8 to 10.5 s of rotation (README, Commissioning).
+ *   30 s for 37 kW (T_R 553 ms), plus 12.5 to 18 s of rotation (19 s for the 4 kW motor with
+ *   saturation, 24 s for 11 kW; README, Commissioning).
  *
  * What is measured, and how (per axis, then combined; the spread between the three axes is
  * reported as a quality figure for each quantity):
@@ -106,7 +114,13 @@
  *     the shaft may not turn).
  *   - L_S (rotating): reactive part of the impedance at the field's frequency, from the commanded
  *     voltage (the inverter error compensated by its model) and the current, demodulated at the
- *     commanded angle; at no load the slip is ~1e-4, and is corrected for.
+ *     commanded angle; at no load the slip is ~1e-4, and is corrected for. Reported at the rated
+ *     V/f flux: interpolated (linearly in the current) between the search's last two levels to
+ *     the current where L_S i = psi; the flux a drive runs at in its base speed range, where
+ *     the estimator needs L_S (a saturating motor's L_m there is 15-25 % below unsaturated).
+ *     If the current limit stops the search below psi, at that limit (the flux is then lower).
+ *   - the magnetising curve (ls_curve_*): L_S at 0.7 i*, 0.85 i*, i* and at the first level if it
+ *     ran above 1.05 i*, each measured as L_S; its spread is L_S's flux dependence.
  *   - n_p, encoder direction and counts: the ratio of the commanded electrical frequency to the
  *     measured mechanical speed is dir * n_p * cpr_assumed / cpr_true. With cc.rated_speed_rpm,
  *     n_p = floor(60 f_rated / n_rated) (the nameplate is the only independent evidence: a
@@ -125,6 +139,28 @@
  * within 0.25 %, T_R within 0.2 %, dead time within 2 ns, the inverter's per-leg voltage error
  * within 0.1 V where the switch and diode thresholds differ by 0.2 V (the part standstill cannot
  * see; the rest of the model is right to a few mV).
+ *
+ * On a saturating motor (the simulator's static magnetising curve, `imest-commission --saturation
+ * 0.25`, and its real motor with iron loss and a double cage, `--real-motor`), against the truth
+ * at the rated V/f flux at no load, before (the rotating run at the standstill L_S's current)
+ * and with the levels:
+ *
+ *     motor                 L_S before / now     sigma before / now    T_R (standstill)
+ *     4 kW, saturation 0.25  -10.5 % / +0.12 %   +11.9 % / -0.02 %     -20.0 %
+ *     4 kW, real motor       -10.5 % / +0.38 %   -37.6 % / -44.4 %     -19.9 %
+ *     11 kW, saturation 0.25 -19.0 % / +0.21 %   +23.3 % / -0.31 %     -30.0 %
+ *     11 kW, real motor      -18.6 % / +0.43 %   -29.6 % / -43.0 %     -30.0 %
+ *
+ * and the curve's points within 0.4 % of the truth at their currents (0.5 % on the linear
+ * motors; L_S there unchanged). What the levels do not fix, and the result says so: T_R comes from the
+ * standstill flux tails, which on a saturating motor run at other currents (incremental, not
+ * static, inductance): tr_s.spread_rel is at least the standstill L_S's departure from the
+ * rated-flux one (41 % and 53 % on these motors), and T_R at rated flux may be off by as much.
+ * A double-cage rotor's sigma*L_S at the square wave's fs/8 is its outer cage's leakage, not
+ * the leakage at slip frequency the estimator needs (sigma -44 % on the 4 kW real motor): the
+ * square wave's resistance shows such a rotor (IMEST_COMM_FLAG_ROTOR_HF: 6 to 37 x R_R' on the
+ * simulator's double cages, at most 2.2 x on its single cages, saturating or not), and
+ * imest_comm_apply then leaves sigma to the data sheet.
  *
  * Limits: the current never exceeds i_max_a in any phase (the routine stops with
  * IMEST_COMM_REASON_OVERCURRENT if it does: the firmware's own protection stays in charge); the
@@ -274,12 +310,20 @@ const char *imest_comm_state_name(int state);
 /** dead time and threshold voltages not separable (the clamped patterns' pulses were too short):
  *  the whole error is in dead_time_s */
 #define IMEST_COMM_FLAG_INVERTER_LUMPED 0x1000u
+/** the rotor's resistance at the square wave's frequency (fs/8) is over 3 x R_R' from the flux
+ *  tails: deep bars or a double cage. Its sigma*L_S there (the one measured) is below the one at
+ *  slip frequency the estimator needs (44 % below on the simulator's double cages), so
+ *  sigma_ls_h.spread_rel is at least 0.5 and imest_comm_apply does not fill sigma: give it from
+ *  the data sheet (its equivalent circuit at rated slip) */
+#define IMEST_COMM_FLAG_ROTOR_HF        0x2000u
 
 /** One identified value with its quality. */
 typedef struct {
-  float value;      /**< the estimate (NaN if not identified) */
-  float std_rel;    /**< relative standard error from the fit's residuals (NaN if not known) */
-  float spread_rel; /**< (max - min) / mean over the three axes (NaN if not per axis) */
+  float value;   /**< the estimate (NaN if not identified) */
+  float std_rel; /**< relative standard error from the fit's residuals (NaN if not known) */
+  /** (max - min) / mean over the three axes (NaN if not per axis); for ls_h, sigma and tr_s
+   *  after the rotating run, the flux dependence: see each */
+  float spread_rel;
 } imest_comm_value_t;
 
 /** Result of a run. Every quantity carries its quality; `valid` says whether the result as a
@@ -302,10 +346,13 @@ typedef struct {
   int wiring_map[3];
 
   /* standstill */
-  imest_comm_value_t rs_ohm;          /**< stator resistance (incl. min(r_sw, r_d), minus r_series_ohm) */
-  float rs_axis_ohm[3];               /**< R_S per axis (gain corrected) */
-  imest_comm_value_t sigma_ls_h;      /**< transient inductance sigma*L_S [H] */
-  imest_comm_value_t tr_s;            /**< rotor time constant from the flux tails [s] */
+  imest_comm_value_t rs_ohm;     /**< stator resistance (incl. min(r_sw, r_d), minus r_series_ohm) */
+  float rs_axis_ohm[3];          /**< R_S per axis (gain corrected) */
+  imest_comm_value_t sigma_ls_h; /**< transient inductance sigma*L_S [H] */
+  /** rotor time constant from the flux tails [s] (at the staircase's currents; after the rotating
+   *  run spread_rel is at least |L_S - L_S standstill| / L_S: on a saturating motor T_R at rated
+   *  flux differs from the standstill one by up to that) */
+  imest_comm_value_t tr_s;
   imest_comm_value_t rr_ohm;          /**< rotor resistance referred to the stator, (1-sigma)L_S/T_R [ohm] */
   imest_comm_value_t ls_standstill_h; /**< L_S from the standstill flux tails [H] */
   imest_inverter_t inverter;          /**< the inverter's voltage error model (incl. i_band_a, uncertainty) */
@@ -316,17 +363,30 @@ typedef struct {
   float rotor_moved_rad;              /**< largest angle change during the standstill part [rad] */
 
   /* rotating */
-  imest_comm_value_t ls_h;  /**< stator inductance L_S [H] (rotating; else standstill) */
-  imest_comm_value_t sigma; /**< total leakage factor sigma_L_S / L_S */
-  unsigned int pole_pairs;  /**< n_p (0 if not identified) */
-  int encoder_dir;          /**< +1: the angle increases with the a-b-c field; -1: reversed; 0: unknown */
-  float encoder_cpr;        /**< true counts per revolution (NaN if encoder_cpr not given) */
-  float speed_ratio;        /**< commanded electrical / measured mechanical speed (signed) */
-  float slip;               /**< slip of the rotating run (no load: ~1e-4) */
-  float neg_seq_rel;        /**< |negative-sequence current| / |positive|, rotating (wiring check) */
-  float rotating_r_ohm;     /**< resistive part of the impedance rotating (R_S + losses) [ohm] */
-  float rotating_i_a;       /**< magnetising current of the rotating run (alpha/beta amplitude) [A] */
-  float rotating_f_hz;      /**< electrical frequency of the rotating run [Hz] */
+  /** stator inductance L_S [H]: rotating, at the rated V/f flux (else standstill). std_rel: the
+   *  interpolation's correction to the nearest level, at least 0.1 % (the rotating measurement's
+   *  repeatability); spread_rel: (max - min) / L_S over the magnetising curve, L_S's flux
+   *  dependence (below 0.5 % on a linear motor, 30-40 % on a saturating one) */
+  imest_comm_value_t ls_h;
+  /** total leakage factor sigma_L_S / L_S at rated flux. std_rel: sigma_ls_h's plus ls_h's;
+   *  spread_rel: the larger of sigma_ls_h's and ls_h's (sigma follows L_S with the flux) */
+  imest_comm_value_t sigma;
+  unsigned int pole_pairs; /**< n_p (0 if not identified) */
+  int encoder_dir;         /**< +1: the angle increases with the a-b-c field; -1: reversed; 0: unknown */
+  float encoder_cpr;       /**< true counts per revolution (NaN if encoder_cpr not given) */
+  float speed_ratio;       /**< commanded electrical / measured mechanical speed (signed) */
+  float slip;              /**< slip of the rotating run (no load: ~1e-4) */
+  float neg_seq_rel;       /**< |negative-sequence current| / |positive|, rotating (wiring check) */
+  /** resistive part of the impedance rotating (R_S + losses), at the level nearest rated flux [ohm] */
+  float rotating_r_ohm;
+  float rotating_i_a;  /**< magnetising current at rated flux (alpha/beta amplitude) [A] */
+  float rotating_f_hz; /**< electrical frequency of the rotating run [Hz] */
+  /** the magnetising curve (rotating; 0 points otherwise): L_S at no load against the
+   *  magnetising current, in increasing current: 0.7 and 0.85 of rotating_i_a, the rated point
+   *  (= ls_h) and, if the first level ran above 1.05 rotating_i_a, that level. 2 to 4 points */
+  unsigned int ls_curve_points;
+  float ls_curve_i_a[4]; /**< magnetising current of each point (alpha/beta amplitude) [A] */
+  float ls_curve_h[4];   /**< L_S at that current [H] (each point's uncertainty: ls_h.std_rel) */
 } imest_comm_result_t;
 
 /** Progress, readable from any context. */
@@ -394,8 +454,8 @@ typedef struct {
   uint32_t pulse_n, pulse_tries, pulse_nk[3];
   imest_comm_block_t cur; /* block being accumulated */
   /* rotation */
-  float we, we_test, psi, psi_im, ls_ss, rs_ff, ph_c, ph_s, if_d, if_q;
-  float rot_sum[10]; /* I_sync d/q, I_neg d/q, U d/q, |i|^2, n, w_e, samples limited */
+  float we, we_test, psi, psi_im, ls_ss, rs_ff, ph_c, ph_s;
+  float rot_sum[9]; /* I_sync d/q, I_neg d/q, U d/q, |i|^2, n, w_e */
   float rot_th0, rot_th1;
   int32_t rot_w0, rot_wraps;
   float inv_td_f, inv_v, inv_rsw, inv_rd, inv_band; /* inverter feed-forward model */
@@ -474,8 +534,11 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r);
  *  linear simulator) 1 % and 2 %, the limits the standstill test holds. Each at most
  *  IMEST_COMM_UNCERTAINTY_MAX. What these cost: on the 4 kW motor at rated load T_R's bound
  *  gains about 0.3 % and R_S's about 3 % (R_S is small against the impedance there). A motor
- *  whose L_S depends on its flux (saturation) is not covered by the floors: the stated figure is
- *  then as good as the spread between the standstill and the rotating L_S shows. */
+ *  whose L_S depends on its flux (saturation): ls_h's and sigma's spread_rel hold their change
+ *  over the magnetising curve (32-40 % on the saturating simulated motors), so without the curve
+ *  in the config T_R is refused (constants_uncertain) rather than wrong; with the curve in the
+ *  config (imest_comm_apply() copies it) the estimator takes L_S at each window's flux, and q()
+ *  of ls_h and sigma is their 3 standard errors only. */
 #define IMEST_COMM_LS_FLOOR               0.002f
 #define IMEST_COMM_SIGMA_FLOOR            0.005f
 #define IMEST_COMM_LS_FLOOR_STANDSTILL    0.01f
@@ -484,10 +547,15 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r);
 
 /**
  * Fill an estimator config from a result: pole_pairs, ls_h, sigma, rs_nominal_ohm, tr_nominal_s
- * and inverter (with i_band_a and uncertainty) - each only if the result holds it - and, with
- * ls_h and sigma, ls_uncertainty and sigma_uncertainty by the rule above. The sample rate,
- * window and the other fields stay as they are; set pwm_hz to the carrier.
- * @return the number of constants filled (0..6: the uncertainties are not counted), or
+ * and inverter (with i_band_a and uncertainty) - each only if the result holds it (sigma not with
+ * IMEST_COMM_FLAG_ROTOR_HF: the config's stays, with its stated sigma_uncertainty, and
+ * imest_config_check() names it if unset) - and, with ls_h and sigma, ls_uncertainty and
+ * sigma_uncertainty by the rule above; the magnetising curve (ls_curve_points, ls_curve_i_a,
+ * ls_curve_h) when the result has 2 or more points and the build follows L_S with the flux
+ * (not with IMEST_WITH_FLUX=0). The sample rate, window and the other fields stay as they are;
+ * set pwm_hz to the carrier.
+ * @return the number of fields filled (0..7: the curve counts as one, the uncertainties are not
+ *         counted), or
  * @retval IMEST_ERR_NULL  a pointer is NULL
  * @retval IMEST_ERR_ARG   the result is not valid (r->valid == 0): nothing filled
  */

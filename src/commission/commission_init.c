@@ -139,6 +139,8 @@ int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
   c->res.rotating_r_ohm = nanf_;
   c->res.rotating_i_a = nanf_;
   c->res.rotating_f_hz = nanf_;
+  c->res.ls_curve_points = 0u;
+  for (int x = 0; x < 4; ++x) c->res.ls_curve_i_a[x] = c->res.ls_curve_h[x] = nanf_;
   c->res.dc_fit_rms_v = nanf_;
   for (int x = 0; x < 3; ++x) c->res.rs_axis_ohm[x] = nanf_;
   c->res.inverter.uncertainty = -1.0f;
@@ -174,7 +176,15 @@ int imest_comm_status(const imest_comm_t *c, imest_comm_status_t *st)
   case IMEST_COMM_STAGE_STAIRCASE: p = 0.08f + per_axis * ((float)c->axis + in_axis); break;
   case IMEST_COMM_STAGE_PULSES:
   case IMEST_COMM_STAGE_DEMAGNETISE: p = 0.08f + per_axis * ((float)c->axis + 0.9f); break;
-  case IMEST_COMM_STAGE_ROTATE: p = ss + (0.98f - ss) * (float)c->step / 5.0f; break;
+  case IMEST_COMM_STAGE_ROTATE: {
+    /* magnetise, ramp, the levels (settle, measure, next), down, stop */
+    const float lv = c->plateau < CM_ROT_LEVELS ? (float)c->plateau : (float)(CM_ROT_LEVELS - 1u);
+    const float s = (c->step == CM_ROT_SETTLE || c->step == CM_ROT_MEASURE || c->step == CM_ROT_NEXT)
+                        ? 2.0f + 2.0f * (lv + 0.5f) / (float)CM_ROT_LEVELS
+                        : (float)c->step;
+    p = ss + (0.98f - ss) * s / 5.0f;
+    break;
+  }
   case IMEST_COMM_STAGE_END:
   default: p = c->state == IMEST_COMM_DONE ? 1.0f : 0.99f; break;
   }

@@ -53,11 +53,22 @@ enum {
   CM_ROT_SETTLE = 2u,
   CM_ROT_MEASURE = 3u,
   CM_ROT_DOWN = 4u,
-  CM_ROT_STOP = 5u
+  CM_ROT_STOP = 5u,
+  CM_ROT_NEXT = 6u /* a level measured: hold it until the background has set the next one */
 };
 
+/* Levels of the rotating run (commission_rotate.c, commission_fit_rotation.c): up to
+   CM_ROT_SEARCH levels searching the current that gives the rated flux, then the curve's two
+   lower levels. The blocks are free while the field turns (the standstill fits are done before it
+   starts): blk[level].s[] holds each level's figures (background), blk[CM_ROT_LEVELS].s[] the
+   search's state and the next level's current the background sets for the ISR (0: done). */
+#define CM_ROT_SEARCH 4u
+#define CM_ROT_LEVELS (CM_ROT_SEARCH + 2u)
+enum { CM_LV_I = 0, CM_LV_LS, CM_LV_ZR };
+enum { CM_LB_NEXT = 0, CM_LB_NSEARCH, CM_LB_I, CM_LB_LS, CM_LB_STD };
+
 /* rot_sum[] */
-enum { CM_R_ID = 0, CM_R_IQ, CM_R_ND, CM_R_NQ, CM_R_UD, CM_R_UQ, CM_R_I2, CM_R_N, CM_R_WE, CM_R_LIM };
+enum { CM_R_ID = 0, CM_R_IQ, CM_R_ND, CM_R_NQ, CM_R_UD, CM_R_UQ, CM_R_I2, CM_R_N, CM_R_WE, CM_R_COUNT };
 
 /* Level of plateau p as a fraction of the top (1/3, 2/3, 1, 2/3, 1/3). */
 static inline float cm_level(uint32_t p)

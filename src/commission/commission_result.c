@@ -5,6 +5,7 @@
 #include <stddef.h>
 
 #include "commission_internal.h"
+#include "estimator/window/bg_flux.h" /* IMEST_WITH_FLUX */
 
 int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r)
 {
@@ -33,16 +34,29 @@ static float quality_rel(const imest_comm_value_t *v)
   return fmaxf(s, p);
 }
 
-/* The rule imest_commission.h states for ls_uncertainty and sigma_uncertainty. */
-static void constants_uncertainty(const imest_comm_result_t *r, imest_config_t *cfg)
+/* 3 standard errors (NaN: not known, 0). */
+static float std3_rel(const imest_comm_value_t *v)
+{
+  return isfinite(v->std_rel) ? 3.0f * v->std_rel : 0.0f;
+}
+
+/* The rule imest_commission.h states for ls_uncertainty and sigma_uncertainty.
+ * curve: the magnetising curve goes to the config, so the estimator takes L_S
+ * (and sigma with it) at each window's flux, and their change over the curve
+ * (ls_h's, sigma's spread_rel) is no longer an error of what it uses. A
+ * high-frequency sigma (IMEST_COMM_FLAG_ROTOR_HF) is not filled: the config's
+ * sigma and its stated uncertainty stay. */
+static void constants_uncertainty(const imest_comm_result_t *r, int curve, imest_config_t *cfg)
 {
   const int standstill = (r->flags & IMEST_COMM_FLAG_LS_STANDSTILL) != 0u;
-  const float u_ls =
-      fmaxf(standstill ? IMEST_COMM_LS_FLOOR_STANDSTILL : IMEST_COMM_LS_FLOOR,
-            fmaxf(quality_rel(&r->ls_h), standstill ? quality_rel(&r->ls_standstill_h) : 0.0f));
-  const float u_sg = fmaxf(standstill ? IMEST_COMM_SIGMA_FLOOR_STANDSTILL : IMEST_COMM_SIGMA_FLOOR,
-                           fmaxf(quality_rel(&r->sigma), quality_rel(&r->sigma_ls_h) + u_ls));
+  const float q_ls = curve ? std3_rel(&r->ls_h) : quality_rel(&r->ls_h);
+  const float u_ls = fmaxf(standstill ? IMEST_COMM_LS_FLOOR_STANDSTILL : IMEST_COMM_LS_FLOOR,
+                           fmaxf(q_ls, standstill ? quality_rel(&r->ls_standstill_h) : 0.0f));
   cfg->ls_uncertainty = fminf(u_ls, IMEST_COMM_UNCERTAINTY_MAX);
+  if (r->flags & IMEST_COMM_FLAG_ROTOR_HF) return;
+  const float q_sg = curve ? std3_rel(&r->sigma) : quality_rel(&r->sigma);
+  const float u_sg = fmaxf(standstill ? IMEST_COMM_SIGMA_FLOOR_STANDSTILL : IMEST_COMM_SIGMA_FLOOR,
+                           fmaxf(q_sg, quality_rel(&r->sigma_ls_h) + u_ls));
   cfg->sigma_uncertainty = fminf(u_sg, IMEST_COMM_UNCERTAINTY_MAX);
 }
 
@@ -56,16 +70,30 @@ int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)
     n++;
   }
   cfg->ls_h = r->ls_h.value;
-  cfg->sigma = r->sigma.value;
   cfg->rs_nominal_ohm = r->rs_ohm.value;
-  constants_uncertainty(r, cfg);
-  n += 3;
+  const int curve =
+      IMEST_WITH_FLUX && r->ls_curve_points >= 2u && r->ls_curve_points <= IMEST_LS_CURVE_POINTS;
+  constants_uncertainty(r, curve, cfg);
+  n += 2;
+  if (!(r->flags & IMEST_COMM_FLAG_ROTOR_HF)) { /* else its sigma is the high-frequency one */
+    cfg->sigma = r->sigma.value;
+    n++;
+  }
   if (isfinite(r->tr_s.value) && r->tr_s.value > 0.0f) {
     cfg->tr_nominal_s = r->tr_s.value;
     n++;
   }
   if (r->inverter.uncertainty >= 0.0f) {
     cfg->inverter = r->inverter;
+    n++;
+  }
+  /* the magnetising curve: the estimator follows L_S with the window's flux (bg_flux.c) */
+  if (curve) {
+    cfg->ls_curve_points = r->ls_curve_points;
+    for (unsigned int k = 0; k < IMEST_LS_CURVE_POINTS; ++k) {
+      cfg->ls_curve_i_a[k] = k < r->ls_curve_points ? r->ls_curve_i_a[k] : 0.0f;
+      cfg->ls_curve_h[k] = k < r->ls_curve_points ? r->ls_curve_h[k] : 0.0f;
+    }
     n++;
   }
   return n;

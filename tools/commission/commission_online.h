@@ -19,8 +19,9 @@ typedef struct {
 
 /* The drive of the options (commission_sim.c) in operation: V/f at its rated point (the paper's
    motor: 30 Hz, 115 V), steady, load_frac of rated torque, for duration_s; the estimator with
-   the constants and inverter model of id (NULL: the true ones), fed the duties, the bus, the
-   currents and the angle (imest_isr_duty). 0, or -1 on a set-up error. */
+   the constants and inverter model of id (NULL: the true ones; sigma the preset's where
+   imest_comm_apply leaves it, IMEST_COMM_FLAG_ROTOR_HF), fed the duties, the bus, the currents
+   and the angle (imest_isr_duty). 0, or -1 on a set-up error. */
 int comm_online_run(const comm_sim_opts_t *o, double load_frac, double duration_s,
                     const imest_comm_result_t *id, comm_online_t *out);
 

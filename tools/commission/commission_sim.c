@@ -75,7 +75,58 @@ int comm_sim_config(const comm_sim_opts_t *o, imsim_config_t *sc)
   }
   sc->seed = o->seed;
   sc->steps_per_sample = 0;
+  if (o->real_motor) imsim_config_real_motor(sc);
+  if (o->sat_fraction > 0.0) sc->sat_fraction = o->sat_fraction;
+  if (o->iron_loss_fraction > 0.0) sc->iron_loss_fraction = o->iron_loss_fraction;
+  if (o->rotor_cage_ratio > 0.0) sc->rotor_cage_ratio = o->rotor_cage_ratio;
   return 0;
+}
+
+int comm_sim_true_at(const imsim_config_t *sc, double i_a, double *ls_h, double *sigma, double *tr_s)
+{
+  imsim_real_params_t p;
+  if (imsim_real_params(sc, &p) != 0) return -1;
+  const double m0 = sqrt((1.0 - sc->sigma) * sc->ls_h * sc->lr_h), rr = sc->lr_h / sc->tr_s;
+  double lm = m0, lls = sc->ls_h - m0, llr = sc->lr_h - m0;
+  if (p.lm0_h > 0.0 && p.sat_a > 0.0 && i_a > 0.0) {
+    /* no load: i_a = psi/L_m0 (1 + a (psi/psi_n)^6), increasing in psi: bisection */
+    double lo = 0.0, hi = p.lm0_h * i_a;
+    for (int it = 0; it < 200; ++it) {
+      const double psi = 0.5 * (lo + hi), q = psi / p.psi_n_wb;
+      const double im = psi / p.lm0_h * (1.0 + p.sat_a * q * q * q * q * q * q);
+      if (im > i_a)
+        hi = psi;
+      else
+        lo = psi;
+    }
+    lm = 0.5 * (lo + hi) / i_a;
+  } else if (p.lm0_h > 0.0) {
+    lm = p.lm0_h;
+  }
+  if (p.lm0_h > 0.0) {
+    lls = p.lls_h;
+    llr = p.llr_h;
+  }
+  if (ls_h) *ls_h = lls + lm;
+  if (sigma) *sigma = 1.0 - lm * lm / ((lls + lm) * (llr + lm));
+  if (tr_s) *tr_s = (llr + lm) / rr;
+  return 0;
+}
+
+double comm_sim_current_at_flux(const imsim_config_t *sc, double psi_wb)
+{
+  /* L_S(i) i increases with i (the static curve's flux does): bisection */
+  double lo = 0.0, hi = psi_wb / (sc->ls_h * (1.0 - sc->sigma)) * 4.0;
+  for (int it = 0; it < 200; ++it) {
+    const double i = 0.5 * (lo + hi);
+    double ls = sc->ls_h;
+    (void)comm_sim_true_at(sc, i, &ls, NULL, NULL);
+    if (ls * i > psi_wb)
+      hi = i;
+    else
+      lo = i;
+  }
+  return 0.5 * (lo + hi);
 }
 
 int comm_sim_operating(const comm_sim_opts_t *o, double load_frac, imsim_config_t *sc)
@@ -185,15 +236,18 @@ int comm_sim_run(const comm_sim_opts_t *o, comm_sim_out_t *out)
     free(simp);
     return -1;
   }
-  /* truth */
-  const double m_h = sqrt((1.0 - sc->sigma) * sc->ls_h * sc->lr_h);
-  out->rs_ohm = sc->rs_ohm;
+  /* truth, at the rated V/f flux (no load) */
+  const double psi_rated = (double)out->cc.rated_voltage_v / (TWO_PI * (double)out->cc.rated_freq_hz);
+  out->i_rated_flux_a = comm_sim_current_at_flux(sc, psi_rated);
   out->ls_h = sc->ls_h;
   out->sigma = sc->sigma;
-  out->sigma_ls_h = sc->sigma * sc->ls_h;
   out->tr_s = sc->tr_s;
-  out->lm_h = (1.0 - sc->sigma) * sc->ls_h;
-  out->rr_ohm = m_h * m_h / sc->lr_h / sc->tr_s;
+  (void)comm_sim_true_at(sc, out->i_rated_flux_a, &out->ls_h, &out->sigma, &out->tr_s);
+  out->ls_preset_h = sc->ls_h;
+  out->rs_ohm = sc->rs_ohm;
+  out->sigma_ls_h = out->sigma * out->ls_h;
+  out->lm_h = (1.0 - out->sigma) * out->ls_h;
+  out->rr_ohm = out->lm_h / out->tr_s;
   out->pole_pairs = (unsigned int)sc->pole_pairs;
   out->rs_identifiable_ohm = sc->rs_ohm + fmin(sc->r_switch_ohm, sc->r_diode_ohm);
 

@@ -34,6 +34,10 @@ typedef struct {
   double speed_frac;   /* V/f speed, fraction of rated (0: routine default) */
   double i_max_a;      /* 0: sqrt(2) x rated current */
   double r_series_ohm; /* known series resistance passed to the routine */
+  /* real-motor effects (sim/README.md, Real-motor effects): real_motor turns on the three at the
+     preset's sizes; a field above 0 sets (or overrides) that effect */
+  int real_motor;
+  double sat_fraction, iron_loss_fraction, rotor_cage_ratio;
   unsigned long seed;
   double max_time_s; /* simulated time limit (default 400) */
   FILE *trace;       /* per-sample CSV (t, stage, currents, duties, speed), or NULL */
@@ -41,8 +45,13 @@ typedef struct {
 } comm_sim_opts_t;
 
 typedef struct {
-  /* truth */
+  /* truth; L_S, sigma, sigma*L_S, T_R, L_m and R_R' at the rated V/f flux at no load (the
+     stator flux amplitude rated_voltage_v / (2 pi rated_freq_hz), the flux the routine's rotating
+     run aims at): with saturation they depend on the flux (comm_sim_true_at); for a linear motor
+     they are the preset's */
   double rs_ohm, ls_h, sigma, sigma_ls_h, tr_s, lm_h, rr_ohm;
+  double i_rated_flux_a; /* magnetising current at that flux (alpha/beta amplitude) [A] */
+  double ls_preset_h;    /* the preset's L_S (= ls_h for a linear motor) */
   unsigned int pole_pairs;
   double rs_identifiable_ohm;      /* winding + min(r_sw, r_d): what terminal measurements can see */
   double i_peak_true_a;            /* largest true phase current */
@@ -77,6 +86,14 @@ int comm_sim_operating(const comm_sim_opts_t *o, double load_frac, imsim_config_
 
 /* The routine's configuration for that drive (fs, carrier, limits, nameplate). */
 void comm_sim_comm_config(const comm_sim_opts_t *o, const imsim_config_t *sc, imest_comm_config_t *cc);
+
+/* The motor's constants at no load with a magnetising current of amplitude i_a (alpha/beta) [A]:
+   L_S, sigma and T_R = L_R / R_R(DC) with the static L_m at that current (sim/README.md,
+   Magnetising curve); the preset's for a linear motor. Any output may be NULL. 0, or -1. */
+int comm_sim_true_at(const imsim_config_t *sc, double i_a, double *ls_h, double *sigma, double *tr_s);
+
+/* The magnetising current (alpha/beta amplitude) at which the no-load stator flux L_S(i) i is psi_wb. */
+double comm_sim_current_at_flux(const imsim_config_t *sc, double psi_wb);
 
 /* Run the routine closed loop. Returns 0 when it ran (out->r says whether it succeeded), -1 on a
    simulator set-up error (message on stderr). */

@@ -46,6 +46,11 @@ static void usage(FILE *f)
           "  --encoder-stuck      the angle never moves\n"
           "  --swap-sensors       current channels b and c swapped\n"
           "  --two-sensors        the firmware computes i_c = -i_a - i_b\n"
+          "  --real-motor         the motor saturates, has iron loss and a double cage, at the\n"
+          "                       preset's sizes (sim/README.md, Real-motor effects)\n"
+          "  --saturation F       main-flux saturation: L_m at rated flux F below unsaturated [off]\n"
+          "  --iron-loss F        iron loss, F x rated power at rated V/f [off]\n"
+          "  --rotor double-cage:R  double-cage rotor, R_R at rated frequency R x DC [single cage]\n"
           "  --seed N             noise seed [1]\n"
           "  --trace FILE         per-sample CSV (t, stage, currents, duties, speed, angle)\n"
           "  --trace-decimate N   every N-th sample in the trace [1]\n"
@@ -161,6 +166,29 @@ int main(int argc, char **argv)
     } else if (tool_args_is(&a, "--load")) {
       if (tool_args_number(&a, &load) || load < 0.0 || load > 2.0) {
         fprintf(stderr, "%s: --load needs a fraction of rated torque in [0, 2]\n", k_prog);
+        return 2;
+      }
+    } else if (tool_args_is(&a, "--real-motor")) {
+      if (tool_args_flag(&a)) return 2;
+      o.real_motor = 1;
+    } else if (tool_args_is(&a, "--saturation")) {
+      if (tool_args_number(&a, &o.sat_fraction) || !(o.sat_fraction > 0.0 && o.sat_fraction < 0.6)) {
+        fprintf(stderr, "%s: --saturation needs a fraction in (0, 0.6)\n", k_prog);
+        return 2;
+      }
+    } else if (tool_args_is(&a, "--iron-loss")) {
+      if (tool_args_number(&a, &o.iron_loss_fraction) ||
+          !(o.iron_loss_fraction > 0.0 && o.iron_loss_fraction < 0.2)) {
+        fprintf(stderr, "%s: --iron-loss needs a fraction in (0, 0.2)\n", k_prog);
+        return 2;
+      }
+    } else if (tool_args_is(&a, "--rotor")) {
+      const char *rv = tool_args_value(&a);
+      if (rv == NULL) return 2;
+      char *end = NULL;
+      o.rotor_cage_ratio = strncmp(rv, "double-cage:", 12) == 0 ? strtod(rv + 12, &end) : 0.0;
+      if (end == NULL || *end != '\0' || !(o.rotor_cage_ratio > 1.0 && o.rotor_cage_ratio <= 4.0)) {
+        fprintf(stderr, "%s: --rotor needs double-cage:RATIO with RATIO in (1, 4]\n", k_prog);
         return 2;
       }
     } else if (tool_args_is(&a, "--csv")) {
@@ -297,7 +325,12 @@ int main(int argc, char **argv)
            (r->flags & IMEST_COMM_FLAG_LS_STANDSTILL) ? "standstill" : "rotating",
            1e3 * (double)r->ls_standstill_h.value, pct((double)r->ls_standstill_h.value, out.ls_h));
   row("L_S [mH]", 1e3, (double)r->ls_h.value, out.ls_h, note);
-  row("sigma", 1.0, (double)r->sigma.value, out.sigma, NULL);
+  if (fabs(out.ls_preset_h - out.ls_h) > 1e-9 * out.ls_h)
+    printf("  %-26s %s %.5g mH (the preset's, at rated load's main flux)\n", "",
+           "true values at the rated V/f flux at no load; L_S", 1e3 * out.ls_preset_h);
+  row("sigma", 1.0, (double)r->sigma.value, out.sigma,
+      (r->flags & IMEST_COMM_FLAG_ROTOR_HF) ? "rotor_hf: sigma*L_S at fs/8 is the rotor's high-frequency one"
+                                            : NULL);
   row("T_R [ms]", 1e3, (double)r->tr_s.value, out.tr_s, "flux tails");
   row("R_R' [ohm]", 1.0, (double)r->rr_ohm.value, out.rr_ohm, "(1-sigma) L_S / T_R");
   {
@@ -358,6 +391,19 @@ int main(int argc, char **argv)
              k == 0 ? "identified" : "true", 100.0 * v[k]->tr_all_rel, 100.0 * v[k]->tr_rel, v[k]->tr_valid,
              v[k]->windows, 100.0 * v[k]->rs_all_rel, 100.0 * v[k]->rs_rel, v[k]->rs_valid,
              imest_reason_name(v[k]->reason));
+  }
+  if (r->ls_curve_points > 0u) {
+    printf("\n  magnetising curve (no load; true L_S at each current):");
+    for (unsigned int j = 0u; j < r->ls_curve_points && j < 4u; ++j) {
+      double ls_t = out.ls_h;
+      (void)comm_sim_true_at(sc, (double)r->ls_curve_i_a[j], &ls_t, NULL, NULL);
+      printf("\n    %8.4f A  %9.5g mH  true %9.5g mH  %+7.3f %%", (double)r->ls_curve_i_a[j],
+             1e3 * (double)r->ls_curve_h[j], 1e3 * ls_t, pct((double)r->ls_curve_h[j], ls_t));
+    }
+    printf("\n    points' uncertainty %.2g %%; L_S over the curve %.2g %% (its flux dependence); rated flux "
+           "at %.4f A (true %.4f A)",
+           100.0 * (double)r->ls_h.std_rel, 100.0 * (double)r->ls_h.spread_rel, (double)r->rotating_i_a,
+           out.i_rated_flux_a);
   }
   printf(
       "\n  rotor travel at standstill %.2g rad; rotating run %.2f Hz, %.3f A, slip %.2g, negative sequence "

@@ -31,6 +31,9 @@ int comm_online_run(const comm_sim_opts_t *o, double load_frac, double duration_
   cfg.fs_hz = (float)sc.fs_hz;
   cfg.pwm_hz = (float)sc.carrier_hz;
   if (id != NULL) {
+    /* a rotor the routine flags as deep-bar or double cage: sigma from the data sheet (here the
+       preset's: its equivalent circuit at rated load), as the header tells the user */
+    cfg.sigma = (float)sc.sigma;
     if (imest_comm_apply(id, &cfg) < 0) goto done;
   } else { /* the true constants and devices (for comparison) */
     cfg.pole_pairs = (unsigned int)sc.pole_pairs;

@@ -150,7 +150,7 @@ static void prepare_rotation(imest_comm_t *c, const axes_t *a, double rs)
   c->ls_ss = (float)ls_ss;
   if (!c->cfg.allow_rotation) {
     set_value(&r->ls_h, ls_ss, (double)NAN, (double)NAN);
-    set_value(&r->sigma, a->slm / ls_ss, (double)NAN, (double)NAN);
+    set_value(&r->sigma, a->slm / ls_ss, (double)NAN, (double)r->sigma_ls_h.spread_rel);
     r->flags |= IMEST_COMM_FLAG_LS_STANDSTILL;
     c->final_ready = 1;
   }
@@ -176,6 +176,13 @@ void imest__cm_fit_standstill(imest_comm_t *c)
   if (!ok) {
     c->bg_fail = IMEST_COMM_REASON_IMPLAUSIBLE;
     return;
+  }
+  /* the rotor's resistance at the square wave's frequency against R_R' from the flux tails: far
+     above it (deep bars, a double cage; single cages stay below 2.2 x, saturated or not), the
+     square wave's sigma*L_S is the rotor's high-frequency leakage, below the slip-frequency one */
+  if ((f[0].rhf_ohm + f[1].rhf_ohm + f[2].rhf_ohm) / 3.0 - a.rm > 3.0 * a.lmm / a.taum) {
+    r->flags |= IMEST_COMM_FLAG_ROTOR_HF;
+    if (!(r->sigma_ls_h.spread_rel >= 0.5f)) r->sigma_ls_h.spread_rel = 0.5f;
   }
   prepare_rotation(c, &a, rs);
 }

@@ -12,9 +12,14 @@
  * (the field frame starts there). Then the frequency ramps to speed_frac of rated (held while a
  * phase current is above 90 % of i_max_a), settles (1 s + 3 T_R) and is measured over whole
  * electrical periods (>= 1 s): the current demodulated at the field angle (positive and negative
- * sequence), the commanded voltage, and the encoder's travel; then it ramps down and the
- * current goes to zero. imest__cm_fit_rotation turns these into L_S, n_p, the encoder's direction and
- * counts, and the phase-order check. ISR, float32. */
+ * sequence), the commanded voltage, and the encoder's travel. Each measured level is handed to
+ * the background (imest__cm_fit_rotation: L_S at that current, n_p, the encoder's direction and
+ * counts, the phase-order check), which sets the next level's magnetising current: the search for
+ * the current that gives the rated flux (L_S measured, not the standstill one, which a saturating
+ * motor makes far too low), then the magnetising curve's lower levels. Meanwhile the ISR holds the
+ * present level (CM_ROT_NEXT); the switch is one reference change, settled and measured as the
+ * first. After the last level the frequency ramps down and the current goes to zero. ISR,
+ * float32. */
 #include "commission_internal.h"
 
 /* cos and sin of a small angle |x| < 0.3 (series; error < 1e-9) */
@@ -34,20 +39,19 @@ void imest__cm_rotate_begin(imest_comm_t *c)
   c->we = 0.0f;
   c->we_test = IMEST_2PI_F * c->cfg.speed_frac * c->cfg.rated_freq_hz;
   c->psi = c->cfg.rated_voltage_v / (IMEST_2PI_F * c->cfg.rated_freq_hz);
-  /* the rated magnetising current (standstill L_S), within 80 % of the top level; less flux if
-     the limit says so */
+  /* the first level: the rated magnetising current with the standstill L_S, within 80 % of the
+     top level (psi_im: that limit holds for every level) */
+  c->psi_im = 0.8f * c->level_a;
   float im = c->psi / c->ls_ss;
-  if (im > 0.8f * c->level_a) {
-    im = 0.8f * c->level_a;
-    c->psi = im * c->ls_ss;
-  }
-  c->psi_im = im;
+  if (im > c->psi_im) im = c->psi_im;
   c->i_ref = im;
+  c->plateau = 0u; /* the level */
   c->ph_c = 1.0f;
   c->ph_s = 0.0f;
-  c->if_d = c->if_q = 0.0f;
   c->lim_cnt = 0u;
-  for (int j = 0; j < 9; ++j) c->rot_sum[j] = 0.0f;
+  for (int j = 0; j < CM_R_COUNT; ++j) c->rot_sum[j] = 0.0f;
+  c->blk[CM_ROT_LEVELS].s[CM_LB_NSEARCH] = 0.0f;
+  c->blk[CM_ROT_LEVELS].s[CM_LB_I] = 0.0f;
   /* measure over whole electrical periods, at least 1 s */
   const float f_e = c->we_test / IMEST_2PI_F;
   const float periods = (float)(uint32_t)(1.0f * f_e + 0.999f);
@@ -74,6 +78,29 @@ static float leg_error(const imest_comm_t *c, float i, float d, float vdc)
   const float ai = imest__abs(i);
   const float dc = i > 0.0f ? d : 1.0f - d;
   return s * (c->inv_td_f * vdc + c->inv_v + c->inv_rd * ai + dc * (c->inv_rsw - c->inv_rd) * ai);
+}
+
+/* A level measured: it holds until the background has set the next level's current from this
+   one's L_S (0: it was the last); then that level settles, or the run ramps down. 1 if the run
+   stopped, 0 if the field control runs. */
+static inline int next_level(imest_comm_t *c)
+{
+  if (!imest__cm_job_done(c)) {
+    if (c->cnt <= (uint32_t)(10.0f * c->cfg.fs_hz)) return 0;
+    imest__cm_fail(c, IMEST_COMM_REASON_BACKGROUND);
+    return 1;
+  }
+  c->cnt = 0u;
+  const float next = c->blk[CM_ROT_LEVELS].s[CM_LB_NEXT];
+  if (next > 0.0f) {
+    c->i_ref = next;
+    c->plateau++;
+    c->step = CM_ROT_SETTLE;
+    for (int j = 0; j < CM_R_COUNT; ++j) c->rot_sum[j] = 0.0f;
+  } else {
+    c->step = CM_ROT_DOWN;
+  }
+  return 0;
 }
 
 /* The run's steps (magnetise, ramp, settle, measure, down, stop): their counters and
@@ -117,6 +144,7 @@ static inline int rotate_steps(imest_comm_t *c, int limited, float ia, float vdc
     }
     break;
   case CM_ROT_MEASURE: break;
+  case CM_ROT_NEXT: return next_level(c);
   case CM_ROT_DOWN:
     c->we = c->we_test * (1.0f - (float)c->cnt / (float)c->n_ramp);
     if (c->cnt >= c->n_ramp) {
@@ -162,8 +190,8 @@ static inline void measure(imest_comm_t *c, float ia, float ib, float id, float 
     c->rot_th1 = c->th_prev;
     c->rot_wraps = c->wraps - c->rot_w0;
     r[CM_R_WE] = c->we;
-    imest__cm_post(c, CM_JOB_ROTATION, 0u);
-    c->step = CM_ROT_DOWN;
+    imest__cm_post(c, CM_JOB_ROTATION | (c->plateau << 4), 0u);
+    c->step = CM_ROT_NEXT;
     c->cnt = 0u;
   }
 }
@@ -210,7 +238,6 @@ void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
   float ia, ib;
   imest__clarke(m, &ia, &ib);
   if (rotate_steps(c, limited, ia, vdc)) return;
-  if (limited && c->step == CM_ROT_MEASURE) c->rot_sum[CM_R_LIM] += 1.0f;
   advance_field(c, ts);
 
   /* current in the field frame, its control (the rated magnetising current on d; ramping down,
