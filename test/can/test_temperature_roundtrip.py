@@ -20,7 +20,8 @@ import subprocess
 import sys
 
 TEMP_COLS = ["stator_c", "stator_uncert_k", "stator_valid", "rotor_c", "rotor_uncert_k", "rotor_valid"]
-MOTOR = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--quiet"]
+MOTOR = ["--pole-pairs", "2", "--ls", "0.2908", "--sigma", "0.096", "--ls-uncertainty", "0",
+         "--sigma-uncertainty", "0", "--quiet"]  # the simulator's own constants: exact
 FAILS = []
 
 

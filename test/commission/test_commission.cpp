@@ -84,7 +84,7 @@ TEST_P(CommissionMotor, ClosedLoopWithinTheIssuesAccuracy)
   imest_config_default(&cfg);
   cfg.fs_hz = (float)out.sim.fs_hz;
   cfg.pwm_hz = (float)out.sim.carrier_hz;
-  EXPECT_EQ(imest_comm_apply(&out.r, &cfg), 6);
+  EXPECT_EQ(imest_comm_apply(&out.r, &cfg), 7); // with the magnetising curve
   EXPECT_EQ(imest_config_check(&cfg, nullptr), IMEST_OK);
   EXPECT_EQ(cfg.pole_pairs, out.pole_pairs);
   EXPECT_FLOAT_EQ(cfg.ls_h, out.r.ls_h.value);
@@ -206,8 +206,8 @@ TEST_P(CommissionSaturating, LsAtRatedFluxAndTheCurveWithinTwoPercent)
     EXPECT_GE(r.sigma_ls_h.spread_rel, 0.5f);
     imest_config_t cfg;
     imest_config_default(&cfg);
-    cfg.sigma = 0.07f; // from the data sheet
-    EXPECT_EQ(imest_comm_apply(&r, &cfg), 5);
+    cfg.sigma = 0.07f;                        // from the data sheet
+    EXPECT_EQ(imest_comm_apply(&r, &cfg), 6); // sigma left to the data sheet, the curve copied
     EXPECT_FLOAT_EQ(cfg.sigma, 0.07f);
     EXPECT_FLOAT_EQ(cfg.ls_h, r.ls_h.value);
   }
@@ -297,6 +297,45 @@ TEST(Commission, ApplyStatesTheConstantsUncertaintyByItsRule)
   ASSERT_GE(imest_comm_apply(&r, &cfg), 3);
   EXPECT_FLOAT_EQ(cfg.ls_uncertainty, 0.03f);
   EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, 0.03f);
+}
+
+// With the magnetising curve in the result, imest_comm_apply() copies it and states L_S's and
+// sigma's uncertainty without their change over the curve (the estimator follows it); without
+// a curve that change is what the stated figure covers (saturation: T_R refused, not wrong).
+TEST(Commission, ApplyCopiesTheCurveAndLeavesItsSpreadOut)
+{
+  imest_comm_result_t r;
+  std::memset(&r, 0, sizeof r);
+  r.valid = 1;
+  r.rs_ohm.value = 1.4f;
+  r.tr_s.value = NAN;
+  r.inverter.uncertainty = -1.0f;
+  r.ls_h = {0.178f, 0.001f, 0.35f};   // L_S changes by 35 % over the curve
+  r.sigma = {0.0645f, 0.001f, 0.35f}; // and sigma with it
+  r.sigma_ls_h = {0.0115f, 0.001f, NAN};
+  r.ls_standstill_h = {0.1f, NAN, NAN};
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  const int without = imest_comm_apply(&r, &cfg);
+  EXPECT_EQ(cfg.ls_curve_points, 0u);
+  EXPECT_FLOAT_EQ(cfg.ls_uncertainty, 0.35f);
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, 0.35f);
+  r.ls_curve_points = 3u;
+  const float ia[3] = {2.0f, 2.5f, 3.0f}, lh[3] = {0.21f, 0.195f, 0.178f};
+  for (unsigned int k = 0; k < 3u; ++k) {
+    r.ls_curve_i_a[k] = ia[k];
+    r.ls_curve_h[k] = lh[k];
+  }
+  EXPECT_EQ(imest_comm_apply(&r, &cfg), without + 1); // the curve counts as one field
+  ASSERT_EQ(cfg.ls_curve_points, 3u);
+  for (unsigned int k = 0; k < 3u; ++k) {
+    EXPECT_FLOAT_EQ(cfg.ls_curve_i_a[k], ia[k]);
+    EXPECT_FLOAT_EQ(cfg.ls_curve_h[k], lh[k]);
+  }
+  EXPECT_FLOAT_EQ(cfg.ls_uncertainty, 0.003f);             // 3 standard errors
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, 0.003f + 0.003f); // sigma*L_S's plus L_S's
+  cfg.pole_pairs = 2;
+  EXPECT_EQ(imest_config_check(&cfg, nullptr), IMEST_OK);
 }
 
 TEST(Commission, EncoderCountingBackwardsIsFound)
