@@ -319,7 +319,7 @@ TEST(Commission, ApplyCopiesTheCurveAndLeavesItsSpreadOut)
   const int without = imest_comm_apply(&r, &cfg);
   EXPECT_EQ(cfg.ls_curve_points, 0u);
   EXPECT_FLOAT_EQ(cfg.ls_uncertainty, 0.35f);
-  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, 0.35f);
+  EXPECT_FLOAT_EQ(cfg.sigma_uncertainty, 0.003f + 0.35f); // sigma*L_S's plus L_S's
   r.ls_curve_points = 3u;
   const float ia[3] = {2.0f, 2.5f, 3.0f}, lh[3] = {0.21f, 0.195f, 0.178f};
   for (unsigned int k = 0; k < 3u; ++k) {
