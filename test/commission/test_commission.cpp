@@ -246,9 +246,8 @@ TEST(Commission, StandstillOnlyFillsLsFromTheFluxTails)
               100.0 * rel(out.r.sigma.value, out.sigma), 100.0 * cfg.sigma_uncertainty);
 }
 
-// imest_comm_apply()'s rule for ls_uncertainty and sigma_uncertainty (imest_commission.h), on
-// hand-made results: the floors, 3 standard errors, the axes' spread, sigma's sum, the cap.
-TEST(Commission, ApplyStatesTheConstantsUncertaintyByItsRule)
+// A valid result with R_S only: what the tests of imest_comm_apply()'s rules fill in.
+static imest_comm_result_t handmade_result()
 {
   imest_comm_result_t r;
   std::memset(&r, 0, sizeof r);
@@ -256,6 +255,14 @@ TEST(Commission, ApplyStatesTheConstantsUncertaintyByItsRule)
   r.rs_ohm.value = 1.4f;
   r.tr_s.value = NAN;
   r.inverter.uncertainty = -1.0f;
+  return r;
+}
+
+// imest_comm_apply()'s rule for ls_uncertainty and sigma_uncertainty (imest_commission.h), on
+// hand-made results: the floors, 3 standard errors, the axes' spread, sigma's sum, the cap.
+TEST(Commission, ApplyStatesTheConstantsUncertaintyByItsRule)
+{
+  imest_comm_result_t r = handmade_result();
   const auto set = [](imest_comm_value_t &v, float value, float std_rel, float spread_rel) {
     v.value = value;
     v.std_rel = std_rel;
@@ -304,12 +311,7 @@ TEST(Commission, ApplyStatesTheConstantsUncertaintyByItsRule)
 // a curve that change is what the stated figure covers (saturation: T_R refused, not wrong).
 TEST(Commission, ApplyCopiesTheCurveAndLeavesItsSpreadOut)
 {
-  imest_comm_result_t r;
-  std::memset(&r, 0, sizeof r);
-  r.valid = 1;
-  r.rs_ohm.value = 1.4f;
-  r.tr_s.value = NAN;
-  r.inverter.uncertainty = -1.0f;
+  imest_comm_result_t r = handmade_result();
   r.ls_h = {0.178f, 0.001f, 0.35f};   // L_S changes by 35 % over the curve
   r.sigma = {0.0645f, 0.001f, 0.35f}; // and sigma with it
   r.sigma_ls_h = {0.0115f, 0.001f, NAN};
