@@ -21,11 +21,12 @@
 #ifndef IMEST_TESTVECTOR
 #define IMEST_TESTVECTOR "test/data/testvector.json"
 #endif
-#ifndef SOLVE_CHAIN_F32
-#define SOLVE_CHAIN_F32 1
-#endif
-
 namespace solvetest {
+
+// The Sturm chain of the library this binary links: true float32 (the
+// default), false float64 (BG_ROOTS_DOUBLE). Defined in solve_chain.cpp, the
+// only file compiled once per chain (test/solve/CMakeLists.txt).
+bool chain_f32();
 
 inline const nlohmann::json &testvector()
 {

@@ -306,7 +306,7 @@ TEST(SturmVsCompanion, RandomFamilies)
       std::vector<std::complex<double>> ev(ps.roots().data(), ps.roots().data() + ps.roots().size());
       const auto cl = clusters(ev);
       int expected = 0;
-      const double u_chain = SOLVE_CHAIN_F32 ? 1e-5 : 1e-12;
+      const double u_chain = solvetest::chain_f32() ? 1e-5 : 1e-12;
       for (const auto &c : cl) {
         const double x = c.mean.real();
         const bool realpos =
@@ -357,7 +357,7 @@ TEST(SturmVsCompanion, RandomFamilies)
           // float32 chain on random-coefficient polynomials: completeness is
           // not claimed (the chain loses its digits; reported, not asserted)
           if (must) ++n_missed_must;
-          if (must && !(SOLVE_CHAIN_F32 && fam == 0)) {
+          if (must && !(solvetest::chain_f32() && fam == 0)) {
             ADD_FAILURE() << family_name[fam] << " case " << it << ": missed root " << x << " (cluster of "
                           << c.size << ", diam " << c.diam << ", nearest " << nearest << ", tol " << tol
                           << ", rho " << rho << ", gap " << gap << ")" << coefs(P.c);
@@ -366,7 +366,7 @@ TEST(SturmVsCompanion, RandomFamilies)
         if (P.separated && must) worst_sep_err = std::max(worst_sep_err, nearest / x);
       }
       // 3. separated: exact count, tight values
-      if (P.separated && SOLVE_CHAIN_F32 == 0 && fam != 4) {
+      if (P.separated && !solvetest::chain_f32() && fam != 4) {
         EXPECT_EQ(nr, expected) << family_name[fam] << " case " << it;
       }
     }
@@ -378,7 +378,7 @@ TEST(SturmVsCompanion, RandomFamilies)
     if (fam != 4) EXPECT_LE(worst_sep_err, 1e-9) << family_name[fam]; // near 0: companion abs. error
   }
   std::printf("[sturm-vs-companion] chain %s: max Sturm evals %u, bisect steps %u, polish evals %u\n",
-              SOLVE_CHAIN_F32 ? "float32" : "float64", max_evals, max_bisect, max_polish);
+              solvetest::chain_f32() ? "float32" : "float64", max_evals, max_bisect, max_polish);
   // iteration bounds of bg_roots.c (bg_bounds.h)
   EXPECT_LE(max_evals, BG_ROOTS_BOUND_STURM);
   EXPECT_LE(max_bisect, BG_ROOTS_BOUND_BISECT);

@@ -190,7 +190,7 @@ TEST(Testvector, SolveEndToEnd)
   std::printf("[solve] PE_K1 %.12g (ref %.12g, rel %.2g)  PE_K2 %.12g (ref %.12g, rel %.2g)\n", o.pe_k1,
               j["PE_K1"].get<double>(), pk1, o.pe_k2, j["PE_K2"].get<double>(), pk2);
   std::printf("[solve] chain %s: sturm %u bisect %u polish %u quality %u work %u chain_len %u\n",
-              SOLVE_CHAIN_F32 ? "float32" : "float64", st.roots.sturm_evals, st.roots.bisect_steps,
+              solvetest::chain_f32() ? "float32" : "float64", st.roots.sturm_evals, st.roots.bisect_steps,
               st.roots.polish_evals, st.quality_evals, o.work, st.roots.chain_len);
   EXPECT_EQ(st.roots.unresolved, 0u);
   EXPECT_EQ(st.roots.rejected, 0u);
