@@ -25,19 +25,17 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r)
   return IMEST_OK;
 }
 
-/* A value's relative uncertainty from its quality: the larger of 3 standard
- * errors and the axes' spread (either NaN: not known, left out). */
-static float quality_rel(const imest_comm_value_t *v)
-{
-  const float s = isfinite(v->std_rel) ? 3.0f * v->std_rel : 0.0f;
-  const float p = isfinite(v->spread_rel) ? v->spread_rel : 0.0f;
-  return fmaxf(s, p);
-}
-
 /* 3 standard errors (NaN: not known, 0). */
 static float std3_rel(const imest_comm_value_t *v)
 {
   return isfinite(v->std_rel) ? 3.0f * v->std_rel : 0.0f;
+}
+
+/* A value's relative uncertainty from its quality: the larger of 3 standard
+ * errors and the axes' spread (either NaN: not known, left out). */
+static float quality_rel(const imest_comm_value_t *v)
+{
+  return fmaxf(std3_rel(v), isfinite(v->spread_rel) ? v->spread_rel : 0.0f);
 }
 
 /* The rule imest_commission.h states for ls_uncertainty and sigma_uncertainty.

@@ -203,12 +203,7 @@ int imest_background(imest_t *s, imest_result_t *out)
   combine_join(s, w, m, &x, out);
   solve(s, w, &x, &so);
   result_from_solve(&x, s, &so, out);
-#if IMEST_WITH_FLUX
   imest__bg_flux(s, &x.st, &x.sums, w->nreg, out, &fx); /* L_S at the window's flux (a curve given) */
-#else
-  fx.tr_b = fx.rs_b = 0.0f;
-  out->ls_window_h = (double)NAN;
-#endif
   imest__bg_judge(s, w, &x.st, &x.sums, &so, &fx, x.steady, out);
   combine_after(s, w, &x, out);
   release_window(s, w, m, out);

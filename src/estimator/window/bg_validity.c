@@ -212,10 +212,8 @@ static float gain_mismatch(const imest_window_t *w, const bg_sums_t *sm)
  * *tol: 6 %, plus the curve's own uncertainty there. */
 static float noload_ls_ref(const imest_t *s, const op_point_t *op, float slip_ratio, float *tol)
 {
-  float err_h = 0.0f;
-  const float ls = IMEST_WITH_FLUX
-                       ? imest__bg_flux_ls(s, sqrtf(op->i2 / (1.0f + slip_ratio * slip_ratio)), &err_h)
-                       : s->ls_h;
+  float err_h;
+  const float ls = imest__bg_flux_ls(s, sqrtf(op->i2 / (1.0f + slip_ratio * slip_ratio)), &err_h);
   *tol = LS_NOLOAD_TOL + err_h / ls;
   return ls;
 }
@@ -450,9 +448,9 @@ static int rs_verdict(judge_t *j)
  * model's, or none known), the timing's, the staircase's, the current
  * sensors' gain mismatch (|E| |Z| / R_S, measured: the paper motor, 1 %
  * between two sensors, R_S -3.5 %); both with the constants' share
- * (ls_uncertainty, sigma_uncertainty). Infinite without an estimate (have: the
+ * (ls_uncertainty, sigma_uncertainty) and the magnetising curve's (fx). Infinite without an estimate (have: the
  * solve gave a positive, finite T_R). */
-static void bounds(judge_t *j, const bg_sums_t *sm, int have)
+static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int have)
 {
   imest_result_t *r = j->r;
   const float mism = gain_mismatch(j->w, sm);
@@ -468,21 +466,16 @@ static void bounds(judge_t *j, const bg_sums_t *sm, int have)
     const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &harm_v);
     systematic_bounds(j->s, j->w, &j->op, (float)j->st->slip_rate, (float)r->tr_s, rs, dv_v, harm_v, &j->tr_b,
                       &j->rs_b, &j->c_tr, &j->c_rs);
+    /* the magnetising curve's share (bg_flux.c), where T_R's bound is finite;
+     * nothing without a curve (the outputs stay as without it) */
+    if (fx != NULL && j->s->ls_curve_points != 0u && isfinite(j->tr_b)) {
+      j->tr_b += fx->tr_b;
+      j->rs_b += fx->rs_b;
+    }
     j->g_b = mism * j->op.z_ohm / rs;
     r->tr_bound_rel = (double)j->tr_b;
     r->rs_bound_rel = (double)(j->rs_b + j->g_b);
   }
-}
-
-/* The magnetising curve's share of the bounds (bg_flux.c), where they are
- * computed; nothing without a curve (the outputs stay as without it). */
-static void flux_bounds(judge_t *j, const bg_flux_t *fx)
-{
-  if (!IMEST_WITH_FLUX || fx == NULL || j->s->ls_curve_points == 0u || !isfinite(j->tr_b)) return;
-  j->tr_b += fx->tr_b;
-  j->rs_b += fx->rs_b;
-  j->r->tr_bound_rel = (double)j->tr_b;
-  j->r->rs_bound_rel = (double)(j->rs_b + j->g_b);
 }
 
 void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_t *st, const bg_sums_t *sm,
@@ -500,8 +493,7 @@ void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_
    * T_R (the motor's, for any size; the nominal T_R where there is none). */
   r->slip_ratio = (double)(fabsf((float)st->slip_rate) * (have ? (float)r->tr_s : s->tr_nominal_s));
   r->ls_noload_h = (double)NAN; /* the no-load check fills it where it runs */
-  bounds(&j, sm, have);
-  flux_bounds(&j, fx);
+  bounds(&j, sm, fx, have);
   j.tr_judged = (float)st->slip_rate * (float)r->tr_s * s->sigma < 1.0f;
   const int status = tr_verdict(&j);
   const int rs_status = status != IMEST_REASON_NONE ? status : rs_verdict(&j);
