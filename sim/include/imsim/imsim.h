@@ -244,6 +244,9 @@ typedef struct {
   double f_n_hz, h_max_s;
   imsim_cpx_t fl[4]; /* psi_S, psi_R1, psi_R2, psi_m (psi_m a state with R_fe only) */
   imsim_cpx_t psi_m_prev;
+  double e_fe_j;      /* iron-loss energy integrated with the flux states (fe) */
+  double e_fe_prev_j; /* ... and its value at the last sample, with its time   */
+  double t_prev_s;
   bool has_prev;
 } imsim_real_t;
 
