@@ -6,13 +6,15 @@
  * what it pulls from libm, libgcc and libc, with --gc-sections. With
  * FW_FLASH_DUTY it also links the duty-cycle input, reported on its own line.
  * FW_FLASH_COMM adds the self-commissioning API (imest_commission.h); with
- * FW_FLASH_COMM_ONLY it is linked alone. */
+ * FW_FLASH_COMM_ONLY it is linked alone. FW_FLASH_MINIMAL links the least a
+ * firmware needs: one voltage input, no CAN publisher, no reason names. */
 #include <stdint.h>
 #if !defined(FW_FLASH_BASELINE) && !defined(FW_FLASH_COMM_ONLY)
 #include "imest/imest.h"
 #include "imest/imest_can.h"
 static imest_t est;
 static imest_result_t res;
+#ifndef FW_FLASH_MINIMAL
 static imest_can_pub_t pub;
 static int probe_send(void *ctx, const imest_can_frame_t *f)
 {
@@ -20,6 +22,7 @@ static int probe_send(void *ctx, const imest_can_frame_t *f)
   return (int)f->data[7]; /* uses the frame, so nothing is optimised away */
 }
 static const imest_can_port_t probe_port = {probe_send, 0};
+#endif
 #endif
 #if defined(FW_FLASH_COMM) || defined(FW_FLASH_COMM_ONLY)
 #include "imest/imest_commission.h"
@@ -67,15 +70,21 @@ int main(void)
   if (imest_init(&est, &cfg) != IMEST_OK) return 1;
   const float u[3] = {0.0f, 0.0f, 0.0f}, i[3] = {0.0f, 0.0f, 0.0f};
   (void)imest_isr_abc(&est, u, i, 0.0f);
+#ifndef FW_FLASH_MINIMAL
   (void)imest_isr_ab(&est, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+#endif
 #ifdef FW_FLASH_DUTY
   (void)imest_isr_duty(&est, u, 0.0f, i, 0.0f);
 #endif
   (void)imest_background(&est, &res);
+#ifdef FW_FLASH_MINIMAL
+  return (int)imest_overruns(&est) + (int)res.tr_valid;
+#else
   (void)imest_reason_name(res.status);
   if (imest_can_pub_init(&pub, &probe_port, IMEST_CAN_DEFAULT_BASE_ID) != IMEST_OK) return 1;
   (void)imest_can_publish(&pub, &res);
   return (int)imest_overruns(&est);
+#endif
 #else
   fw_mark_b0();
   return 0;
