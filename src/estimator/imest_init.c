@@ -331,7 +331,7 @@ static void init_isr_constants(imest_t *s, const imest_config_t *cfg, double m)
     s->dcb_a = wd / (1.0f + wd); /* backward Euler: stable for any wd */
   }
   design_bw3(&s->bw, (double)cfg->filter_hz, (double)fs);
-  imest__bg_noise_gains(&s->bw, (double)fs, s->noise_g);
+  imest__bg_noise_gains(&s->bw, fs, s->noise_g);
   design_aa(&s->aa, (double)cfg->aa_hz, (double)fs);
   s->aa_on = cfg->aa_hz > 0.0f;
   design_angle(&s->obs, cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz, fs);

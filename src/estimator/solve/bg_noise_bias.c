@@ -18,31 +18,36 @@ static float bias_f(const bg_noise_t *nz, unsigned int i, unsigned int j)
   return nz->bias[IMEST_ACC_INDEX(lo, hi)];
 }
 
-static double bias_at(const bg_noise_t *nz, unsigned int i, unsigned int j)
+/* The bias taken out of the sums: f B, formed in float32 (B is float32 and
+ * f in [0, 1] a share, not a measured number: a 6e-8 rounding of f B is one
+ * of B itself) and subtracted in float64, the sums' precision. B c0 and
+ * c0' B c0, c0' B_y likewise in float32: c0 is the window's float32 centring,
+ * each product and sum rounds by 6e-8 of its terms, what B's own rounding
+ * already is; the differences that cancel (B_yy - 2 c0' B_y + c0' B c0, the
+ * noise's share of the centred residual, B_iy - (B c0)_i) are taken in
+ * float64 from those float32 terms, so no float32 cancellation is added. */
+static void apply(bg_sums_t *sm, const bg_noise_t *nz, float ff, double m)
 {
-  return (double)bias_f(nz, i, j);
-}
-
-static void apply(bg_sums_t *sm, const bg_noise_t *nz, double f, double m)
-{
-  double c0[7];
-  for (unsigned int i = 0; i < 7u; ++i) c0[i] = sm->c0[k_of_col[i]];
-  double bwc[7]; /* B_WW c0 */
+  const double f = (double)ff;
+  float c0[7];
+  for (unsigned int i = 0; i < 7u; ++i) c0[i] = (float)sm->c0[k_of_col[i]];
+  float bwc[7]; /* B_WW c0 */
   for (unsigned int i = 0; i < 7u; ++i) {
-    bwc[i] = 0.0;
-    for (unsigned int j = 0; j < 7u; ++j) bwc[i] += bias_at(nz, i, j) * c0[j];
+    bwc[i] = 0.0f;
+    for (unsigned int j = 0; j < 7u; ++j) bwc[i] += bias_f(nz, i, j) * c0[j];
   }
-  double cbc = 0.0, cby = 0.0;
+  float cbc = 0.0f, cby = 0.0f;
   for (unsigned int i = 0; i < 7u; ++i) {
-    for (unsigned int j = 0; j < 7u; ++j) sm->rw[k_of_col[i]][k_of_col[j]] -= f * bias_at(nz, i, j);
-    sm->rwy[k_of_col[i]] -= f * bias_at(nz, i, 7u);
-    sm->rwe[k_of_col[i]] -= f * (bias_at(nz, i, 7u) - bwc[i]);
+    for (unsigned int j = 0; j < 7u; ++j) sm->rw[k_of_col[i]][k_of_col[j]] -= (double)(ff * bias_f(nz, i, j));
+    sm->rwy[k_of_col[i]] -= (double)(ff * bias_f(nz, i, 7u));
+    sm->rwe[k_of_col[i]] -= f * ((double)bias_f(nz, i, 7u) - (double)bwc[i]);
     cbc += c0[i] * bwc[i];
-    cby += c0[i] * bias_at(nz, i, 7u);
+    cby += c0[i] * bias_f(nz, i, 7u);
   }
-  sm->ry -= f * bias_at(nz, 7u, 7u);
-  sm->ree -= f * (bias_at(nz, 7u, 7u) - 2.0 * cby + cbc);
-  sm->e_slack = f * (bias_at(nz, 7u, 7u) - 2.0 * cby + cbc);
+  const double b77 = (double)bias_f(nz, 7u, 7u);
+  sm->ry -= (double)(ff * bias_f(nz, 7u, 7u));
+  sm->e_slack = f * (b77 - 2.0 * (double)cby + (double)cbc);
+  sm->ree -= sm->e_slack;
   /* column 3 is -m column 4, for the noise as for everything */
   for (unsigned int j = 0; j < 8u; ++j) sm->rw[2][j] = -m * sm->rw[3][j];
   for (unsigned int i = 0; i < 8u; ++i) sm->rw[i][2] = -m * sm->rw[i][3];
@@ -57,15 +62,17 @@ void imest__bg_noise_subtract(bg_sums_t *sums, bg_noise_t *nz, double m)
    * window is noise and the bias estimate the weakest: take only as much of
    * it as leaves every column (and y) 10 % of its energy. (R_W is nearly
    * singular at constant speed, W6 ~ a^2 W4 and W7 ~ a^2 W1, so definiteness
-   * is no test: the bias has the same near-collinearity.) */
-  double f = nz->steady ? 1.0 : 0.0;
+   * is no test: the bias has the same near-collinearity.) float32: the
+   * energies are of B's magnitudes, which are float32; the share is
+   * continuous where the test flips (0.9 r / b = 1 there). */
+  float f = nz->steady ? 1.0f : 0.0f;
   for (unsigned int i = 0; i < 8u; ++i) {
-    const double r = (i < 7u) ? sums->rw[k_of_col[i]][k_of_col[i]] : sums->ry, b = bias_at(nz, i, i);
-    if (b > 0.9 * r) f = fmin(f, r > 0.0 ? 0.9 * r / b : 0.0);
+    const float r = (float)((i < 7u) ? sums->rw[k_of_col[i]][k_of_col[i]] : sums->ry), b = bias_f(nz, i, i);
+    if (b > 0.9f * r) f = fminf(f, r > 0.0f ? 0.9f * r / b : 0.0f);
   }
-  nz->scale = f;
+  nz->scale = (double)f;
   sums->e_slack = 0.0;
-  if (f > 0.0) apply(sums, nz, f, m);
+  if (f > 0.0f) apply(sums, nz, f, m);
   nz->e_c0 = sums->e_slack;
 }
 
