@@ -175,13 +175,13 @@ static void combine_after(imest_t *s, const imest_window_t *w, const bg_step_t *
 /* Centre later windows on the latest trusted K (T_R valid: R_S may be
  * refused for its own bound while K1, K2 are well determined); clear the
  * buffer and release it to the ISR. */
-static void release_window(imest_t *s, imest_window_t *w, double m, const imest_result_t *out)
+static void release_window(imest_t *s, imest_window_t *w, const imest_result_t *out)
 {
   if (out->tr_valid) {
     s->last_k1 = (float)out->k1;
     s->last_k2 = (float)out->k2;
   }
-  if (s->last_k2 > 0.0f) imest__bg_centre_from_k(w->c0, (double)s->last_k1, (double)s->last_k2, m);
+  if (s->last_k2 > 0.0f) imest__bg_centre_from_k(w->c0, s->last_k1, s->last_k2, s->m);
   for (unsigned int p = 0; p < IMEST_NACC; ++p) {
     w->sum[p] = 0;
     w->blk[p] = 0;
@@ -208,6 +208,6 @@ int imest_background(imest_t *s, imest_result_t *out)
   imest__bg_flux(s, &x.st, &x.sums, w->nreg, out, &fx); /* L_S at the window's flux (a curve given) */
   imest__bg_judge(s, w, &x.st, &x.sums, &so, &fx, x.steady, out);
   combine_after(s, w, &x, out);
-  release_window(s, w, m, out);
+  release_window(s, w, out);
   return 1;
 }

@@ -28,6 +28,6 @@ void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums
                            bg_window_stats_t *st);
 
 /* c0 (7-column centring vector) from K1, K2. */
-void imest__bg_centre_from_k(imest_real_t c0[7], double k1, double k2, double m);
+void imest__bg_centre_from_k(imest_real_t c0[7], imest_real_t k1, imest_real_t k2, imest_real_t m);
 
 #endif /* IMEST_BG_WINDOW_H */
