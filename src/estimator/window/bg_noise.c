@@ -94,7 +94,8 @@ void imest__bg_noise_estimate(const imest_t *s, const imest_window_t *w, const b
   /* 2 sin(x/2) by its series (|x| <= pi: error < 1e-3 of it; libm's sin
    * would cost 5 KB of flash on a soft-double core) */
   const float x = fminf(fabsf(we / fs), IMEST_PI_F), x2 = x * x;
-  const float h = x * (1.0f - x2 * (1.0f / 24.0f) * (1.0f - x2 * (1.0f / 80.0f) * (1.0f - x2 * (1.0f / 168.0f))));
+  const float h =
+      x * (1.0f - x2 * (1.0f / 24.0f) * (1.0f - x2 * (1.0f / 80.0f) * (1.0f - x2 * (1.0f / 168.0f))));
   const float h3 = h * h * h, h6 = h3 * h3;
   const float ni = (float)(w->sum[IMEST_ACC_NOISE_I] + w->blk[IMEST_ACC_NOISE_I]) / n;
   const float nu = (float)(w->sum[IMEST_ACC_NOISE_U] + w->blk[IMEST_ACC_NOISE_U]) / n;

@@ -475,8 +475,8 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
     const float rs = j->rs;
     float harm_v;
     const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &harm_v);
-    systematic_bounds(j->s, j->w, &j->op, j->st->slip_rate, j->tr, rs, dv_v, harm_v, &j->tr_b,
-                      &j->rs_b, &j->c_tr, &j->c_rs);
+    systematic_bounds(j->s, j->w, &j->op, j->st->slip_rate, j->tr, rs, dv_v, harm_v, &j->tr_b, &j->rs_b,
+                      &j->c_tr, &j->c_rs);
     /* the magnetising curve's share (bg_flux.c), where T_R's bound is finite;
      * nothing without a curve (the outputs stay as without it) */
     if (fx != NULL && j->s->ls_curve_points != 0u && isfinite(j->tr_b)) {
