@@ -713,60 +713,32 @@ TEST(Verdict, RsOutOfRangeBoundaries)
 TEST(Verdict, Float32ThresholdsFlipOnlyAtTheEdge)
 {
   const double d = 1e-6, edge = std::ldexp(1.0, -26); // below float32's half step (2^-24)
-  {
-    Win x = build(paper_scene());
-    const double lim = (double)x.s.max_ei;
-    x.r.e_i_noise = 0.0;
-    x.r.e_i = lim * (1.0 - d);
+  // the figure *fig 1e-6 below and above lim: valid, then refused for why
+  auto around = [&](Win &x, double *fig, double lim, int why) {
+    *fig = lim * (1.0 - d);
     EXPECT_VALID(judge(x));
-    x.r.e_i = lim;
-    EXPECT_VALID(judge(x));
-    x.r.e_i = lim * (1.0 + d);
-    EXPECT_TR_REASON(judge(x), IMEST_REASON_HIGH_RESIDUAL);
-    x.r.e_i = lim * (1.0 + edge); // float64 would refuse it
-    EXPECT_VALID(judge(x));
-  }
-  {
-    Win x = build(paper_scene());
-    const double lim = (double)x.s.max_pe_k2_rel;
-    x.r.pe_k2_rel = lim * (1.0 - d);
-    EXPECT_VALID(judge(x));
-    x.r.pe_k2_rel = lim * (1.0 + d);
-    EXPECT_TR_REASON(judge(x), IMEST_REASON_POORLY_DETERMINED);
-  }
-  {
-    Win x = build(paper_scene());
-    const double rs = x.r.rs_ohm;
-    x.s.rs_max_ohm = (float)rs;
-    const double lim = (double)x.s.rs_max_ohm;
-    x.r.rs_ohm = lim * (1.0 - d);
-    EXPECT_VALID(judge(x));
-    x.r.rs_ohm = lim;
-    EXPECT_VALID(judge(x));
-    x.r.rs_ohm = lim * (1.0 + d);
-    EXPECT_TR_REASON(judge(x), IMEST_REASON_RS_OUT_OF_RANGE);
-    x.r.rs_ohm = lim * (1.0 + edge);
-    EXPECT_VALID(judge(x));
-  }
-  {
-    Win x = build(paper_scene());
-    x.s.tr_nominal_known = 1;
-    x.s.tr_nominal_s = (float)(x.r.tr_s / 1.5);
-    const double lim = 1.5 * (double)x.s.tr_nominal_s; // TR_NOMINAL_MAX
-    x.r.tr_s = lim * (1.0 - d);
-    EXPECT_VALID(judge(x));
-    x.r.tr_s = lim * (1.0 + d);
-    EXPECT_TR_REASON(judge(x), IMEST_REASON_CONSTANTS_MISMATCH);
-  }
-  {
-    Win x = build(paper_scene());
-    x.s.rs_nominal_ohm = (float)(x.r.rs_ohm / 1.9);
-    const double lim = 1.9 * (double)x.s.rs_nominal_ohm; // RS_NOMINAL_MAX
-    x.r.rs_ohm = lim * (1.0 - d);
-    EXPECT_VALID(judge(x));
-    x.r.rs_ohm = lim * (1.0 + d);
-    EXPECT_TR_REASON(judge(x), IMEST_REASON_CONSTANTS_MISMATCH);
-  }
+    *fig = lim * (1.0 + d);
+    EXPECT_TR_REASON(judge(x), why);
+  };
+  Win x = build(paper_scene());
+  x.r.e_i_noise = 0.0;
+  around(x, &x.r.e_i, (double)x.s.max_ei, IMEST_REASON_HIGH_RESIDUAL);
+  x.r.e_i = (double)x.s.max_ei * (1.0 + edge); // float64 would refuse it
+  EXPECT_VALID(judge(x));
+  x = build(paper_scene());
+  around(x, &x.r.pe_k2_rel, (double)x.s.max_pe_k2_rel, IMEST_REASON_POORLY_DETERMINED);
+  x = build(paper_scene());
+  x.s.rs_max_ohm = (float)x.r.rs_ohm;
+  around(x, &x.r.rs_ohm, (double)x.s.rs_max_ohm, IMEST_REASON_RS_OUT_OF_RANGE);
+  x.r.rs_ohm = (double)x.s.rs_max_ohm * (1.0 + edge);
+  EXPECT_VALID(judge(x));
+  x = build(paper_scene());
+  x.s.tr_nominal_known = 1;
+  x.s.tr_nominal_s = (float)(x.r.tr_s / 1.5);
+  around(x, &x.r.tr_s, 1.5 * (double)x.s.tr_nominal_s, IMEST_REASON_CONSTANTS_MISMATCH); // TR_NOMINAL_MAX
+  x = build(paper_scene());
+  x.s.rs_nominal_ohm = (float)(x.r.rs_ohm / 1.9);
+  around(x, &x.r.rs_ohm, 1.9 * (double)x.s.rs_nominal_ohm, IMEST_REASON_CONSTANTS_MISMATCH); // RS_NOMINAL_MAX
 }
 
 // ---------------------------------------------------------------------------
