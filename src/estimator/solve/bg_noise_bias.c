@@ -18,36 +18,34 @@ static float bias_f(const bg_noise_t *nz, unsigned int i, unsigned int j)
   return nz->bias[IMEST_ACC_INDEX(lo, hi)];
 }
 
-/* The bias taken out of the sums: f B, formed in float32 (B is float32 and
- * f in [0, 1] a share, not a measured number: a 6e-8 rounding of f B is one
- * of B itself) and subtracted in float64, the sums' precision. B c0 and
- * c0' B c0, c0' B_y likewise in float32: c0 is the window's float32 centring,
- * each product and sum rounds by 6e-8 of its terms, what B's own rounding
- * already is; the differences that cancel (B_yy - 2 c0' B_y + c0' B c0, the
- * noise's share of the centred residual, B_iy - (B c0)_i) are taken in
- * float64 from those float32 terms, so no float32 cancellation is added. */
-static void apply(bg_sums_t *sm, const bg_noise_t *nz, float ff, double m)
+static double bias_at(const bg_noise_t *nz, unsigned int i, unsigned int j)
 {
-  const double f = (double)ff;
-  float c0[7];
-  for (unsigned int i = 0; i < 7u; ++i) c0[i] = (float)sm->c0[k_of_col[i]];
-  float bwc[7]; /* B_WW c0 */
+  return (double)bias_f(nz, i, j);
+}
+
+/* In float64 although B and c0 are float32: B_yy - 2 c0' B_y + c0' B c0 (the
+ * noise's share of the centred residual) cancels; formed in float32 it moved
+ * PE_K1 of a poorly determined window by 10 % (tools/studies/compare). */
+static void apply(bg_sums_t *sm, const bg_noise_t *nz, double f, double m)
+{
+  double c0[7];
+  for (unsigned int i = 0; i < 7u; ++i) c0[i] = sm->c0[k_of_col[i]];
+  double bwc[7]; /* B_WW c0 */
   for (unsigned int i = 0; i < 7u; ++i) {
-    bwc[i] = 0.0f;
-    for (unsigned int j = 0; j < 7u; ++j) bwc[i] += bias_f(nz, i, j) * c0[j];
+    bwc[i] = 0.0;
+    for (unsigned int j = 0; j < 7u; ++j) bwc[i] += bias_at(nz, i, j) * c0[j];
   }
-  float cbc = 0.0f, cby = 0.0f;
+  double cbc = 0.0, cby = 0.0;
   for (unsigned int i = 0; i < 7u; ++i) {
-    for (unsigned int j = 0; j < 7u; ++j) sm->rw[k_of_col[i]][k_of_col[j]] -= (double)(ff * bias_f(nz, i, j));
-    sm->rwy[k_of_col[i]] -= (double)(ff * bias_f(nz, i, 7u));
-    sm->rwe[k_of_col[i]] -= f * ((double)bias_f(nz, i, 7u) - (double)bwc[i]);
+    for (unsigned int j = 0; j < 7u; ++j) sm->rw[k_of_col[i]][k_of_col[j]] -= f * bias_at(nz, i, j);
+    sm->rwy[k_of_col[i]] -= f * bias_at(nz, i, 7u);
+    sm->rwe[k_of_col[i]] -= f * (bias_at(nz, i, 7u) - bwc[i]);
     cbc += c0[i] * bwc[i];
-    cby += c0[i] * bias_f(nz, i, 7u);
+    cby += c0[i] * bias_at(nz, i, 7u);
   }
-  const double b77 = (double)bias_f(nz, 7u, 7u);
-  sm->ry -= (double)(ff * bias_f(nz, 7u, 7u));
-  sm->e_slack = f * (b77 - 2.0 * (double)cby + (double)cbc);
-  sm->ree -= sm->e_slack;
+  sm->ry -= f * bias_at(nz, 7u, 7u);
+  sm->ree -= f * (bias_at(nz, 7u, 7u) - 2.0 * cby + cbc);
+  sm->e_slack = f * (bias_at(nz, 7u, 7u) - 2.0 * cby + cbc);
   /* column 3 is -m column 4, for the noise as for everything */
   for (unsigned int j = 0; j < 8u; ++j) sm->rw[2][j] = -m * sm->rw[3][j];
   for (unsigned int i = 0; i < 8u; ++i) sm->rw[i][2] = -m * sm->rw[i][3];
@@ -72,7 +70,7 @@ void imest__bg_noise_subtract(bg_sums_t *sums, bg_noise_t *nz, double m)
   }
   nz->scale = (double)f;
   sums->e_slack = 0.0;
-  if (f > 0.0f) apply(sums, nz, f, m);
+  if (f > 0.0f) apply(sums, nz, (double)f, m);
   nz->e_c0 = sums->e_slack;
 }
 
