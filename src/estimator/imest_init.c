@@ -331,7 +331,7 @@ static void init_isr_constants(imest_t *s, const imest_config_t *cfg, double m)
     s->dcb_a = wd / (1.0f + wd); /* backward Euler: stable for any wd */
   }
   design_bw3(&s->bw, (double)cfg->filter_hz, (double)fs);
-  imest__bg_noise_gains(&s->bw, (double)fs, s->noise_g);
+  imest__bg_noise_gains(&s->bw, fs, s->noise_g);
   design_aa(&s->aa, (double)cfg->aa_hz, (double)fs);
   s->aa_on = cfg->aa_hz > 0.0f;
   design_angle(&s->obs, cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz, fs);
@@ -418,10 +418,10 @@ int imest_init(imest_t *s, const imest_config_t *cfg)
   init_background_constants(s, cfg);
   /* first centring: nominal T_R, and gamma with R_S = 0 (any c0 is correct;
    * a close one only improves float32 precision) */
-  const double k2 = 1.0 / (double)cfg->tr_nominal_s;
-  const double k1 = m * k2;
-  imest__bg_centre_from_k(s->win[0].c0, k1, k2, m);
-  imest__bg_centre_from_k(s->win[1].c0, k1, k2, m);
+  const imest_real_t k2 = RL(1) / (imest_real_t)cfg->tr_nominal_s;
+  const imest_real_t k1 = s->m * k2;
+  imest__bg_centre_from_k(s->win[0].c0, k1, k2, s->m);
+  imest__bg_centre_from_k(s->win[1].c0, k1, k2, s->m);
   s->win[0].flags = s->warm ? IMEST_FLAG_WARMUP : 0u;
   return IMEST_OK;
 }

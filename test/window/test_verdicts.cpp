@@ -704,6 +704,43 @@ TEST(Verdict, RsOutOfRangeBoundaries)
   EXPECT_TR_REASON(judge(sc), IMEST_REASON_RS_OUT_OF_RANGE);
 }
 
+// The checks compare in float32 (bg_validity.c, judge_t): the result's
+// float64 figure rounded to float32 against a float32 threshold. A verdict
+// may then differ from float64's only within a float32 rounding of the
+// threshold; 1e-6 relative away (17 of them) it is float64's, for each
+// threshold the checks compare with. At the edge itself: a figure above the
+// threshold by less than half a float32 step rounds onto it and passes.
+TEST(Verdict, Float32ThresholdsFlipOnlyAtTheEdge)
+{
+  const double d = 1e-6, edge = std::ldexp(1.0, -26); // below float32's half step (2^-24)
+  // the figure *fig 1e-6 below and above lim: valid, then refused for why
+  auto around = [&](Win &x, double *fig, double lim, int why) {
+    *fig = lim * (1.0 - d);
+    EXPECT_VALID(judge(x));
+    *fig = lim * (1.0 + d);
+    EXPECT_TR_REASON(judge(x), why);
+  };
+  Win x = build(paper_scene());
+  x.r.e_i_noise = 0.0;
+  around(x, &x.r.e_i, (double)x.s.max_ei, IMEST_REASON_HIGH_RESIDUAL);
+  x.r.e_i = (double)x.s.max_ei * (1.0 + edge); // float64 would refuse it
+  EXPECT_VALID(judge(x));
+  x = build(paper_scene());
+  around(x, &x.r.pe_k2_rel, (double)x.s.max_pe_k2_rel, IMEST_REASON_POORLY_DETERMINED);
+  x = build(paper_scene());
+  x.s.rs_max_ohm = (float)x.r.rs_ohm;
+  around(x, &x.r.rs_ohm, (double)x.s.rs_max_ohm, IMEST_REASON_RS_OUT_OF_RANGE);
+  x.r.rs_ohm = (double)x.s.rs_max_ohm * (1.0 + edge);
+  EXPECT_VALID(judge(x));
+  x = build(paper_scene());
+  x.s.tr_nominal_known = 1;
+  x.s.tr_nominal_s = (float)(x.r.tr_s / 1.5);
+  around(x, &x.r.tr_s, 1.5 * (double)x.s.tr_nominal_s, IMEST_REASON_CONSTANTS_MISMATCH); // TR_NOMINAL_MAX
+  x = build(paper_scene());
+  x.s.rs_nominal_ohm = (float)(x.r.rs_ohm / 1.9);
+  around(x, &x.r.rs_ohm, 1.9 * (double)x.s.rs_nominal_ohm, IMEST_REASON_CONSTANTS_MISMATCH); // RS_NOMINAL_MAX
+}
+
 // ---------------------------------------------------------------------------
 // The error bounds
 // ---------------------------------------------------------------------------

@@ -23,6 +23,9 @@ static double bias_at(const bg_noise_t *nz, unsigned int i, unsigned int j)
   return (double)bias_f(nz, i, j);
 }
 
+/* In float64 although B and c0 are float32: B_yy - 2 c0' B_y + c0' B c0 (the
+ * noise's share of the centred residual) cancels; formed in float32 it moved
+ * PE_K1 of a poorly determined window by 10 % (tools/studies/compare). */
 static void apply(bg_sums_t *sm, const bg_noise_t *nz, double f, double m)
 {
   double c0[7];
@@ -57,15 +60,17 @@ void imest__bg_noise_subtract(bg_sums_t *sums, bg_noise_t *nz, double m)
    * window is noise and the bias estimate the weakest: take only as much of
    * it as leaves every column (and y) 10 % of its energy. (R_W is nearly
    * singular at constant speed, W6 ~ a^2 W4 and W7 ~ a^2 W1, so definiteness
-   * is no test: the bias has the same near-collinearity.) */
-  double f = nz->steady ? 1.0 : 0.0;
+   * is no test: the bias has the same near-collinearity.) float32: the
+   * energies are of B's magnitudes, which are float32; the share is
+   * continuous where the test flips (0.9 r / b = 1 there). */
+  float f = nz->steady ? 1.0f : 0.0f;
   for (unsigned int i = 0; i < 8u; ++i) {
-    const double r = (i < 7u) ? sums->rw[k_of_col[i]][k_of_col[i]] : sums->ry, b = bias_at(nz, i, i);
-    if (b > 0.9 * r) f = fmin(f, r > 0.0 ? 0.9 * r / b : 0.0);
+    const float r = (float)((i < 7u) ? sums->rw[k_of_col[i]][k_of_col[i]] : sums->ry), b = bias_f(nz, i, i);
+    if (b > 0.9f * r) f = fminf(f, r > 0.0f ? 0.9f * r / b : 0.0f);
   }
-  nz->scale = f;
+  nz->scale = (double)f;
   sums->e_slack = 0.0;
-  if (f > 0.0) apply(sums, nz, f, m);
+  if (f > 0.0f) apply(sums, nz, (double)f, m);
   nz->e_c0 = sums->e_slack;
 }
 

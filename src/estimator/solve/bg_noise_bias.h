@@ -9,8 +9,8 @@
 
 /* The window's noise and its bias on the sums. */
 typedef struct bg_noise {
-  double var_i;   /* white-noise variance of the current per alpha/beta axis [A^2] */
-  double var_u;   /* ... of the voltage [V^2] (0 with the duty-cycle input) */
+  float var_i;    /* white-noise variance of the current per alpha/beta axis [A^2] */
+  float var_u;    /* ... of the voltage [V^2] (0 with the duty-cycle input) */
   double e_c0;    /* E_p^2 the noise explains at the window's centring (subtracted) */
   int steady;     /* the speed was steady: the bias model applies */
   double scale;   /* share of the bias subtracted (1; less where the whole bias

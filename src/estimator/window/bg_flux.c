@@ -108,8 +108,8 @@ void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums
   fx->rs_b = 0.0f;
   r->ls_window_h = (double)NAN;
   if (s->ls_curve_points == 0u) return;
-  const float tr0 = (float)r->tr_s, rs0 = (float)r->rs_ohm, ws = (float)st->slip_rate;
-  const float we = ws + (float)s->n * (float)st->w_mean; /* s->n: float64 in the reference build */
+  const float tr0 = (float)r->tr_s, rs0 = (float)r->rs_ohm, ws = st->slip_rate;
+  const float we = ws + (float)s->n * st->w_mean; /* s->n: float64 in the reference build */
   const float i2 = nreg > 0u ? (float)sm->rw[3][3] / (float)nreg : 0.0f;
   /* The steady-state picture: an estimate, a field, a slip, below the
    * pull-out slip (tr_uncertain's condition). Elsewhere (a run-up, a

@@ -35,11 +35,13 @@ static float bw3_step(const imest_bw3_t *f, bw3_state_t *c, float x)
   return y;
 }
 
-void imest__bg_noise_gains(const imest_bw3_t *bw, double fs, float g[6])
+void imest__bg_noise_gains(const imest_bw3_t *bw, float fs, float g[6])
 {
-  /* float32: gains of a correction, summed over a few hundred samples */
+  /* float32: gains of a correction, summed over a few hundred samples
+   * (0.5 fs and fs^2 are the float64 products rounded: a product of two
+   * float32 numbers is exact in float64) */
   bw3_state_t c = {0.0f, 0.0f, 0.0f};
-  const float f1 = (float)(0.5 * fs), f2 = (float)(fs * fs);
+  const float f1 = 0.5f * fs, f2 = fs * fs;
   float y1 = 0.0f, y2 = 0.0f, peak = 0.0f;
   float acc[6] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
   for (uint32_t n = 0; n < 65536u; ++n) {
@@ -79,29 +81,35 @@ static float quad3(const float *g, const float *a, const float *b)
 void imest__bg_noise_estimate(const imest_t *s, const imest_window_t *w, const bg_window_stats_t *st,
                               const bg_sums_t *sums, int steady, bg_noise_t *nz)
 {
-  const double n = w->nreg > 0u ? (double)w->nreg : 1.0;
-  const double fs = (double)s->fs, np = (double)s->n;
+  /* float32: the noise level is a statistic of the window (its own
+   * scatter is ~1/sqrt(samples), >= 1e-3), a bias estimate that becomes a
+   * correction; the float32 sums of the third differences carry no more
+   * than float32's precision to begin with. Speeds up to speed_limit_rad_s,
+   * variances 1e-12..1e10 A^2, V^2: inside float32's range. */
+  const float n = w->nreg > 0u ? (float)w->nreg : 1.0f;
+  const float np = (float)s->n, fs = (float)s->fs;
   /* the smooth signal's share of the third differences: a sinusoid at the
    * stator frequency, half of |i|^2 on the alpha axis */
-  const double we = np * st->w_mean + st->slip_rate;
+  const float we = np * st->w_mean + st->slip_rate;
   /* 2 sin(x/2) by its series (|x| <= pi: error < 1e-3 of it; libm's sin
    * would cost 5 KB of flash on a soft-double core) */
-  const double x = fmin(fabs(we / fs), IMEST_PI_D), x2 = x * x;
-  const double h = x * (1.0 - x2 * (1.0 / 24.0) * (1.0 - x2 * (1.0 / 80.0) * (1.0 - x2 * (1.0 / 168.0))));
-  const double h6 = h * h * h * h * h * h;
-  const double ni = ((double)w->sum[IMEST_ACC_NOISE_I] + (double)w->blk[IMEST_ACC_NOISE_I]) / n;
-  const double nu = ((double)w->sum[IMEST_ACC_NOISE_U] + (double)w->blk[IMEST_ACC_NOISE_U]) / n;
-  const double i2 = 0.5 * sums->rw[3][3] / n;
-  const double u2 = st->u_ms;
+  const float x = fminf(fabsf(we / fs), IMEST_PI_F), x2 = x * x;
+  const float h =
+      x * (1.0f - x2 * (1.0f / 24.0f) * (1.0f - x2 * (1.0f / 80.0f) * (1.0f - x2 * (1.0f / 168.0f))));
+  const float h3 = h * h * h, h6 = h3 * h3;
+  const float ni = (float)(w->sum[IMEST_ACC_NOISE_I] + w->blk[IMEST_ACC_NOISE_I]) / n;
+  const float nu = (float)(w->sum[IMEST_ACC_NOISE_U] + w->blk[IMEST_ACC_NOISE_U]) / n;
+  const float i2 = 0.5f * (float)sums->rw[3][3] / n;
+  const float u2 = st->u_ms;
   /* two current sensors (the third computed: the zero sequence is exactly
    * zero) give beta 5/3 of alpha's noise: 4/3 per axis on average */
   const int two = w->sum[IMEST_ACC_I0A] == (imest_real_t)0 && w->sum[IMEST_ACC_I0B] == (imest_real_t)0;
-  nz->var_i = fmax(0.0, ni - h6 * i2) / 20.0 * (two ? 4.0 / 3.0 : 1.0);
-  nz->var_u = fmax(0.0, nu - h6 * u2) / 20.0;
+  nz->var_i = fmaxf(0.0f, ni - h6 * i2) / 20.0f * (two ? 4.0f / 3.0f : 1.0f);
+  nz->var_u = fmaxf(0.0f, nu - h6 * u2) / 20.0f;
   nz->scale = 1.0;
   nz->steady = steady;
   /* the columns W1 W2 W4 W5 W6 W7 W8 y in one row (docs/METHOD.md §2, b = n w' = 0) */
-  const float a = (float)(np * st->w_mean), a2 = a * a, a3 = a2 * a;
+  const float a = np * st->w_mean, a2 = a * a, a3 = a2 * a;
   const float m = (float)s->m, m1 = 1.0f + m;
   static const coef_t zero = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, {0.0f, 0.0f}};
   coef_t c[8];
@@ -125,9 +133,9 @@ void imest__bg_noise_estimate(const imest_t *s, const imest_window_t *w, const b
   c[7].v[1] = -1.0f;
 
   const float inv_s = (float)s->inv_s;
-  const float vi = (float)nz->var_i, vv = (float)nz->var_u * inv_s * inv_s;
+  const float vi = nz->var_i, vv = nz->var_u * inv_s * inv_s;
   const float *g = s->noise_g;
-  const float twice_n = (float)(2.0 * n); /* two rows, every sample */
+  const float twice_n = 2.0f * n; /* two rows, every sample */
   unsigned int p = 0;
   for (unsigned int i = 0; i < 8u; ++i) {
     for (unsigned int j = i; j < 8u; ++j) {

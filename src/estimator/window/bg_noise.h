@@ -12,7 +12,7 @@
  * (filter and central differences) for unit white noise at its input, packed
  * (xx, x dx, x d2x, dx dx, dx d2x, d2x d2x). Bounded: at most 65536 samples
  * of the impulse response. */
-void imest__bg_noise_gains(const imest_bw3_t *bw, double fs, float g[6]);
+void imest__bg_noise_gains(const imest_bw3_t *bw, float fs, float g[6]);
 
 /* The noise variances from the window's third differences (the smooth
  * signal's share removed), and the bias they put into the sums for the

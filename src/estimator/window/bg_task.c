@@ -54,12 +54,14 @@ static void result_header(const imest_t *s, const imest_window_t *w, imest_resul
 static void window_sums(imest_t *s, const imest_window_t *w, double m, bg_step_t *x, imest_result_t *out)
 {
   imest__bg_window_sums(w, m, (double)s->fs, &x->sums, &x->st);
-  const double w_before = (double)s->w_prev_rad_s;
-  x->steady =
-      w->used > 0u && s->w_prev_valid &&
-      fabs(x->st.w_mean - w_before) <=
-          IMEST_STEADY_REL_LIT * fmax(fabs(x->st.w_mean), fabs(w_before)) + IMEST_STEADY_ABS_RAD_S_LIT;
-  s->w_prev_rad_s = (float)x->st.w_mean;
+  /* float32, as the ISR's own test (isr_engage_observer): a 2 % tolerance on
+   * speeds of at most speed_limit_rad_s; the mean rounded to float32
+   * (relative 6e-8) moves the verdict only at the tolerance's edge */
+  const float w_now = x->st.w_mean, w_before = s->w_prev_rad_s;
+  x->steady = w->used > 0u && s->w_prev_valid &&
+              fabsf(w_now - w_before) <= (float)IMEST_STEADY_REL_LIT * fmaxf(fabsf(w_now), fabsf(w_before)) +
+                                             (float)IMEST_STEADY_ABS_RAD_S_LIT;
+  s->w_prev_rad_s = w_now;
   s->w_prev_valid = w->used > 0u;
   imest__bg_noise_estimate(s, w, &x->st, &x->sums, x->steady, &x->nz);
   x->ry_raw = x->sums.ry;
@@ -67,8 +69,8 @@ static void window_sums(imest_t *s, const imest_window_t *w, double m, bg_step_t
   x->sums.noise = &x->nz;
   x->sums.noise_f = x->nz.scale;
   x->sums.noise_m = m;
-  out->noise_i_a = sqrt(x->nz.var_i);
-  out->noise_u_v = sqrt(x->nz.var_u);
+  out->noise_i_a = (double)sqrtf(x->nz.var_i);
+  out->noise_u_v = (double)sqrtf(x->nz.var_u);
 }
 
 /* Too little information in the window before (poorly determined, nothing
@@ -173,13 +175,13 @@ static void combine_after(imest_t *s, const imest_window_t *w, const bg_step_t *
 /* Centre later windows on the latest trusted K (T_R valid: R_S may be
  * refused for its own bound while K1, K2 are well determined); clear the
  * buffer and release it to the ISR. */
-static void release_window(imest_t *s, imest_window_t *w, double m, const imest_result_t *out)
+static void release_window(imest_t *s, imest_window_t *w, const imest_result_t *out)
 {
   if (out->tr_valid) {
     s->last_k1 = (float)out->k1;
     s->last_k2 = (float)out->k2;
   }
-  if (s->last_k2 > 0.0f) imest__bg_centre_from_k(w->c0, (double)s->last_k1, (double)s->last_k2, m);
+  if (s->last_k2 > 0.0f) imest__bg_centre_from_k(w->c0, s->last_k1, s->last_k2, s->m);
   for (unsigned int p = 0; p < IMEST_NACC; ++p) {
     w->sum[p] = 0;
     w->blk[p] = 0;
@@ -206,6 +208,6 @@ int imest_background(imest_t *s, imest_result_t *out)
   imest__bg_flux(s, &x.st, &x.sums, w->nreg, out, &fx); /* L_S at the window's flux (a curve given) */
   imest__bg_judge(s, w, &x.st, &x.sums, &so, &fx, x.steady, out);
   combine_after(s, w, &x, out);
-  release_window(s, w, m, out);
+  release_window(s, w, out);
   return 1;
 }

@@ -35,12 +35,12 @@ typedef struct {
 /* Constants of the checks (their reasons where they are used):
  * R_S within what heating explains around its nominal: 20 C .. 200 C copper
  * and a 10 % data-sheet error. */
-#define RS_NOMINAL_MIN     0.7
-#define RS_NOMINAL_MAX     1.9
+#define RS_NOMINAL_MIN     0.7f
+#define RS_NOMINAL_MAX     1.9f
 /* T_R within its band around a known nominal: the rotor heats (T_R falls to
  * about 0.6 of cold) and data-sheet values are off. */
-#define TR_NOMINAL_MIN     0.45
-#define TR_NOMINAL_MAX     1.5
+#define TR_NOMINAL_MIN     0.45f
+#define TR_NOMINAL_MAX     1.5f
 /* L_S at no load that differs from ls_h by more than this cannot be the motor's. */
 #define LS_NOLOAD_TOL      0.06f
 /* No load: slip ratio below this (L_S measured 1 % low), field above 5 Hz. */
@@ -48,7 +48,7 @@ typedef struct {
 #define NOLOAD_MIN_HZ      5.0f
 /* At rest: the mean speed below this (about 10 rpm; an encoder toggling by
  * a count averages to zero here). */
-#define AT_REST_RAD_S      1.0
+#define AT_REST_RAD_S      1.0f
 /* A current-sensor gain mismatch |E| worth flagging (0.2 %). */
 #define GAIN_MISMATCH_FLAG 0.002f
 /* The wiring checks: judged above this field frequency only. */
@@ -58,12 +58,12 @@ static void operating_point(const imest_t *s, const bg_window_stats_t *st, const
                             op_point_t *op)
 {
   const float n = nreg > 0u ? (float)nreg : 1.0f;
-  const float slip_rate = (float)st->slip_rate;
-  op->we = (float)(slip_rate + s->n * (float)st->w_mean);
+  const float slip_rate = st->slip_rate;
+  op->we = (float)(slip_rate + s->n * st->w_mean);
   op->slip = fabsf(op->we) > 0.0f ? slip_rate / op->we : 0.0f;
   /* W1.W4 - W2.W4 = u.i / (sigma L_S) exactly (i_perp.i = 0) */
   op->p_w = (float)((float)(sm->rw[0][3] - sm->rw[1][3]) / s->inv_s / n);
-  const float i2 = fmaxf((float)sm->rw[3][3] / n, 0.0f), u2 = fmaxf(2.0f * (float)st->u_ms, 0.0f);
+  const float i2 = fmaxf((float)sm->rw[3][3] / n, 0.0f), u2 = fmaxf(2.0f * st->u_ms, 0.0f);
   op->i2 = i2;
   op->s_va = sqrtf(i2 * u2); /* balanced: |u|^2 = 2 u_alpha^2 */
   op->z_ohm = i2 > 0.0f ? sqrtf(u2 / i2) : 0.0f;
@@ -250,6 +250,14 @@ typedef struct {
   const bg_solve_out_t *so;
   imest_result_t *r;
   op_point_t op;
+  /* The result's figures the checks compare, in float32 (converted once,
+   * in imest__bg_judge): every check is a comparison with a float32 config
+   * value or a product of float32 constants, and a figure rounded to float32
+   * (relative 6e-8) against a threshold can change a verdict only where the
+   * float64 figure lies within that of the threshold: at the edge, where
+   * either verdict is as right. Finiteness is judged on the float64 figures
+   * (imest__bg_finite): a finite float64 beyond FLT_MAX stays finite. */
+  float tr, rs, e_i, e_i_noise, pe_k2_rel;
   int steady;
   float tr_b, rs_b, g_b; /* T_R's and R_S's systematic bounds, the gain mismatch's share */
   float c_tr, c_rs;      /* the constants' share of tr_b and rs_b (in them) */
@@ -282,13 +290,13 @@ static inline int warmup(judge_t *j)
  * rest with excitation, not without current. */
 static inline int low_current(judge_t *j)
 {
-  return !(j->st->i_rms_a >= (double)j->s->min_current_a);
+  return !(j->st->i_rms_a >= j->s->min_current_a);
 }
 static inline int low_current_at_rest(judge_t *j)
 {
-  const double ia = (double)j->w->off_ia, ib = (double)j->w->off_ib;
-  const int dc = sqrt(ia * ia + ib * ib) >= (double)j->s->min_current_a;
-  return low_current(j) && dc && fabs(j->st->w_mean) < AT_REST_RAD_S;
+  const float ia = (float)j->w->off_ia, ib = (float)j->w->off_ib;
+  const int dc = sqrtf(ia * ia + ib * ib) >= j->s->min_current_a;
+  return low_current(j) && dc && fabsf(j->st->w_mean) < AT_REST_RAD_S;
 }
 /* ls_h, sigma, pole_pairs, rs_nominal_ohm */
 static inline int wiring(judge_t *j)
@@ -304,11 +312,11 @@ static inline int ls_mismatch(judge_t *j)
 /* min_slip_ratio */
 static inline int low_slip(judge_t *j)
 {
-  return !(j->r->slip_ratio >= (double)j->s->min_slip_ratio);
+  return !((float)j->r->slip_ratio >= j->s->min_slip_ratio); /* slip_ratio is a float32 product */
 }
 static inline int low_slip_at_rest(judge_t *j)
 {
-  return low_slip(j) && fabs(j->st->w_mean) < AT_REST_RAD_S;
+  return low_slip(j) && fabsf(j->st->w_mean) < AT_REST_RAD_S;
 }
 static inline int solve_numeric(judge_t *j)
 {
@@ -333,40 +341,43 @@ static inline int not_minimum(judge_t *j)
  * max_pe_k2_rel^2. */
 static inline int poorly_determined(judge_t *j)
 {
-  const imest_result_t *r = j->r;
-  const double f = r->e_i > 0.0 ? fmin(1.0, (r->e_i_noise * r->e_i_noise) / (r->e_i * r->e_i)) : 1.0;
-  const double pe2 = r->pe_k2_rel * r->pe_k2_rel * ((1.0 - f) + f / (double)r->windows);
-  return !(pe2 <= (double)j->s->max_pe_k2_rel * (double)j->s->max_pe_k2_rel);
+  /* float32: e_i, e_i_noise ~1e-3..10 and pe ~1e-4..1e30 (BG_PE_UNBOUNDED)
+   * squared stay inside float32's range (pe^2 of an unbounded index is
+   * inf: poorly determined, as in float64); a few roundings of 6e-8 */
+  const float ei = j->e_i, en = j->e_i_noise, pe = j->pe_k2_rel, lim = j->s->max_pe_k2_rel;
+  const float f = ei > 0.0f ? fminf(1.0f, (en * en) / (ei * ei)) : 1.0f;
+  const float pe2 = pe * pe * ((1.0f - f) + f / (float)j->r->windows);
+  return !(pe2 <= lim * lim);
 }
 /* max_ei: the residual beyond what the sensors' white noise explains */
 static inline int high_residual(judge_t *j)
 {
-  const imest_result_t *r = j->r;
-  const double em = sqrt(fmax(0.0, r->e_i * r->e_i - r->e_i_noise * r->e_i_noise));
-  return !(em <= (double)j->s->max_ei);
+  /* float32: E_I and its noise share are O(1e-3..10); the difference of
+   * their squares loses only what a 6e-8 rounding of each is worth */
+  const float em = sqrtf(fmaxf(0.0f, j->e_i * j->e_i - j->e_i_noise * j->e_i_noise));
+  return !(em <= j->s->max_ei);
 }
 /* rs_min_ohm, rs_max_ohm */
 static inline int rs_out_of_range(judge_t *j)
 {
-  return !(j->r->rs_ohm >= (double)j->s->rs_min_ohm && j->r->rs_ohm <= (double)j->s->rs_max_ohm);
+  return !(j->rs >= j->s->rs_min_ohm && j->rs <= j->s->rs_max_ohm);
 }
 /* rs_nominal_ohm: constants that cannot be the motor's */
 static inline int rs_off_nominal(judge_t *j)
 {
-  const double rn = (double)j->s->rs_nominal_ohm;
-  return j->s->rs_nominal_ohm > 0.0f &&
-         !(j->r->rs_ohm >= RS_NOMINAL_MIN * rn && j->r->rs_ohm <= RS_NOMINAL_MAX * rn);
+  const float rn = j->s->rs_nominal_ohm;
+  return rn > 0.0f && !(j->rs >= RS_NOMINAL_MIN * rn && j->rs <= RS_NOMINAL_MAX * rn);
 }
 /* tr_nominal_s (when given) */
 static inline int tr_off_nominal(judge_t *j)
 {
-  const double tn = (double)j->s->tr_nominal_s;
-  return j->s->tr_nominal_known && !(j->r->tr_s >= TR_NOMINAL_MIN * tn && j->r->tr_s <= TR_NOMINAL_MAX * tn);
+  const float tn = j->s->tr_nominal_s;
+  return j->s->tr_nominal_known && !(j->tr >= TR_NOMINAL_MIN * tn && j->tr <= TR_NOMINAL_MAX * tn);
 }
 /* never a confident non-finite number */
 static inline int not_finite(judge_t *j)
 {
-  return !(isfinite(j->r->tr_s) && isfinite(j->r->rs_ohm) && isfinite(j->r->e_i));
+  return !(imest__bg_finite(j->r->tr_s) && imest__bg_finite(j->r->rs_ohm) && imest__bg_finite(j->r->e_i));
 }
 /* tr_tolerance, ls_uncertainty, sigma_uncertainty: the constants' share alone
  * (judged where T_R's bound is: j->tr_judged) */
@@ -460,12 +471,12 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
   j->g_b = 0.0f;
   j->c_tr = 0.0f; /* without an estimate the total's INFINITY says tr_uncertain */
   j->c_rs = 0.0f;
-  if (have && isfinite(r->rs_ohm) && r->rs_ohm > 0.0) {
-    const float rs = (float)r->rs_ohm;
+  if (have && imest__bg_finite(r->rs_ohm) && j->rs > 0.0f) {
+    const float rs = j->rs;
     float harm_v;
     const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &harm_v);
-    systematic_bounds(j->s, j->w, &j->op, (float)j->st->slip_rate, (float)r->tr_s, rs, dv_v, harm_v, &j->tr_b,
-                      &j->rs_b, &j->c_tr, &j->c_rs);
+    systematic_bounds(j->s, j->w, &j->op, j->st->slip_rate, j->tr, rs, dv_v, harm_v, &j->tr_b, &j->rs_b,
+                      &j->c_tr, &j->c_rs);
     /* the magnetising curve's share (bg_flux.c), where T_R's bound is finite;
      * nothing without a curve (the outputs stay as without it) */
     if (fx != NULL && j->s->ls_curve_points != 0u && isfinite(j->tr_b)) {
@@ -483,18 +494,26 @@ void imest__bg_judge(imest_t *s, const imest_window_t *w, const bg_window_stats_
 {
   judge_t j = {.s = s, .w = w, .st = st, .so = so, .r = r, .steady = steady};
   operating_point(s, st, sm, w->nreg, &j.op);
-  r->i_rms_a = st->i_rms_a;
-  const int have = so->status == IMEST_OK && isfinite(r->tr_s) && r->tr_s > 0.0;
+  r->i_rms_a = (double)st->i_rms_a;
+  j.tr = (float)r->tr_s;
+  j.rs = (float)r->rs_ohm;
+  j.e_i = (float)r->e_i;
+  j.e_i_noise = (float)r->e_i_noise;
+  j.pe_k2_rel = (float)r->pe_k2_rel;
+  /* a positive T_R of the solve is >= tr_min_s, far above float32's least
+   * normal number: j.tr > 0 is r->tr_s > 0 */
+  const int have = so->status == IMEST_OK && imest__bg_finite(r->tr_s) && j.tr > 0.0f;
   /* Excitation: the mean rotation rate of the rotor-frame current vector
    * (sum of i x di/dt over sum of |i|^2) times T_R: in steady state the
    * slip frequency x T_R, the ratio of rotor to magnetising current (noise
    * averages out of it: 0.004..0.008 at no load with 12-bit sensors, 1.1 at
    * rated load). Below 0.1 T_R is weakly observable. With the estimate's
    * T_R (the motor's, for any size; the nominal T_R where there is none). */
-  r->slip_ratio = (double)(fabsf((float)st->slip_rate) * (have ? (float)r->tr_s : s->tr_nominal_s));
+  const float slip_rate = st->slip_rate;
+  r->slip_ratio = (double)(fabsf(slip_rate) * (have ? j.tr : s->tr_nominal_s));
   r->ls_noload_h = (double)NAN; /* the no-load check fills it where it runs */
   bounds(&j, sm, fx, have);
-  j.tr_judged = (float)st->slip_rate * (float)r->tr_s * s->sigma < 1.0f;
+  j.tr_judged = slip_rate * j.tr * s->sigma < 1.0f;
   const int status = tr_verdict(&j);
   const int rs_status = status != IMEST_REASON_NONE ? status : rs_verdict(&j);
   r->tr_reason = status;

@@ -62,24 +62,28 @@ void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums
 
   /* the sums hold every second used sample (isr_accumulate.h); the angle
    * steps all of them */
-  const double n = w->nreg > 0u ? (double)w->nreg : 1.0;
-  const double n_used = w->used > 0u ? (double)w->used : 1.0;
-  const double r44 = out->rw[3][3];
-  st->i_rms_a = sqrt(fmax(r44, 0.0) / n);
-  st->w_mean = (double)w->rot * fs / n_used;
-  const double cross = (double)w->sum[IMEST_ACC_ROT] + (double)w->blk[IMEST_ACC_ROT];
-  st->slip_rate = (r44 > 0.0) ? cross / r44 : 0.0;
-  st->u_ms = ((double)w->sum[IMEST_ACC_UU] + (double)w->blk[IMEST_ACC_UU]) / n;
+  const float n = w->nreg > 0u ? (float)w->nreg : 1.0f;
+  const float n_used = w->used > 0u ? (float)w->used : 1.0f;
+  const float r44 = (float)out->rw[3][3];
+  st->i_rms_a = sqrtf(fmaxf(r44, 0.0f) / n);
+  st->w_mean = (float)w->rot * (float)fs / n_used;
+  const float cross = (float)(w->sum[IMEST_ACC_ROT] + w->blk[IMEST_ACC_ROT]);
+  st->slip_rate = (r44 > 0.0f) ? cross / r44 : 0.0f;
+  st->u_ms = (float)(w->sum[IMEST_ACC_UU] + w->blk[IMEST_ACC_UU]) / n;
 }
 
-/* Centring vector c0 (7-column form) for a given K1, K2 (docs/METHOD.md §2, §10). */
-void imest__bg_centre_from_k(imest_real_t c0[7], double k1, double k2, double m)
+/* Centring vector c0 (7-column form) for a given K1, K2 (docs/METHOD.md §2, §10),
+ * in the ISR's type: any c0 is correct (the background undoes it exactly,
+ * imest__bg_window_sums), a close one only keeps the ISR's float32 sums
+ * small, so a rounding more or less in it changes nothing that matters. */
+void imest__bg_centre_from_k(imest_real_t c0[7], imest_real_t k1, imest_real_t k2, imest_real_t m)
 {
-  c0[0] = (imest_real_t)k1;
-  c0[1] = (imest_real_t)k2;
-  c0[2] = (imest_real_t)(k1 * k2 - m * k2 * k2); /* K4 - m K3 (column 3 folded into 4) */
-  c0[3] = (imest_real_t)(1.0 / k2);
-  c0[4] = (imest_real_t)(k1 / k2);
-  c0[5] = (imest_real_t)(k1 / (k2 * k2));
-  c0[6] = (imest_real_t)(1.0 / (k2 * k2));
+  const imest_real_t ik = RL(1) / k2;
+  c0[0] = k1;
+  c0[1] = k2;
+  c0[2] = k2 * (k1 - m * k2); /* K4 - m K3 (column 3 folded into 4) */
+  c0[3] = ik;
+  c0[4] = k1 * ik;
+  c0[5] = k1 * ik * ik;
+  c0[6] = ik * ik;
 }
