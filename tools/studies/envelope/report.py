@@ -422,6 +422,26 @@ def render_real(fam, rows, table, meta):
                      f"{_w(analyse.median(r)) if r else '–'} |")
         L.append("")
 
+    if wrong:
+        L.append("## The largest valid-and-wrong windows per family, against their bounds\n")
+        L.append("The error bound a valid verdict stated (`tr_bound_rel`, `rs_bound_rel`) against the "
+                 "error it had: the bound missed by the difference.\n")
+        L.append("| family | recording | window | e_TR | T_R bound | e_TR against L_R/R_R | e_RS | R_S bound | "
+                 "pe_k2_rel | E_I |")
+        L.append("|---|---|---|---|---|---|---|---|---|---|")
+        for f in fam:
+            def size(w):
+                a = abs(w["e_tr"]) / analyse.REAL_TR if w["tr_valid"] else 0.0
+                b = abs(w["e_rs"]) / analyse.REAL_RS if w["rs_valid"] else 0.0
+                return max(a, b)
+            for w in sorted((w for w in wrong if w["family"] == f), key=size, reverse=True)[:3]:
+                L.append(f"| {f} | {w['name'][len(f) + 1:]} | {w['seq']} | "
+                         f"{_w(w['e_tr']) + (' (valid)' if w['tr_valid'] else '')} | "
+                         f"{_w(w['tr_bound_rel'])} | {_w(w['e_tr_lrrr'])} | "
+                         f"{_w(w['e_rs']) + (' (valid)' if w['rs_valid'] else '')} | {_w(w['rs_bound_rel'])} | "
+                         f"{w['pe_k2_rel']:.3g} | {w['E_I']:.3g} |")
+        L.append("")
+
     L.append("## Refusals\n")
     L.append("| family | T_R refused (reasons) | R_S refused (reasons) |")
     L.append("|---|---|---|")
