@@ -61,8 +61,8 @@ REAL_FAMILIES = [
     ("real_fw_all", "--real-motor", "phase"),
 ]
 REAL_MOTORS = ["0.4kw", "4kw", "11kw", "37kw"]  # --real-motor needs a preset's nameplate
-REAL_FREQS = [25, 50, 75, 100]
-REAL_LOADS = [25, 50, 75, 100]
+REAL_FREQS = [25, 50, 100]
+REAL_LOADS = [25, 50, 100]
 # The field-weakening families' points: FW_FREQ % of rated frequency at the rated voltage (the
 # voltage limit; the flux falls as 1/f), loads of FW_POWERS % of rated power (the torque
 # FW_POWERS % x f_n / f of rated: the constant-power range of a drive).
