@@ -342,7 +342,7 @@ static double tr_ifoc(const imsim_real_t *rm, double lm, double rr, double llr, 
   const double tr = (lm + llr) / rr;
   if (!rm->fe) return tr;
   const double ws = fabs(wsl) > 1e-6 ? wsl : (wsl < 0.0 ? -1e-6 : 1e-6); /* as tr_s's 1e-6 */
-  const double k = lm * we / rm->rfe_ohm; /* omega_e L_m / R_fe */
+  const double k = lm * we / rm->rfe_ohm;                                /* omega_e L_m / R_fe */
   return (tr + k / ws) / (1.0 - ws * llr / rr * k);
 }
 
@@ -374,8 +374,8 @@ void ims_rm_fill(imsim_t *s, imsim_sample_t *o)
   o->rr_eff_ohm = z.re;
   o->lr_eff_h = o->lm_h + z.im / we;
   o->tr_s = o->lr_eff_h / o->rr_eff_ohm;
-  o->tr_ifoc_s = slip_known ? tr_ifoc(rm, o->lm_h, z.re, z.im / we, wsl + (double)s->c.pole_pairs * s->w, wsl)
-                             : o->tr_s;
+  o->tr_ifoc_s =
+      slip_known ? tr_ifoc(rm, o->lm_h, z.re, z.im / we, wsl + (double)s->c.pole_pairs * s->w, wsl) : o->tr_s;
 }
 
 /* ---- phasor steady state ------------------------------------------------------------------ */

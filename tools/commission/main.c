@@ -99,7 +99,8 @@ static int print_apply_args(const imest_comm_result_t *r)
   printf(" --ls-uncertainty %.9g --rs %.9g", (double)cfg.ls_uncertainty, (double)cfg.rs_nominal_ohm);
   if (cfg.tr_nominal_s != tr0) printf(" --tr-nominal %.9g", (double)cfg.tr_nominal_s);
   for (unsigned int k = 0; k < cfg.ls_curve_points; ++k)
-    printf("%s%.9g:%.9g", k == 0u ? " --ls-curve " : ",", (double)cfg.ls_curve_i_a[k], (double)cfg.ls_curve_h[k]);
+    printf("%s%.9g:%.9g", k == 0u ? " --ls-curve " : ",", (double)cfg.ls_curve_i_a[k],
+           (double)cfg.ls_curve_h[k]);
   const imest_inverter_t *v = &cfg.inverter;
   printf("\n--dead-time %.9g --v-switch %.9g --r-switch %.9g --v-diode %.9g --r-diode %.9g --i-band %.9g "
          "--inverter-uncertainty %.9g\n",
@@ -226,11 +227,13 @@ int main(int argc, char **argv)
       char *end = NULL;
       const int single = strcmp(rv, "single") == 0;
       o.rotor_cage_ratio = strncmp(rv, "double-cage:", 12) == 0 ? strtod(rv + 12, &end) : 0.0;
-      if (!single && (end == NULL || *end != '\0' || !(o.rotor_cage_ratio > 1.0 && o.rotor_cage_ratio <= 4.0))) {
+      if (!single &&
+          (end == NULL || *end != '\0' || !(o.rotor_cage_ratio > 1.0 && o.rotor_cage_ratio <= 4.0))) {
         fprintf(stderr, "%s: --rotor needs single or double-cage:RATIO with RATIO in (1, 4]\n", k_prog);
         return 2;
       }
-      o.real_off = single ? o.real_off | COMM_SIM_OFF_DOUBLE_CAGE : o.real_off & ~(unsigned)COMM_SIM_OFF_DOUBLE_CAGE;
+      o.real_off =
+          single ? o.real_off | COMM_SIM_OFF_DOUBLE_CAGE : o.real_off & ~(unsigned)COMM_SIM_OFF_DOUBLE_CAGE;
     } else if (tool_args_is(&a, "--csv")) {
       if (tool_args_flag(&a)) return 2;
       csv = 1;

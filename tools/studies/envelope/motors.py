@@ -173,7 +173,7 @@ def library_commissioning(m, effects, commission, cache_dir, inverter_flags):
     real-motor flags `effects` (the same flags imest-commission takes): imest-commission
     --apply-args (the config imest_comm_apply() fills, as imest-replay options) on the preset
     with those effects, on a drive with the inverter of inverter_flags. Cached in
-    cache_dir/<motor>_<effects>.txt (run once per motor and family). Returns dict: `args` (the
+    a file per motor and effects in cache_dir (run once per motor and family). Returns dict: `args` (the
     constants' options), `inverter` (the inverter model's), and the values for the tables (np,
     ls, sigma or None when commissioning leaves it to the data sheet, ls_unc, sigma_unc, rs, tr,
     curve = the magnetising curve's points)."""
