@@ -21,7 +21,7 @@ static const char HEADER[] =
     "ifoc_torque_ref_nm,ifoc_flux_ref_wb,ifoc_tr_s,ifoc_speed_ref_rad_s,"
     "d_a,d_b,d_c,v_dc";
 /* Appended when a real-motor effect is on (sim/README.md, Real-motor effects). */
-static const char HEADER_REAL[] = ",psi_m_wb,lm_h,lr_eff_h,rr_eff_ohm,p_fe_w";
+static const char HEADER_REAL[] = ",psi_m_wb,lm_h,lr_eff_h,rr_eff_ohm,p_fe_w,T_R_ifoc_s";
 
 const char *imsim_cli_header(void)
 {
@@ -113,7 +113,8 @@ static const char USAGE[] =
     "  --integrator fast|rk4 (fast; rk4 = slow reference)  --rk4-substeps N (8)\n"
     "  --steps-per-sample N  steps per sample for the ideal supplies (0 = auto: 5; PWM: fixed)\n"
     "real-motor effects (all off by default; any on: flux-linkage model, sub-stepped RK4, and the\n"
-    "CSV gains psi_m_wb,lm_h,lr_eff_h,rr_eff_ohm,p_fe_w; see sim/README.md, Real-motor effects):\n"
+    "CSV gains psi_m_wb,lm_h,lr_eff_h,rr_eff_ohm,p_fe_w,T_R_ifoc_s; see sim/README.md, Real-motor\n"
+    "effects):\n"
     "  --saturation F        main-flux saturation: static L_m at rated flux F below unsaturated,\n"
     "                        0 <= F < 0.6 (0)\n"
     "  --iron-loss F         core-loss resistance across the magnetising branch, sized to F x rated\n"
@@ -557,7 +558,8 @@ void imsim_cli_write_row(FILE *f, const imsim_sample_t *s)
   /* real-motor truth: only when an effect is on (NaN otherwise), so that the record of the
      linear machine keeps its columns */
   if (!isnan(s->psi_m_wb))
-    fprintf(f, ",%.9g,%.9g,%.9g,%.9g,%.9g", s->psi_m_wb, s->lm_h, s->lr_eff_h, s->rr_eff_ohm, s->p_fe_w);
+    fprintf(f, ",%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", s->psi_m_wb, s->lm_h, s->lr_eff_h, s->rr_eff_ohm, s->p_fe_w,
+            s->tr_ifoc_s);
   fputc('\n', f);
 }
 

@@ -329,6 +329,28 @@ double ims_rm_p_rotor(const imsim_t *s)
   return kr * (s->rm.r1_ohm * cabs2(k.i1) + s->rm.r2_ohm * cabs2(k.i2));
 }
 
+/* The T_R an IFOC needs in the steady state: the one for which its slip relation
+   omega_sl = i_q / (T_R i_d) holds, with i_d, i_q the stator current in the frame of the rotor
+   flux psi_R = psi_m + L_lr,eff i_R (the frame in which the rotor current is in quadrature:
+   i_R = -j omega_sl psi_R / R_R,eff). With psi_R real, psi_m = psi_R (1 + j a),
+   a = omega_sl L_lr,eff / R_R,eff, and i_S = psi_m (1/L_m + j omega_e / R_fe) - i_R:
+     i_d = psi_R (1/L_m - a omega_e / R_fe),
+     i_q = psi_R (omega_sl (L_m + L_lr,eff) / (L_m R_R,eff) + omega_e / R_fe),
+   so T_R,ifoc = ((L_m + L_lr,eff)/R_R,eff + L_m omega_e / (omega_sl R_fe)) /
+                 (1 - a L_m omega_e / R_fe).
+   Without iron loss (R_fe infinite) it is L_R,eff / R_R,eff; with it the iron-loss current,
+   in phase with the EMF (in quadrature with the flux), adds to i_q a share that does not scale
+   with the slip, and T_R,ifoc grows without bound as the slip goes to 0 (no load). Slip not yet
+   known (the first sample): tr_s. */
+static double tr_ifoc(const imsim_real_t *rm, double lm, double rr, double llr, double we, double wsl)
+{
+  const double tr = (lm + llr) / rr;
+  if (!rm->fe) return tr;
+  const double ws = fabs(wsl) > 1e-6 ? wsl : (wsl < 0.0 ? -1e-6 : 1e-6); /* as tr_s's 1e-6 */
+  const double k = lm * we / rm->rfe_ohm;                                /* omega_e L_m / R_fe */
+  return (tr + k / ws) / (1.0 - ws * llr / rr * k);
+}
+
 void ims_rm_fill(imsim_t *s, imsim_sample_t *o)
 {
   imsim_real_t *rm = &s->rm;
@@ -354,7 +376,8 @@ void ims_rm_fill(imsim_t *s, imsim_sample_t *o)
                wm_of(rm, x);
   /* slip frequency: the main flux's rotation over the last sample period, less n_p w */
   double wsl = 0.0;
-  if (rm->has_prev && x > 0.0 && cabs2(rm->psi_m_prev) > 0.0) {
+  const bool slip_known = rm->has_prev && x > 0.0 && cabs2(rm->psi_m_prev) > 0.0;
+  if (slip_known) {
     const cpx p = rm->psi_m_prev;
     const double dphi = atan2(p.re * k.psim.im - p.im * k.psim.re, p.re * k.psim.re + p.im * k.psim.im);
     wsl = dphi * s->c.fs_hz - (double)s->c.pole_pairs * s->w;
@@ -366,6 +389,8 @@ void ims_rm_fill(imsim_t *s, imsim_sample_t *o)
   o->rr_eff_ohm = z.re;
   o->lr_eff_h = o->lm_h + z.im / we;
   o->tr_s = o->lr_eff_h / o->rr_eff_ohm;
+  o->tr_ifoc_s =
+      slip_known ? tr_ifoc(rm, o->lm_h, z.re, z.im / we, wsl + (double)s->c.pole_pairs * s->w, wsl) : o->tr_s;
 }
 
 /* ---- phasor steady state ------------------------------------------------------------------ */

@@ -85,7 +85,7 @@ void ims_fill_sample(imsim_t *s, imsim_sample_t *o)
   if (s->rm.on)
     ims_rm_fill(s, o);
   else
-    o->psi_m_wb = o->lm_h = o->lr_eff_h = o->rr_eff_ohm = o->p_fe_w = o->w_mag_j = NAN_D;
+    o->psi_m_wb = o->lm_h = o->lr_eff_h = o->rr_eff_ohm = o->p_fe_w = o->w_mag_j = o->tr_ifoc_s = NAN_D;
   double utrue[2];
   const bool fw = ims_firmware_timing(c);
   if (fw) {

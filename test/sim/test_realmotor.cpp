@@ -308,6 +308,44 @@ TEST(SimRealMotor, TruthColumnsOnlyWithEffects)
   EXPECT_GT(on.back().p_fe_w, 0.0);
   // T_R_true_s = (L_m(|psi_m|) + L_lr,eff) / R_R,eff at the slip frequency
   EXPECT_NEAR(on.back().tr_s, on.back().lr_eff_h / on.back().rr_eff_ohm, 1e-12);
+  EXPECT_TRUE(std::isnan(off.back().tr_ifoc_s));
+  EXPECT_TRUE(std::isfinite(on.back().tr_ifoc_s));
+}
+
+// T_R_ifoc_s: without iron loss it is T_R_true_s (saturation and the double cage change L_R
+// and R_R, not the form of the slip relation); with iron loss it is the T_R for which an IFOC's
+// slip relation omega_sl = i_q / (T_R i_d) holds, computed here from its definition on the
+// simulated state: i_d, i_q the true stator current in the frame of the true rotor flux
+// (psi_ab: for a single cage psi_R1 = psi_m + L_lr i_R, in which the rotor current is in
+// quadrature), omega_sl that frame's rotation over a sample less n_p omega. On the ideal sine in
+// the steady state, 4 kW at half its rated torque with saturation and iron loss. The iron loss
+// makes it differ from L_R,eff / R_R,eff by several percent (asserted > 2 %: otherwise this
+// test could not tell the two apart).
+TEST(SimRealMotor, IfocTrHoldsTheSlipRelation)
+{
+  for (const double cage : {0.0, 1.3}) {
+    const imsim_config_t c0 = real_sine("4kw", 0.25, 0.0, cage);
+    const auto a = run(c0, 400);
+    ASSERT_FALSE(a.empty());
+    for (size_t k = 1; k < a.size(); ++k) EXPECT_DOUBLE_EQ(a[k].tr_ifoc_s, a[k].tr_s);
+  }
+  imsim_config_t c = real_sine("4kw", 0.25, 0.035, 0.0);
+  c.load_nm = 0.5 * c.rated_torque_nm;
+  const long n = 2000;
+  const auto s = run(c, n);
+  ASSERT_FALSE(s.empty());
+  double def = 0, col = 0, tr = 0;
+  for (long k = 1; k <= n; ++k) {
+    const cd psi = psiab(s[static_cast<size_t>(k)]), prev = psiab(s[static_cast<size_t>(k - 1)]);
+    const cd idq = iab(s[static_cast<size_t>(k)]) * std::conj(psi) / std::abs(psi);
+    const double wsl = std::arg(psi / prev) * c.fs_hz - c.pole_pairs * s[static_cast<size_t>(k)].speed_rad_s;
+    def += idq.imag() / (wsl * idq.real());
+    col += s[static_cast<size_t>(k)].tr_ifoc_s;
+    tr += s[static_cast<size_t>(k)].tr_s;
+  }
+  EXPECT_NEAR(col / def, 1.0, 1e-4) << "T_R_ifoc " << col / n << " s, from the definition " << def / n;
+  EXPECT_GT(col / tr, 1.02) << "T_R_ifoc " << col / n << " s, L_R/R_R " << tr / n;
+  RecordProperty("tr_ifoc_over_lr_rr", std::to_string(col / tr));
 }
 
 // The flags: --real-motor applies the preset's sizes and later flags override them; --rotor
@@ -342,11 +380,11 @@ TEST(SimRealMotor, CliFlags)
   ASSERT_EQ(parse({"--preset", "exp1", "--real-motor"}, c), 0);
   EXPECT_EQ(c.rated_voltage_v, 230.0);
   EXPECT_EQ(c.rated_torque_nm, 2.064);
-  EXPECT_EQ(std::string(imsim_cli_header_real()), ",psi_m_wb,lm_h,lr_eff_h,rr_eff_ohm,p_fe_w");
+  EXPECT_EQ(std::string(imsim_cli_header_real()), ",psi_m_wb,lm_h,lr_eff_h,rr_eff_ohm,p_fe_w,T_R_ifoc_s");
 }
 
 #ifdef IMEST_SIM_EXE
-// With an effect on, the CSV header and every row carry the five real-motor columns.
+// With an effect on, the CSV header and every row carry the six real-motor columns.
 TEST(SimRealMotor, CsvHasRealColumnsWhenOn)
 {
   const std::string out = ::testing::TempDir() + "imsim_real.csv";

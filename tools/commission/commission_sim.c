@@ -79,6 +79,9 @@ int comm_sim_config(const comm_sim_opts_t *o, imsim_config_t *sc)
   if (o->sat_fraction > 0.0) sc->sat_fraction = o->sat_fraction;
   if (o->iron_loss_fraction > 0.0) sc->iron_loss_fraction = o->iron_loss_fraction;
   if (o->rotor_cage_ratio > 0.0) sc->rotor_cage_ratio = o->rotor_cage_ratio;
+  if (o->real_off & COMM_SIM_OFF_SATURATION) sc->sat_fraction = 0.0;
+  if (o->real_off & COMM_SIM_OFF_IRON_LOSS) sc->iron_loss_fraction = 0.0;
+  if (o->real_off & COMM_SIM_OFF_DOUBLE_CAGE) sc->rotor_cage_ratio = 0.0;
   return 0;
 }
 

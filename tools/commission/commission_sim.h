@@ -16,6 +16,8 @@
 extern "C" {
 #endif
 
+enum { COMM_SIM_OFF_SATURATION = 1, COMM_SIM_OFF_IRON_LOSS = 2, COMM_SIM_OFF_DOUBLE_CAGE = 4 };
+
 typedef struct {
   char preset[16];    /* imsim preset: 4kw, 11kw, 15kw, 37kw, 75kw, exp1 (paper motor) */
   double dead_time_s; /* inverter (defaults: 2 us, 1 V + r_sw, 0.8 V + r_d) */
@@ -35,9 +37,12 @@ typedef struct {
   double i_max_a;      /* 0: sqrt(2) x rated current */
   double r_series_ohm; /* known series resistance passed to the routine */
   /* real-motor effects (sim/README.md, Real-motor effects): real_motor turns on the three at the
-     preset's sizes; a field above 0 sets (or overrides) that effect */
+     preset's sizes; a field above 0 sets (or overrides) that effect; a bit of real_off turns
+     it off even with real_motor (COMM_SIM_OFF_*: the same motor as imest-sim's --real-motor
+     --iron-loss 0 ...) */
   int real_motor;
   double sat_fraction, iron_loss_fraction, rotor_cage_ratio;
+  unsigned int real_off;
   unsigned long seed;
   double max_time_s; /* simulated time limit (default 400) */
   FILE *trace;       /* per-sample CSV (t, stage, currents, duties, speed), or NULL */

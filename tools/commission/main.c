@@ -50,11 +50,18 @@ static void usage(FILE *f)
           "                       preset's sizes (sim/README.md, Real-motor effects)\n"
           "  --saturation F       main-flux saturation: L_m at rated flux F below unsaturated [off]\n"
           "  --iron-loss F        iron loss, F x rated power at rated V/f [off]\n"
-          "  --rotor double-cage:R  double-cage rotor, R_R at rated frequency R x DC [single cage]\n"
+          "  --rotor single|double-cage:R  double-cage rotor, R_R at rated frequency R x DC [single]\n"
+          "                       (--saturation 0, --iron-loss 0, --rotor single: that effect off,\n"
+          "                       also with --real-motor, as imest-sim's flags)\n"
           "  --seed N             noise seed [1]\n"
           "  --trace FILE         per-sample CSV (t, stage, currents, duties, speed, angle)\n"
           "  --trace-decimate N   every N-th sample in the trace [1]\n"
           "  --csv                one machine-readable line instead of the table\n"
+          "  --apply-args         instead of the table: what imest_comm_apply() fills, as imest-replay\n"
+          "                       options: line 1 the constants (--pole-pairs, --ls, --sigma, their\n"
+          "                       uncertainties, --rs, --tr-nominal, --ls-curve; no --sigma with a\n"
+          "                       deep-bar rotor: give the data sheet's), line 2 the inverter model\n"
+          "                       (for --voltage duty)\n"
           "  --verbose            also the per-axis fits\n"
           "  --sensitivity        instead: the online estimator's T_R and R_S error per 1 %% error of\n"
           "                       L_S and sigma and per 0.1 V of inverter model error (preset at\n"
@@ -72,6 +79,34 @@ static void usage(FILE *f)
           "completed); 1 it failed or its result is not valid (the reason is printed), or a run\n"
           "or the trace file failed; 2 bad option or argument.\n",
           k_prog);
+}
+
+/* --apply-args: the config imest_comm_apply() fills from r, as imest-replay options (the
+   fields it leaves alone, e.g. sigma with IMEST_COMM_FLAG_ROTOR_HF, are not printed). */
+static int print_apply_args(const imest_comm_result_t *r)
+{
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  const float tr0 = cfg.tr_nominal_s;
+  if (imest_comm_apply(r, &cfg) < 0) {
+    fprintf(stderr, "%s: the result is not valid (%s): nothing to apply\n", k_prog,
+            imest_comm_reason_name(r->reason));
+    return 1;
+  }
+  printf("--pole-pairs %u --ls %.9g", cfg.pole_pairs, (double)cfg.ls_h);
+  if (!(r->flags & IMEST_COMM_FLAG_ROTOR_HF))
+    printf(" --sigma %.9g --sigma-uncertainty %.9g", (double)cfg.sigma, (double)cfg.sigma_uncertainty);
+  printf(" --ls-uncertainty %.9g --rs %.9g", (double)cfg.ls_uncertainty, (double)cfg.rs_nominal_ohm);
+  if (cfg.tr_nominal_s != tr0) printf(" --tr-nominal %.9g", (double)cfg.tr_nominal_s);
+  for (unsigned int k = 0; k < cfg.ls_curve_points; ++k)
+    printf("%s%.9g:%.9g", k == 0u ? " --ls-curve " : ",", (double)cfg.ls_curve_i_a[k],
+           (double)cfg.ls_curve_h[k]);
+  const imest_inverter_t *v = &cfg.inverter;
+  printf("\n--dead-time %.9g --v-switch %.9g --r-switch %.9g --v-diode %.9g --r-diode %.9g --i-band %.9g "
+         "--inverter-uncertainty %.9g\n",
+         (double)v->dead_time_s, (double)v->v_switch_v, (double)v->r_switch_ohm, (double)v->v_diode_v,
+         (double)v->r_diode_ohm, (double)v->i_band_a, (double)v->uncertainty);
+  return 0;
 }
 
 static int parse3(tool_args_t *a, double v[3])
@@ -113,7 +148,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "%s: unknown preset '%s' (%s)\n", k_prog, preset, imsim_preset_names());
     return 2;
   }
-  int csv = 0, verbose = 0, sensitivity = 0, online = 0, duty_input = 0;
+  int csv = 0, apply_args = 0, verbose = 0, sensitivity = 0, online = 0, duty_input = 0;
   double load = 1.0;
   const char *trace = NULL;
   tool_args_t a;
@@ -172,28 +207,39 @@ int main(int argc, char **argv)
       if (tool_args_flag(&a)) return 2;
       o.real_motor = 1;
     } else if (tool_args_is(&a, "--saturation")) {
-      if (tool_args_number(&a, &o.sat_fraction) || !(o.sat_fraction > 0.0 && o.sat_fraction < 0.6)) {
-        fprintf(stderr, "%s: --saturation needs a fraction in (0, 0.6)\n", k_prog);
+      if (tool_args_number(&a, &o.sat_fraction) || !(o.sat_fraction >= 0.0 && o.sat_fraction < 0.6)) {
+        fprintf(stderr, "%s: --saturation needs a fraction in [0, 0.6)\n", k_prog);
         return 2;
       }
+      o.real_off = o.sat_fraction > 0.0 ? o.real_off & ~(unsigned)COMM_SIM_OFF_SATURATION
+                                        : o.real_off | COMM_SIM_OFF_SATURATION;
     } else if (tool_args_is(&a, "--iron-loss")) {
       if (tool_args_number(&a, &o.iron_loss_fraction) ||
-          !(o.iron_loss_fraction > 0.0 && o.iron_loss_fraction < 0.2)) {
-        fprintf(stderr, "%s: --iron-loss needs a fraction in (0, 0.2)\n", k_prog);
+          !(o.iron_loss_fraction >= 0.0 && o.iron_loss_fraction < 0.2)) {
+        fprintf(stderr, "%s: --iron-loss needs a fraction in [0, 0.2)\n", k_prog);
         return 2;
       }
+      o.real_off = o.iron_loss_fraction > 0.0 ? o.real_off & ~(unsigned)COMM_SIM_OFF_IRON_LOSS
+                                              : o.real_off | COMM_SIM_OFF_IRON_LOSS;
     } else if (tool_args_is(&a, "--rotor")) {
       const char *rv = tool_args_value(&a);
       if (rv == NULL) return 2;
       char *end = NULL;
+      const int single = strcmp(rv, "single") == 0;
       o.rotor_cage_ratio = strncmp(rv, "double-cage:", 12) == 0 ? strtod(rv + 12, &end) : 0.0;
-      if (end == NULL || *end != '\0' || !(o.rotor_cage_ratio > 1.0 && o.rotor_cage_ratio <= 4.0)) {
-        fprintf(stderr, "%s: --rotor needs double-cage:RATIO with RATIO in (1, 4]\n", k_prog);
+      if (!single &&
+          (end == NULL || *end != '\0' || !(o.rotor_cage_ratio > 1.0 && o.rotor_cage_ratio <= 4.0))) {
+        fprintf(stderr, "%s: --rotor needs single or double-cage:RATIO with RATIO in (1, 4]\n", k_prog);
         return 2;
       }
+      o.real_off =
+          single ? o.real_off | COMM_SIM_OFF_DOUBLE_CAGE : o.real_off & ~(unsigned)COMM_SIM_OFF_DOUBLE_CAGE;
     } else if (tool_args_is(&a, "--csv")) {
       if (tool_args_flag(&a)) return 2;
       csv = 1;
+    } else if (tool_args_is(&a, "--apply-args")) {
+      if (tool_args_flag(&a)) return 2;
+      apply_args = 1;
     } else if (tool_args_is(&a, "--trace")) {
       if ((trace = tool_args_value(&a)) == NULL) return 2;
     } else if (tool_args_is(&a, "--offsets")) {
@@ -276,6 +322,7 @@ int main(int argc, char **argv)
   if (o.trace && o.trace != stdout) fclose(o.trace);
   const imest_comm_result_t *r = &out.r;
   const imsim_config_t *sc = &out.sim;
+  if (apply_args) return print_apply_args(r);
   comm_online_t on_id, on_true;
   if (online && r->valid) {
     if (comm_online_run(&o, load, 20.0, r, &on_id) != 0 ||

@@ -205,8 +205,11 @@ typedef struct {
   /* Real-motor effects (NaN when all are off; sim/README.md, Real-motor effects): main flux
      |psi_m|, static L_m(|psi_m|), the single-cage equivalent an IFOC's slip relation needs at
      the present slip frequency (L_R = L_m + L_lr,eff, R_R,eff; tr_s is then L_R / R_R,eff),
-     iron loss, stored magnetic energy. */
-  double psi_m_wb, lm_h, lr_eff_h, rr_eff_ohm, p_fe_w, w_mag_j;
+     iron loss, stored magnetic energy. tr_ifoc_s: the T_R for which an IFOC's slip relation
+     omega_sl = i_q / (T_R i_d) holds in the steady state at the present flux and slip, with
+     i_d, i_q in the rotor-flux frame (sim/README.md, Truth columns with the effects on); it
+     equals tr_s without iron loss. */
+  double psi_m_wb, lm_h, lr_eff_h, rr_eff_ohm, p_fe_w, w_mag_j, tr_ifoc_s;
   /* IFOC (NaN when not IFOC). */
   double ifoc_torque_ref_nm, ifoc_flux_ref_wb, ifoc_tr_s, ifoc_speed_ref_rad_s;
   /* Drive (PWM stages). duty: upper-switch duty of each leg, in [0, 1], applied during

@@ -2,7 +2,9 @@
 """Joins the replayed windows with the truth, classifies them and computes the summary.
 
 Per window: e_TR = T_R / T_R,true - 1 and e_RS likewise (truth: the simulator's columns averaged
-over the window). T_R is judged by `tr_valid`, R_S by `rs_valid` where imest-replay writes them,
+over the window; T_R,true is the T_R an IFOC needs, `T_R_ifoc_s`, which the simulator writes
+with the real-motor effects on and which is `T_R_true_s` without them; e_TR_lrrr is the error
+against the effective L_R/R_R, `T_R_true_s`). T_R is judged by `tr_valid`, R_S by `rs_valid` where imest-replay writes them,
 otherwise both by `valid`.
 
 * T_R good: valid and |e_TR| <= 1 %; R_S good: valid and |e_RS| <= 3 % (the goals).
@@ -51,7 +53,8 @@ def load_point(p, work, skip, replay_name=None):
             w["seq"] = seq
             w["t_end_s"] = _f(r["t_end_s"])
             w["tr_s"], w["rs_ohm"] = _f(r["T_R_s"]), _f(r["R_S_ohm"])
-            w["tr_true_s"], w["rs_true_ohm"] = _f(t["tr_true_s"]), _f(t["rs_true_ohm"])
+            w["tr_true_s"], w["rs_true_ohm"] = _f(t.get("tr_ifoc_s", t["tr_true_s"])), _f(t["rs_true_ohm"])
+            w["tr_lrrr_s"] = _f(t["tr_true_s"])
             w["speed_rad_s"], w["load_nm"] = _f(t["speed_rad_s"]), _f(t["load_nm"])
             w["valid"] = int(r["valid"])
             w["tr_valid"] = int(r["tr_valid"]) if per_param else w["valid"]
@@ -63,6 +66,7 @@ def load_point(p, work, skip, replay_name=None):
                       "rs_bound_rel"):
                 w[k] = _f(r.get(k))  # nan where this imest-replay does not write it
             w["e_tr"] = w["tr_s"] / w["tr_true_s"] - 1.0
+            w["e_tr_lrrr"] = w["tr_s"] / w["tr_lrrr_s"] - 1.0
             w["e_rs"] = w["rs_ohm"] / w["rs_true_ohm"] - 1.0
             classify(w)
             rows.append(w)
@@ -143,7 +147,8 @@ def point_table(rows, pts):
 
 
 WINDOW_COLS = ["name", "family", "motor", "f_pct", "load_pct", "sensors", "encoder", "input", "goal",
-               "seq", "t_end_s", "tr_s", "tr_true_s", "e_tr", "rs_ohm", "rs_true_ohm", "e_rs",
+               "seq", "t_end_s", "tr_s", "tr_true_s", "e_tr", "tr_lrrr_s", "e_tr_lrrr", "rs_ohm",
+               "rs_true_ohm", "e_rs",
                "valid", "tr_valid", "rs_valid", "status", "tr_reason", "rs_reason", "E_I",
                "pe_k1_rel", "pe_k2_rel", "slip_ratio", "span_s", "tr_bound_rel", "rs_bound_rel",
                "speed_rad_s", "load_nm", "tr_good",
@@ -178,6 +183,9 @@ def real_stats(ws):
     s = dict(windows=len(ws))
     s.update(one("tr_valid", "e_tr", REAL_TR))
     s.update(one("rs_valid", "e_rs", REAL_RS))
+    lr = [w["e_tr_lrrr"] if math.isfinite(w["e_tr_lrrr"]) else math.inf for w in ws if w["tr_valid"]]
+    s["tr_wrong_lrrr"] = sum(abs(x) > REAL_TR for x in lr)  # the same against L_R/R_R
+    s["tr_worst_lrrr"] = max(lr, key=abs) if lr else math.nan
     return s
 
 

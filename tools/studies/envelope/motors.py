@@ -40,6 +40,25 @@ MOTORS = [
          source="sim preset 75kw (Simscape 100 HP 400 V 50 Hz), standing in for 55 kW"),
 ]
 
+# Motors of the real-motor design only (points.real_design). The paper's 0.4 kW motor as the
+# simulator's exp1 preset (--real-motor sizes its effects from it: the paper's 230 V, 60 Hz,
+# 2.064 N m) with the envelope's 0.4 kW drive given as flags (the 4kw preset's drive on a 340 V
+# bus with its own sensor ranges); the motor constants are exp1's, stated for constants().
+REAL_ONLY = [
+    dict(name="0.4kw", kw=0.37, preset="exp1",
+         flags="--pole-pairs 2 --ls 0.2908 --lr 0.2908 --sigma 0.096 --rs 5.04 --tr 0.12 "
+               "--j 1.2e-3 --b 1e-4 --supply pwm --carrier-hz 8000 --modulation svpwm "
+               "--timing firmware --fs 8000 --i-range 6 --u-range 250 --vdc-range 800",
+         vll=230.0, f=60.0, t_nm=2.064, vdc=340.0,
+         source="the paper's motor as the simulator's exp1 preset (its real-motor sizes), on the "
+                "0.4 kW envelope motor's drive"),
+]
+
+def by_name(name, real=False):
+    """The motor called name: of MOTORS, or for the real-motor design of REAL_ONLY first."""
+    return next(m for m in (REAL_ONLY if real else []) + MOTORS if m["name"] == name)
+
+
 # Constants of the presets, as sim/src/motors.c converts them (T equivalent -> L_S, sigma, T_R).
 _PRESET = {
     "4kw": (1.405, 1.395, 5.839e-3, 172.2e-3, 26.5, 4000.0),
@@ -91,15 +110,33 @@ def _point(c, psi, f_hz, load_nm, phasors=False):
     return (u, i, wm) if phasors else (abs(u), abs(i), wm)
 
 
-def rated_flux(m):
-    """Rotor flux of the motor at its rated voltage, frequency and torque (bisection)."""
+def flux_at(m, vll, f_hz, load_nm):
+    """Rotor flux of the linear model at supply voltage vll, frequency f_hz and load torque
+    load_nm (bisection)."""
     c = constants(m)
     lo, hi = 1e-3, 10.0
     for _ in range(200):
         mid = 0.5 * (lo + hi)
-        v, _, _ = _point(c, mid, m["f"], m["t_nm"])
-        lo, hi = (mid, hi) if v < m["vll"] else (lo, mid)
+        v, _, _ = _point(c, mid, f_hz, load_nm)
+        lo, hi = (mid, hi) if v < vll else (lo, mid)
     return 0.5 * (lo + hi)
+
+
+def rated_flux(m):
+    """Rotor flux of the motor at its rated voltage, frequency and torque."""
+    return flux_at(m, m["vll"], m["f"], m["t_nm"])
+
+
+def field_weakening_point(m, f_pct, power_pct):
+    """(f_hz, V_ll, load_nm, i_ab, speed_rad_s) above base speed: f_pct % of rated frequency
+    (> 100) at the rated voltage (the voltage limit: the flux falls as 1/f) and a load of
+    power_pct % of the rated torque x f_n / f (constant power: power_pct % of rated power)."""
+    c = constants(m)
+    f_hz = m["f"] * f_pct / 100.0
+    load = m["t_nm"] * power_pct / 100.0 * 100.0 / f_pct
+    psi = flux_at(m, m["vll"], f_hz, load)
+    u, i, wm = _point(c, psi, f_hz, load)
+    return f_hz, u, load, i, wm
 
 
 def operating_point(m, f_pct, load_pct, inv=None, vdc=560.0, f_carrier=8000.0):
@@ -126,6 +163,45 @@ def operating_point(m, f_pct, load_pct, inv=None, vdc=560.0, f_carrier=8000.0):
 
 def rated_current(m):
     return operating_point(m, 100.0, 100.0)[3]
+
+
+COMMISSION_PRESET = {"0.4kw": "exp1"}  # imest-commission's preset of a motor (default: its own)
+
+
+def library_commissioning(m, effects, commission, cache_dir, inverter_flags):
+    """What the library's commissioning gives the estimator for motor m with the imest-sim
+    real-motor flags `effects` (the same flags imest-commission takes): imest-commission
+    --apply-args (the config imest_comm_apply() fills, as imest-replay options) on the preset
+    with those effects, on a drive with the inverter of inverter_flags. Cached in
+    a file per motor and effects in cache_dir (run once per motor and family). Returns dict: `args` (the
+    constants' options), `inverter` (the inverter model's), and the values for the tables (np,
+    ls, sigma or None when commissioning leaves it to the data sheet, ls_unc, sigma_unc, rs, tr,
+    curve = the magnetising curve's points)."""
+    import os
+    import subprocess
+    tag = "_".join(t.lstrip("-").replace(":", "") for t in effects.split()) or "linear"
+    path = os.path.join(cache_dir, f"{m['name']}_{tag}.txt")
+    if not os.path.exists(path):
+        os.makedirs(cache_dir, exist_ok=True)
+        cmd = [commission, "--preset", COMMISSION_PRESET.get(m["name"], m["preset"])] + \
+            effects.split() + list(inverter_flags) + ["--apply-args"]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)} failed ({r.returncode}): {r.stderr.strip()}")
+        with open(path + ".tmp", "w") as f:
+            f.write(f"# {' '.join(cmd[1:])}\n" + r.stdout)
+        os.replace(path + ".tmp", path)
+    with open(path) as f:
+        lines = [line.split() for line in f if line.strip() and not line.startswith("#")]
+    args, inv = lines[0], lines[1]
+    opt = {args[k]: args[k + 1] for k in range(0, len(args) - 1, 2)}
+    return dict(args=args, inverter=inv, np=int(opt["--pole-pairs"]), ls=float(opt["--ls"]),
+                sigma=float(opt["--sigma"]) if "--sigma" in opt else None,
+                ls_unc=float(opt["--ls-uncertainty"]),
+                sigma_unc=float(opt["--sigma-uncertainty"]) if "--sigma-uncertainty" in opt else None,
+                rs=float(opt["--rs"]), tr=float(opt["--tr-nominal"]) if "--tr-nominal" in opt else None,
+                curve=len(opt["--ls-curve"].split(",")) if "--ls-curve" in opt else 0,
+                source=os.path.basename(path))
 
 
 def commissioning(m, effects, sim):

@@ -18,8 +18,10 @@ The real-motor design (`real_design`, `run --real`) is a separate measurement, o
 region and the gate: the 4, 11 and 37 kW motors with the simulator's real-motor effects
 (main-flux saturation, iron loss, double cage; each alone, all three, and all three on the
 duty-cycle input with dead time), and the same points on the linear motor as the control, at
-25-100 % of rated frequency x 25-100 % of rated torque, with the goal sensors. The estimator gets
-what a standstill + no-load commissioning gives (`motors.commissioning`).
+25-100 % of rated frequency x 25-100 % of rated torque, with the goal sensors; and field
+weakening (1.5x rated frequency at the rated voltage, 25-100 % of rated power) on the linear,
+the saturating and the all-effects motor. The estimator gets what the library's commissioning
+gives (`motors.library_commissioning`: imest-commission --apply-args).
 """
 import motors
 
@@ -53,10 +55,20 @@ REAL_FAMILIES = [
     ("real_deepbar", "--real-motor --saturation 0 --iron-loss 0", "phase"),
     ("real_all", "--real-motor", "phase"),
     ("real_all_duty", "--real-motor", "duty_inv"),
+    # field weakening: above base speed at the rated voltage, constant power (FIELD_WEAKENING)
+    ("real_fw_linear", "", "phase"),
+    ("real_fw_sat", "--real-motor --iron-loss 0 --rotor single", "phase"),
+    ("real_fw_all", "--real-motor", "phase"),
 ]
-REAL_MOTORS = ["4kw", "11kw", "37kw"]  # presets: --real-motor needs the preset's nameplate
-REAL_FREQS = [25, 50, 75, 100]
-REAL_LOADS = [25, 50, 75, 100]
+REAL_MOTORS = ["0.4kw", "4kw", "11kw", "37kw"]  # --real-motor needs a preset's nameplate
+REAL_FREQS = [25, 50, 100]
+REAL_LOADS = [25, 50, 100]
+# The field-weakening families' points: FW_FREQ % of rated frequency at the rated voltage (the
+# voltage limit; the flux falls as 1/f), loads of FW_POWERS % of rated power (the torque
+# FW_POWERS % x f_n / f of rated: the constant-power range of a drive).
+FIELD_WEAKENING = {"real_fw_linear", "real_fw_sat", "real_fw_all"}
+FW_FREQ = 150
+FW_POWERS = [25, 50, 75, 100]
 
 
 
@@ -88,9 +100,12 @@ def _finish(pts, seed0=1000, family_in_name=False):
     """Drop points the motor cannot run at, name the rest, one recording per name, seeds."""
     out = []
     for p in pts:
-        m = next(x for x in motors.MOTORS if x["name"] == p["motor"])
+        m = motors.by_name(p["motor"], real="effects" in p)
         inv = INVERTER if p["input"] == "duty_inv" else None  # the drive makes up its error
-        f_hz, vll, load, i_ab, wm = motors.operating_point(m, p["f_pct"], p["load_pct"], inv, m["vdc"])
+        if "power_pct" in p:
+            f_hz, vll, load, i_ab, wm = motors.field_weakening_point(m, p["f_pct"], p["power_pct"])
+        else:
+            f_hz, vll, load, i_ab, wm = motors.operating_point(m, p["f_pct"], p["load_pct"], inv, m["vdc"])
         if wm <= 0.0:
             continue
         p.update(f_hz=f_hz, vll=vll, load_nm=load, speed_rad_s=wm, goal=in_goal(p))
@@ -104,14 +119,16 @@ def real_design():
     """The real-motor points (dicts with `effects`, the imest-sim flags); never in the goal
     region (goal False), so never in the envelope's summary lines or its gate."""
     pts = []
-    mm = {m["name"]: m for m in motors.MOTORS}
     for fam, effects, inp in REAL_FAMILIES:
         for name in REAL_MOTORS:
-            for f in REAL_FREQS:
-                for ld in REAL_LOADS:
-                    p = _point(fam, mm[name], f, ld, input=inp)
-                    p["effects"] = effects
-                    pts.append(p)
+            if fam in FIELD_WEAKENING:  # load_pct: the torque in % of rated, rounded
+                grid = [(FW_FREQ, round(pw * 100 / FW_FREQ), dict(power_pct=pw)) for pw in FW_POWERS]
+            else:
+                grid = [(f, ld, {}) for f in REAL_FREQS for ld in REAL_LOADS]
+            for f, ld, kw in grid:
+                p = _point(fam, motors.by_name(name, real=True), f, ld, input=inp, **kw)
+                p["effects"] = effects
+                pts.append(p)
     out = _finish(pts, seed0=5000, family_in_name=True)
     keys = sorted({(p["motor"], p["f_pct"], p["load_pct"]) for p in out})
     for p in out:  # the same noise at the same operating point in every family

@@ -295,13 +295,40 @@ def _w(x):
 
 def _real_row(label, s):
     return (f"| {label} | {s['windows']} | {s['tr_valid']} | {s['tr_within']} | **{s['tr_wrong']}** | "
-            f"{_w(s['tr_worst'])} | {s['rs_valid']} | {s['rs_within']} | **{s['rs_wrong']}** | "
-            f"{_w(s['rs_worst'])} |")
+            f"{_w(s['tr_worst'])} | {s['tr_wrong_lrrr']} | {_w(s['tr_worst_lrrr'])} | {s['rs_valid']} | "
+            f"{s['rs_within']} | **{s['rs_wrong']}** | {_w(s['rs_worst'])} |")
 
 
 REAL_HEAD = ["| family | windows | T_R valid | T_R valid, within 2 % | T_R valid, > 2 % off | worst valid "
-             "e_TR | R_S valid | R_S valid, within 5 % | R_S valid, > 5 % off | worst valid e_RS |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "e_TR | against L_R/R_R: T_R valid, > 2 % off | worst valid e_TR against L_R/R_R | R_S valid | "
+             "R_S valid, within 5 % | R_S valid, > 5 % off | worst valid e_RS |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+
+# The families the goals are read over (the real-motor effects; the linear ones are controls).
+REAL_CONTROLS = ("real_linear", "real_fw_linear")
+
+
+def real_goals(fam, rows):
+    """The goals of the real-motor table as (goal, figure, met) rows, over the windows of every
+    family but the linear controls."""
+    ws = [w for w in rows if w["family"] in fam and w["family"] not in REAL_CONTROLS]
+    s = analyse.real_stats(ws) if ws else None
+    if not s:
+        return []
+    n = s["windows"]
+    wrong = s["tr_wrong"] + s["rs_wrong"]
+    fw = {f: sum(w["tr_valid"] for w in rows if w["family"] == f)
+          for f in fam if f in points.FIELD_WEAKENING and f not in REAL_CONTROLS}
+    g = [("no window valid with T_R more than 2 % off what the IFOC needs, or R_S more than 5 % off",
+          f"{s['tr_wrong']} T_R + {s['rs_wrong']} R_S windows of {n}", wrong == 0),
+         ("T_R valid and within 2 % in at least 60 % of the windows",
+          f"{100.0 * s['tr_within'] / n:.1f} % ({s['tr_within']} of {n})", s["tr_within"] >= 0.6 * n),
+         ("R_S valid and within 5 % in at least 30 % of the windows",
+          f"{100.0 * s['rs_within'] / n:.1f} % ({s['rs_within']} of {n})", s["rs_within"] >= 0.3 * n)]
+    if fw:
+        g.append(("field weakening valid, not only refused (T_R valid in every field-weakening family)",
+                  ", ".join(f"{f} {v} T_R valid" for f, v in fw.items()), all(v > 0 for v in fw.values())))
+    return g
 
 
 def render_real(fam, rows, table, meta):
@@ -317,17 +344,29 @@ def render_real(fam, rows, table, meta):
         L.append("Left out, the motor did not hold its operating point: " + ", ".join(meta["not_held"]) + ".\n")
     L.append("Motors " + ", ".join(points.REAL_MOTORS) + "; frequency " +
              ", ".join(map(str, points.REAL_FREQS)) + " % of rated; load " +
-             ", ".join(map(str, points.REAL_LOADS)) + " % of rated torque; goal sensors (12-bit ADCs, "
-             "1 LSB noise, 16384 counts). Truth: the simulator's `T_R_true_s` (the effective "
-             "L_R/R_R an IFOC's slip relation needs) and `R_S_true_ohm`, averaged per window. "
-             "Constants given to the estimator: those of a standstill + no-load commissioning "
-             "(tools/studies/envelope/README.md, Real-motor effects).\n")
+             ", ".join(map(str, points.REAL_LOADS)) + " % of rated torque; field weakening "
+             f"(`real_fw_*`): {points.FW_FREQ} % of rated frequency at the rated voltage, "
+             + ", ".join(map(str, points.FW_POWERS)) + " % of rated power; goal sensors (12-bit ADCs, "
+             "1 LSB noise, 16384 counts). Truth: the simulator's `T_R_ifoc_s` (the T_R for which an "
+             "IFOC's slip relation holds in the steady state, sim/README.md; without the effects "
+             "`T_R_true_s`) and `R_S_true_ohm`, averaged per window; the T_R errors against the "
+             "effective L_R/R_R (`T_R_true_s`) are given beside them. Constants given to the "
+             "estimator: what the library's commissioning fills (`imest-commission --apply-args`, "
+             "i.e. imest_comm_apply(), on the same motor with the same effects; table at the end).\n")
     L.append("| family | imest-sim flags | input |")
     L.append("|---|---|---|")
     for f, eff, inp in points.REAL_FAMILIES:
         if f in fam:
             L.append(f"| {f} | `{eff or '(linear motor)'}` | "
                      f"{'duty cycle, 2 µs dead time + drops, model given' if inp == 'duty_inv' else 'phase voltage'} |")
+    goals = real_goals(fam, rows)
+    if goals:
+        L.append("\n## Goals (over every family but the linear controls " +
+                 ", ".join(f"`{f}`" for f in REAL_CONTROLS) + ")\n")
+        L.append("| goal | figure | met |")
+        L.append("|---|---|---|")
+        for g, fig, ok in goals:
+            L.append(f"| {g} | {fig} | {'met' if ok else '**not met**'} |")
     L.append("\n## Against the promise (no valid T_R more than 2 % off, no valid R_S more than 5 % off)\n")
     L += REAL_HEAD
     for f, s in fam.items():
@@ -383,6 +422,26 @@ def render_real(fam, rows, table, meta):
                      f"{_w(analyse.median(r)) if r else '–'} |")
         L.append("")
 
+    if wrong:
+        L.append("## The largest valid-and-wrong windows per family, against their bounds\n")
+        L.append("The error bound a valid verdict stated (`tr_bound_rel`, `rs_bound_rel`) against the "
+                 "error it had: the bound missed by the difference.\n")
+        L.append("| family | recording | window | e_TR | T_R bound | e_TR against L_R/R_R | e_RS | R_S bound | "
+                 "pe_k2_rel | E_I |")
+        L.append("|---|---|---|---|---|---|---|---|---|---|")
+        for f in fam:
+            def size(w):
+                a = abs(w["e_tr"]) / analyse.REAL_TR if w["tr_valid"] else 0.0
+                b = abs(w["e_rs"]) / analyse.REAL_RS if w["rs_valid"] else 0.0
+                return max(a, b)
+            for w in sorted((w for w in wrong if w["family"] == f), key=size, reverse=True)[:3]:
+                L.append(f"| {f} | {w['name'][len(f) + 1:]} | {w['seq']} | "
+                         f"{_w(w['e_tr']) + (' (valid)' if w['tr_valid'] else '')} | "
+                         f"{_w(w['tr_bound_rel'])} | {_w(w['e_tr_lrrr'])} | "
+                         f"{_w(w['e_rs']) + (' (valid)' if w['rs_valid'] else '')} | {_w(w['rs_bound_rel'])} | "
+                         f"{w['pe_k2_rel']:.3g} | {w['E_I']:.3g} |")
+        L.append("")
+
     L.append("## Refusals\n")
     L.append("| family | T_R refused (reasons) | R_S refused (reasons) |")
     L.append("|---|---|---|")
@@ -394,12 +453,17 @@ def render_real(fam, rows, table, meta):
                  ", ".join(f"`{k}` {v}" for k, v in rs.most_common()) + " |")
     L.append("")
 
-    L.append("## Constants given to the estimator\n")
-    L.append("| motor, family | L_S [H] | sigma | R_S [ohm] | T_R nominal [s] | L_m at no load [H] |")
-    L.append("|---|---|---|---|---|---|")
+    L.append("## Constants given to the estimator (imest-commission --apply-args)\n")
+    L.append("Sigma \"data sheet\": commissioning flags the rotor deep-bar (its sigma*L_S at the "
+             "test frequency is the rotor's high-frequency one) and leaves sigma to the data sheet: "
+             "the motor's, with imest-replay's default uncertainty.\n")
+    L.append("| motor, family | L_S [H] | L_S uncertainty | sigma | sigma uncertainty | R_S [ohm] | "
+             "T_R nominal [s] | curve points | cached in |")
+    L.append("|---|---|---|---|---|---|---|---|---|")
     for k, c in meta["constants"].items():
-        L.append(f"| {k} | {c['ls']:.6g} | {c['sigma']:.5g} | {c['rs']:.5g} | {c['tr']:.5g} | "
-                 f"{c['lm']:.6g} |" if "lm" in c else
-                 f"| {k} | {c['ls']:.6g} | {c['sigma']:.5g} | {c['rs']:.5g} | {c['tr']:.5g} | (linear) |")
+        sg = f"{c['sigma']:.5g} | {c['sigma_unc']:.3g}" if c.get("sigma") is not None else "data sheet | default"
+        tr = f"{c['tr']:.5g}" if c.get("tr") else "–"
+        L.append(f"| {k} | {c['ls']:.6g} | {c['ls_unc']:.3g} | {sg} | {c['rs']:.5g} | {tr} | {c['curve']} | "
+                 f"commissioning/{c['source']} |")
     L.append("")
     return "\n".join(L)

@@ -13,21 +13,24 @@ import points
 
 FS_HZ = 8000.0  # the drive presets: one sample per 8 kHz carrier period
 
+# tr_ifoc_s: the T_R an IFOC needs (T_R_ifoc_s, written with the real-motor effects on; without
+# them it is T_R_true_s); tr_true_s: the effective L_R/R_R (T_R_true_s)
 TRUTH_AWK = r"""
-NR == 1 { for (j = 1; j <= NF; j++) col[$j] = j; next }
+NR == 1 { for (j = 1; j <= NF; j++) col[$j] = j; ki = ("T_R_ifoc_s" in col) ? col["T_R_ifoc_s"] : col["T_R_true_s"]; next }
 { r = NR - 2; k = int(r / N); n[k]++;
-  tr[k] += $col["T_R_true_s"]; rs[k] += $col["R_S_true_ohm"];
+  tr[k] += $col["T_R_true_s"]; rs[k] += $col["R_S_true_ohm"]; ti[k] += $ki;
   w[k] += $col["speed_rad_s"]; te[k] += $col["torque_nm"]; ld[k] += $col["load_nm"];
   if (k > kmax) kmax = k }
-END { print "seq,tr_true_s,rs_true_ohm,speed_rad_s,torque_nm,load_nm,rows";
+END { print "seq,tr_true_s,rs_true_ohm,speed_rad_s,torque_nm,load_nm,rows,tr_ifoc_s";
       for (k = 0; k <= kmax; k++) if (n[k] == N)
-        printf "%d,%.9g,%.9g,%.7g,%.7g,%.7g,%d\n", k, tr[k]/n[k], rs[k]/n[k], w[k]/n[k],
-               te[k]/n[k], ld[k]/n[k], n[k] }
+        printf "%d,%.9g,%.9g,%.7g,%.7g,%.7g,%d,%.9g\n", k, tr[k]/n[k], rs[k]/n[k], w[k]/n[k],
+               te[k]/n[k], ld[k]/n[k], n[k], ti[k]/n[k] }
 """
 
 
 def motor_of(p):
-    return next(m for m in motors.MOTORS if m["name"] == p["motor"])
+    """The motor of a point (a real-motor point's, with `effects`, from motors.REAL_ONLY first)."""
+    return motors.by_name(p["motor"], real="effects" in p)
 
 
 def sim_args(p, duration_s):
@@ -59,27 +62,38 @@ def inverter_flags(inv):
 
 def constants_uncertainty(p):
     """--ls-uncertainty, --sigma-uncertainty: 0 for the simulator's own constants (exact); for
-    commissioned ones what imest_comm_apply() states for a rotating commissioning
-    (imest_commission.h: its floors, 0.2 % and 0.5 %; motors.commissioning reports no fit quality
-    or spread that would raise them)."""
+    the study's own no-load commissioning (motors.commissioning, deadtime --real-motor) what
+    imest_comm_apply() states for a rotating commissioning without fit quality (imest_commission.h:
+    its floors, 0.2 % and 0.5 %). The library's commissioning (`args` in the constants) states its
+    own."""
     if p.get("consts"):
         return ["--ls-uncertainty", "0.002", "--sigma-uncertainty", "0.005"]
     return ["--ls-uncertainty", "0", "--sigma-uncertainty", "0"]
 
 
 def replay_args(p, extra=()):
-    """The estimator's options: the motor's constants (with `consts` in the point, the
-    commissioned ones of motors.commissioning, with R_S and T_R nominal), how well they are
-    known (constants_uncertainty), the input."""
+    """The estimator's options: the motor's constants (with `consts` in the point: with `args`,
+    what imest_comm_apply() fills (motors.library_commissioning), sigma from the data sheet
+    (the motor's, with imest-replay's default uncertainty) where commissioning leaves it; else
+    the study's no-load commissioning, with R_S and T_R nominal), how well they are known, the
+    input (the duty-cycle input with the commissioned inverter model where there is one)."""
     c = p.get("consts") or motors.constants(motor_of(p))
-    a = ["--pole-pairs", str(c["np"]), "--ls", f"{c['ls']:.7g}", "--sigma", f"{c['sigma']:.7g}",
-         "--from-rest", "no", "--quiet"] + constants_uncertainty(p)
-    if p.get("consts"):
-        a += ["--rs", f"{c['rs']:.7g}", "--tr-nominal", f"{c['tr']:.7g}"]
+    base = ["--from-rest", "no", "--quiet"]
+    if c.get("args"):
+        a = base + c["args"]
+        if c["sigma"] is None:
+            a += ["--sigma", f"{motors.constants(motor_of(p))['sigma']:.7g}"]
+    else:
+        a = ["--pole-pairs", str(c["np"]), "--ls", f"{c['ls']:.7g}", "--sigma", f"{c['sigma']:.7g}"] + \
+            base + constants_uncertainty(p)
+        if p.get("consts"):
+            a += ["--rs", f"{c['rs']:.7g}", "--tr-nominal", f"{c['tr']:.7g}"]
     if p["input"] == "phase":
         # the phase voltage of the simulated drive is the volt-seconds of the sample period
         # that just ended: half a sample behind the currents
         a += ["--u-delay", f"{0.5 / FS_HZ:.9g}"]
+    elif p["input"] == "duty_inv" and c.get("inverter"):
+        a += ["--voltage", "duty"] + c["inverter"]
     else:
         inv = points.INVERTER if p["input"] == "duty_inv" else dict.fromkeys(points.INVERTER, 0.0)
         a += ["--voltage", "duty"] + inverter_flags(inv)
