@@ -159,13 +159,13 @@ static void print_result(const imest_comm_result_t *r, const imest_comm_axis_fit
   print_floats("ls_curve_h", r->ls_curve_h, r->ls_curve_points < 4u ? r->ls_curve_points : 4u);
   for (int k = 0; k < 3; ++k) {
     const imest_comm_axis_fit_t *f = &fit[k];
-    const double v[] = {f->r_ohm,  f->r_std,  f->td_s,    f->td_std,    f->vth_v,   f->vth_std,
-                        f->dr_ohm, f->dr_std, f->tau_s,   f->tau_std,   f->lm_h,    f->slsig_h,
-                        f->slsig_std, f->rhf_ohm, f->gain_dev, f->rms_v, f->i_top_a};
+    const float v[] = {f->r_ohm, f->r_std,   f->td_s,    f->td_std,    f->vth_v,   f->vth_std,
+                       f->dr_ohm, f->dr_std, f->tau_s,   f->tau_std,   f->lm_h,    f->slsig_h,
+                       f->slsig_std, f->rhf_ohm, f->gain_dev, f->rms_v, f->i_top_a};
     static const char *const names[] = {"r_ohm",  "r_std",  "td_s",    "td_std",    "vth_v",   "vth_std",
                                         "dr_ohm", "dr_std", "tau_s",   "tau_std",   "lm_h",    "slsig_h",
                                         "slsig_std", "rhf_ohm", "gain_dev", "rms_v", "i_top_a"};
-    for (int j = 0; j < (int)(sizeof v / sizeof v[0]); ++j) printf("fit[%d].%s %.12g\n", k, names[j], v[j]);
+    for (int j = 0; j < (int)(sizeof v / sizeof v[0]); ++j) printf("fit[%d].%s %.9g\n", k, names[j], (double)v[j]);
     printf("fit[%d].ok %d\nfit[%d].separable %d\n", k, f->ok, k, f->separable);
   }
 }
@@ -456,9 +456,10 @@ int main(int argc, char **argv)
       printf("\n  axis %d: R %.5f (%.2g) td %.4f us (%.2g) vth %.4f (%.2g) dr %.5f (%.2g) tau %.5f (%.2g) lm "
              "%.5f sl %.6f (%.2g) "
              "rhf %.4f gain %.5f rms %.4f",
-             k, f->r_ohm, f->r_std, f->td_s * 1e6, f->td_std * 1e6, f->vth_v, f->vth_std, f->dr_ohm,
-             f->dr_std, f->tau_s, f->tau_std, f->lm_h, f->slsig_h, f->slsig_std, f->rhf_ohm, f->gain_dev,
-             f->rms_v);
+             k, (double)f->r_ohm, (double)f->r_std, (double)f->td_s * 1e6, (double)f->td_std * 1e6,
+             (double)f->vth_v, (double)f->vth_std, (double)f->dr_ohm, (double)f->dr_std, (double)f->tau_s,
+             (double)f->tau_std, (double)f->lm_h, (double)f->slsig_h, (double)f->slsig_std, (double)f->rhf_ohm,
+             (double)f->gain_dev, (double)f->rms_v);
     }
   if (online && r->valid) {
     const comm_online_t *v[2] = {&on_id, &on_true};
