@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning: config defaults and checks, instance set-up, abort, progress and names.
- * Runs outside the ISR (init) or reads only: float64 and <math.h> are fine here. */
+ * Runs outside the ISR (init) or reads only. float32: sample counts to the nearest sample,
+ * below 2^24 for any configured time and rate but time_max_s (where a few samples do not
+ * matter), and rates that are floats already. */
 #include <math.h>
 #include <stddef.h>
 
@@ -93,10 +95,10 @@ int imest_comm_config_check(const imest_comm_config_t *cc, const char **field)
   return bad ? IMEST_ERR_CONFIG : IMEST_OK;
 }
 
-static uint32_t samples(double t_s, double fs)
+static uint32_t samples(float t_s, float fs)
 {
-  const double n = t_s * fs + 0.5;
-  return n < 1.0 ? 1u : (n > 4.0e9 ? 4000000000u : (uint32_t)n);
+  const float n = t_s * fs + 0.5f;
+  return n < 1.0f ? 1u : (n > 4.0e9f ? 4000000000u : (uint32_t)n);
 }
 
 int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
@@ -106,22 +108,22 @@ int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
   if (rc != IMEST_OK) return rc;
   imest__cm_copy(c, NULL, sizeof *c);
   imest__cm_copy(&c->cfg, cc, sizeof *cc);
-  const double fs = (double)cc->fs_hz;
-  c->ts_s = (float)(1.0 / fs);
+  const float fs = cc->fs_hz;
+  c->ts_s = 1.0f / fs;
   c->fpwm = cc->pwm_hz > 0.0f ? cc->pwm_hz : cc->fs_hz;
   c->i_trip = cc->i_max_a;
   /* phase current top level -> alpha/beta axis current: i_n = sqrt(3/2) i_phase */
   c->level_a = cc->level_frac * cc->i_max_a * IMEST_SQRT3_2_F;
   /* Current loop crossover fs/40 (1.5 samples of delay cost 13 degrees of phase there). */
-  c->wc = (float)(2.0 * IMEST_PI_D * fs / 40.0);
-  c->n_off = samples(0.25, fs);
+  c->wc = IMEST_2PI_F * fs / 40.0f;
+  c->n_off = samples(0.25f, fs);
   /* discards after a level step and after a pattern switch: the loop's settling (about 5 and
      4 closed-loop time constants of the slow PI zero at wc/4) */
-  c->n_disc_level = samples(20.0 / (double)c->wc, fs);
-  c->n_disc_pattern = samples(12.0 / (double)c->wc, fs);
+  c->n_disc_level = samples(20.0f / c->wc, fs);
+  c->n_disc_pattern = samples(12.0f / c->wc, fs);
   c->n_hf_half = 4u; /* square wave at fs/8 */
-  c->n_hf_blk = samples(0.2 / (double)CM_HF_BLOCKS, fs);
-  c->n_max = samples((double)cc->time_max_s, fs);
+  c->n_hf_blk = samples(0.2f / (float)CM_HF_BLOCKS, fs);
+  c->n_max = samples(cc->time_max_s, fs);
   for (int x = 0; x < 3; ++x) {
     c->ginv[x] = 1.0f;
     c->bg_ginv[x] = 1.0f;
