@@ -1,4 +1,4 @@
-// SPDX-License-Identifier: Apache-2.0
+/* SPDX-License-Identifier: Apache-2.0 */
 // The commissioning fits' own numerics (src/commission/fits/commission_fit.h): exp without libm
 // and the weighted straight line the probe and the sensor-gain fits share.
 #include <gtest/gtest.h>
@@ -18,7 +18,7 @@ double ulps(double a, double b)
   return std::fabs(a - b) / (b * std::numeric_limits<double>::epsilon());
 }
 
-}  // namespace
+} // namespace
 
 TEST(CommissionFits, ExpWithinTwoUlpOfLibm)
 {
@@ -42,7 +42,7 @@ TEST(CommissionFits, ExpWithinTwoUlpOfLibm)
   EXPECT_EQ(imest__cm_exp(0.0), 1.0);
   EXPECT_EQ(imest__cm_exp(-800.0), 0.0);
   EXPECT_TRUE(std::isnan(imest__cm_exp(std::nan(""))));
-  EXPECT_GT(imest__cm_exp(800.0), 1e300);  // held at e^700, finite
+  EXPECT_GT(imest__cm_exp(800.0), 1e300); // held at e^700, finite
   EXPECT_TRUE(std::isfinite(imest__cm_exp(800.0)));
 }
 
@@ -50,7 +50,7 @@ TEST(CommissionFits, LineFitRecoversSlopeAndResidual)
 {
   cm_line_t l = {};
   const double x[5] = {0.1, 0.4, 0.5, 0.9, 1.3}, w[5] = {1.0, 2.0, 3.0, 1.0, 4.0};
-  const double e[5] = {0.01, -0.02, 0.015, -0.01, 0.002};  // residuals about the line
+  const double e[5] = {0.01, -0.02, 0.015, -0.01, 0.002}; // residuals about the line
   for (int k = 0; k < 5; ++k) imest__cm_line_add(&l, w[k], x[k], 2.0 - 3.0 * x[k] + e[k]);
   double a = 0.0;
   const double sse = imest__cm_line_fit(&l, &a);
@@ -87,7 +87,7 @@ TEST(CommissionFits, LineFitWithOneDistinctXHasNoSlope)
   double a = 7.0;
   const double sse = imest__cm_line_fit(&l, &a);
   EXPECT_EQ(a, 0.0);
-  EXPECT_NEAR(sse, 1.0 * 0.75 * 0.75 + 3.0 * 0.25 * 0.25, 1e-12);  // about the mean 1.75
+  EXPECT_NEAR(sse, 1.0 * 0.75 * 0.75 + 3.0 * 0.25 * 0.25, 1e-12); // about the mean 1.75
   cm_line_t empty = {};
   EXPECT_EQ(imest__cm_line_fit(&empty, &a), 0.0);
   EXPECT_EQ(a, 0.0);

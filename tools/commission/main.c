@@ -120,7 +120,8 @@ static void print_online(const char *which, const comm_online_t *v)
   printf("online.%s.windows %d\nonline.%s.tr_valid %d\nonline.%s.rs_valid %d\n", which, v->windows, which,
          v->tr_valid, which, v->rs_valid);
   printf("online.%s.tr_rel %.9g\nonline.%s.rs_rel %.9g\n", which, v->tr_rel, which, v->rs_rel);
-  printf("online.%s.tr_all_rel %.9g\nonline.%s.rs_all_rel %.9g\n", which, v->tr_all_rel, which, v->rs_all_rel);
+  printf("online.%s.tr_all_rel %.9g\nonline.%s.rs_all_rel %.9g\n", which, v->tr_all_rel, which,
+         v->rs_all_rel);
 }
 
 /* --result: every field of the result, for comparing two builds (name value per line). */
@@ -128,7 +129,8 @@ static void print_result(const imest_comm_result_t *r, const imest_comm_axis_fit
 {
   printf("state %d\nreason %d\nstage %d\nvalid %d\nflags %u\n", r->state, r->reason, r->stage, r->valid,
          r->flags);
-  printf("time_s %.9g\ni_peak_a %.9g\nvdc_v %.9g\n", (double)r->time_s, (double)r->i_peak_a, (double)r->vdc_v);
+  printf("time_s %.9g\ni_peak_a %.9g\nvdc_v %.9g\n", (double)r->time_s, (double)r->i_peak_a,
+         (double)r->vdc_v);
   print_floats("i_offset_a", r->i_offset_a, 3u);
   print_floats("i_gain_rel", r->i_gain_rel, 3u);
   for (int k = 0; k < 3; ++k) printf("wiring_map[%d] %d\n", k, r->wiring_map[k]);
@@ -159,13 +161,14 @@ static void print_result(const imest_comm_result_t *r, const imest_comm_axis_fit
   print_floats("ls_curve_h", r->ls_curve_h, r->ls_curve_points < 4u ? r->ls_curve_points : 4u);
   for (int k = 0; k < 3; ++k) {
     const imest_comm_axis_fit_t *f = &fit[k];
-    const float v[] = {f->r_ohm, f->r_std,   f->td_s,    f->td_std,    f->vth_v,   f->vth_std,
-                       f->dr_ohm, f->dr_std, f->tau_s,   f->tau_std,   f->lm_h,    f->slsig_h,
-                       f->slsig_std, f->rhf_ohm, f->gain_dev, f->rms_v, f->i_top_a};
-    static const char *const names[] = {"r_ohm",  "r_std",  "td_s",    "td_std",    "vth_v",   "vth_std",
-                                        "dr_ohm", "dr_std", "tau_s",   "tau_std",   "lm_h",    "slsig_h",
-                                        "slsig_std", "rhf_ohm", "gain_dev", "rms_v", "i_top_a"};
-    for (int j = 0; j < (int)(sizeof v / sizeof v[0]); ++j) printf("fit[%d].%s %.9g\n", k, names[j], (double)v[j]);
+    const float v[] = {f->r_ohm,     f->r_std,   f->td_s,     f->td_std,  f->vth_v,  f->vth_std,
+                       f->dr_ohm,    f->dr_std,  f->tau_s,    f->tau_std, f->lm_h,   f->slsig_h,
+                       f->slsig_std, f->rhf_ohm, f->gain_dev, f->rms_v,   f->i_top_a};
+    static const char *const names[] = {"r_ohm",     "r_std",   "td_s",     "td_std",  "vth_v",  "vth_std",
+                                        "dr_ohm",    "dr_std",  "tau_s",    "tau_std", "lm_h",   "slsig_h",
+                                        "slsig_std", "rhf_ohm", "gain_dev", "rms_v",   "i_top_a"};
+    for (int j = 0; j < (int)(sizeof v / sizeof v[0]); ++j)
+      printf("fit[%d].%s %.9g\n", k, names[j], (double)v[j]);
     printf("fit[%d].ok %d\nfit[%d].separable %d\n", k, f->ok, k, f->separable);
   }
 }
@@ -458,8 +461,8 @@ int main(int argc, char **argv)
              "rhf %.4f gain %.5f rms %.4f",
              k, (double)f->r_ohm, (double)f->r_std, (double)f->td_s * 1e6, (double)f->td_std * 1e6,
              (double)f->vth_v, (double)f->vth_std, (double)f->dr_ohm, (double)f->dr_std, (double)f->tau_s,
-             (double)f->tau_std, (double)f->lm_h, (double)f->slsig_h, (double)f->slsig_std, (double)f->rhf_ohm,
-             (double)f->gain_dev, (double)f->rms_v);
+             (double)f->tau_std, (double)f->lm_h, (double)f->slsig_h, (double)f->slsig_std,
+             (double)f->rhf_ohm, (double)f->gain_dev, (double)f->rms_v);
     }
   if (online && r->valid) {
     const comm_online_t *v[2] = {&on_id, &on_true};

@@ -14,7 +14,7 @@
 #define CM_LN2_LO_LIT 1.90821492927058770002e-10
 #define CM_LOG2E_LIT  1.44269504088896338700e+00
 /* terms of the series of e^r, |r| <= ln2 / 2: the next one, r^14 / 14!, is 1.2e-18 */
-#define CM_EXP_TERMS 13
+#define CM_EXP_TERMS  13
 
 double imest__cm_exp(double x)
 {

@@ -356,7 +356,7 @@ static int report_axis(axis_ctx_t *x, double u, double sse, const double d_p[CM_
   for (uint32_t bi = 0; bi < x->nb; ++bi) n_dc += dc_used(x, bi) ? 1u : 0u;
   if (!x->ok || n_dc <= x->npar) return -1;
   const double d2 = imest__cm_curvature(axis_cost, x, u, sse, 0.02);
-  (void)axis_solve(x, x->tau0 * imest__cm_exp(u));            /* beta at the minimum again */
+  (void)axis_solve(x, x->tau0 * imest__cm_exp(u));  /* beta at the minimum again */
   const double s2 = sse / (double)(n_dc - x->npar); /* per-sample variance of the voltage */
   const double tau = x->tau0 * imest__cm_exp(u);
   f->separable = !x->lumped;

@@ -174,8 +174,9 @@ void imest__cm_fit_standstill(imest_comm_t *c)
   r->flags |= IMEST_COMM_FLAG_STANDSTILL;
 
   /* plausibility */
-  const int ok = rs > 0.0f && rs < 1e3f && a.slm > 0.0f && a.slm < 10.0f && a.taum > 1e-3f && a.taum < 30.0f &&
-                 a.tdm > -0.5e-6f && a.tdm < 20e-6f && a.vthm > -0.5f && a.vthm < 5.0f && a.lmm > 0.0f;
+  const int ok = rs > 0.0f && rs < 1e3f && a.slm > 0.0f && a.slm < 10.0f && a.taum > 1e-3f &&
+                 a.taum < 30.0f && a.tdm > -0.5e-6f && a.tdm < 20e-6f && a.vthm > -0.5f && a.vthm < 5.0f &&
+                 a.lmm > 0.0f;
   if (!ok) {
     c->bg_fail = IMEST_COMM_REASON_IMPLAUSIBLE;
     return;
