@@ -414,10 +414,11 @@ typedef struct {
   float s[IMEST_COMM_NSUM];
 } imest_comm_block_t;
 
-/** Per-axis fit (background). */
+/** Per-axis fit (background): computed in float64, kept as float (each to well below its
+ *  standard error). */
 typedef struct {
-  double r_ohm, r_std, td_s, td_std, vth_v, vth_std, dr_ohm, dr_std;
-  double tau_s, tau_std, lm_h, slsig_h, slsig_std, rhf_ohm, gain_dev, rms_v, i_top_a;
+  float r_ohm, r_std, td_s, td_std, vth_v, vth_std, dr_ohm, dr_std;
+  float tau_s, tau_std, lm_h, slsig_h, slsig_std, rhf_ohm, gain_dev, rms_v, i_top_a;
   int ok, separable;
 } imest_comm_axis_fit_t;
 

@@ -1,17 +1,30 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Commissioning: config defaults and checks, instance set-up, abort, progress and names.
- * Runs outside the ISR (init) or reads only: float64 and <math.h> are fine here. */
+ * Runs outside the ISR (init) or reads only. float32: sample counts to the nearest sample,
+ * below 2^24 for any configured time and rate but time_max_s (where a few samples do not
+ * matter), and rates that are floats already. */
 #include <math.h>
 #include <stddef.h>
 
 #include "commission_internal.h"
 
+/* Copies n chars (src NULL: zeroes): a struct assignment would call memcpy, which nothing else
+   in the library links (0.3 KB on a Cortex-M4F); no <string.h> in the core. */
+void imest__cm_copy(void *dst, const void *src, size_t n)
+{
+  unsigned char *d = (unsigned char *)dst;
+  const unsigned char *s = (const unsigned char *)src;
+  if (s == NULL)
+    for (size_t b = 0; b < n; ++b) d[b] = 0u;
+  else
+    for (size_t b = 0; b < n; ++b) d[b] = s[b];
+}
+
 void imest_comm_config_default(imest_comm_config_t *cc)
 {
   if (cc == NULL) return;
   /* every field defined, those not named below 0 */
-  unsigned char *raw = (unsigned char *)cc;
-  for (size_t b = 0; b < sizeof *cc; ++b) raw[b] = 0u;
+  imest__cm_copy(cc, NULL, sizeof *cc);
   cc->fs_hz = 8000.0f;
   cc->pwm_hz = 0.0f;
   cc->i_max_a = 0.0f; /* required */
@@ -44,8 +57,8 @@ int imest_comm_config_check(const imest_comm_config_t *cc, const char **field)
     if (field) *field = "cc";
     return IMEST_ERR_NULL;
   }
-  const double fs = (double)cc->fs_hz;
-  if (!pos(cc->fs_hz) || fs < 1000.0 || fs > 1.0e5)
+  const float fs = cc->fs_hz;
+  if (!pos(fs) || fs < 1000.0f || fs > 1.0e5f)
     bad = "fs_hz";
   else if (!(isfinite(cc->pwm_hz) && cc->pwm_hz >= 0.0f) ||
            (cc->pwm_hz > 0.0f && (cc->pwm_hz < cc->fs_hz || cc->pwm_hz > 64.0f * cc->fs_hz)))
@@ -68,11 +81,11 @@ int imest_comm_config_check(const imest_comm_config_t *cc, const char **field)
     bad = "r_series_ohm";
   else if (cc->allow_rotation && !pos(cc->rated_voltage_v))
     bad = "rated_voltage_v";
-  else if (cc->allow_rotation && !(pos(cc->rated_freq_hz) && (double)cc->rated_freq_hz < 0.1 * fs))
+  else if (cc->allow_rotation && !(pos(cc->rated_freq_hz) && cc->rated_freq_hz < 0.1f * fs))
     bad = "rated_freq_hz";
   else if (!(isfinite(cc->rated_speed_rpm) && cc->rated_speed_rpm >= 0.0f) ||
            (cc->rated_speed_rpm > 0.0f && pos(cc->rated_freq_hz) &&
-            (double)cc->rated_speed_rpm >= 60.0 * (double)cc->rated_freq_hz))
+            cc->rated_speed_rpm >= 60.0f * cc->rated_freq_hz))
     bad = "rated_speed_rpm";
   else if (!(isfinite(cc->speed_frac) && cc->speed_frac >= 0.05f && cc->speed_frac <= 1.0f))
     bad = "speed_frac";
@@ -82,10 +95,10 @@ int imest_comm_config_check(const imest_comm_config_t *cc, const char **field)
   return bad ? IMEST_ERR_CONFIG : IMEST_OK;
 }
 
-static uint32_t samples(double t_s, double fs)
+static uint32_t samples(float t_s, float fs)
 {
-  const double n = t_s * fs + 0.5;
-  return n < 1.0 ? 1u : (n > 4.0e9 ? 4000000000u : (uint32_t)n);
+  const float n = t_s * fs + 0.5f;
+  return n < 1.0f ? 1u : (n > 4.0e9f ? 4000000000u : (uint32_t)n);
 }
 
 int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
@@ -93,26 +106,24 @@ int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
   if (c == NULL || cc == NULL) return IMEST_ERR_NULL;
   const int rc = imest_comm_config_check(cc, NULL);
   if (rc != IMEST_OK) return rc;
-  unsigned char *raw = (unsigned char *)c; /* no <string.h> in the core */
-  for (size_t b = 0; b < sizeof *c; ++b) raw[b] = 0u;
-
-  c->cfg = *cc;
-  const double fs = (double)cc->fs_hz;
-  c->ts_s = (float)(1.0 / fs);
+  imest__cm_copy(c, NULL, sizeof *c);
+  imest__cm_copy(&c->cfg, cc, sizeof *cc);
+  const float fs = cc->fs_hz;
+  c->ts_s = 1.0f / fs;
   c->fpwm = cc->pwm_hz > 0.0f ? cc->pwm_hz : cc->fs_hz;
   c->i_trip = cc->i_max_a;
   /* phase current top level -> alpha/beta axis current: i_n = sqrt(3/2) i_phase */
   c->level_a = cc->level_frac * cc->i_max_a * IMEST_SQRT3_2_F;
   /* Current loop crossover fs/40 (1.5 samples of delay cost 13 degrees of phase there). */
-  c->wc = (float)(2.0 * IMEST_PI_D * fs / 40.0);
-  c->n_off = samples(0.25, fs);
+  c->wc = IMEST_2PI_F * fs / 40.0f;
+  c->n_off = samples(0.25f, fs);
   /* discards after a level step and after a pattern switch: the loop's settling (about 5 and
      4 closed-loop time constants of the slow PI zero at wc/4) */
-  c->n_disc_level = samples(20.0 / (double)c->wc, fs);
-  c->n_disc_pattern = samples(12.0 / (double)c->wc, fs);
+  c->n_disc_level = samples(20.0f / c->wc, fs);
+  c->n_disc_pattern = samples(12.0f / c->wc, fs);
   c->n_hf_half = 4u; /* square wave at fs/8 */
-  c->n_hf_blk = samples(0.2 / (double)CM_HF_BLOCKS, fs);
-  c->n_max = samples((double)cc->time_max_s, fs);
+  c->n_hf_blk = samples(0.2f / (float)CM_HF_BLOCKS, fs);
+  c->n_max = samples(cc->time_max_s, fs);
   for (int x = 0; x < 3; ++x) {
     c->ginv[x] = 1.0f;
     c->bg_ginv[x] = 1.0f;

@@ -4,6 +4,8 @@
 #ifndef IMEST_COMMISSION_INTERNAL_H
 #define IMEST_COMMISSION_INTERNAL_H
 
+#include <stddef.h>
+
 #include "imest/imest_commission.h"
 #include "common/imest_math.h" /* constants, imest__abs, imest__clarke, IMEST_BARRIER */
 
@@ -76,6 +78,24 @@ static inline float cm_level(uint32_t p)
   const uint32_t q = p < 3u ? p + 1u : 5u - p;
   return (float)q * (1.0f / 3.0f);
 }
+
+/* The component of three phase values along axis a (0..2) in the power-invariant 3-2 transform
+   (imest__clarke's alpha for a = 0). */
+static inline float cm_axis_component(const float x[3], uint32_t a)
+{
+  return IMEST_SQRT2_3_F * (x[a] - 0.5f * (x[(a + 1u) % 3u] + x[(a + 2u) % 3u]));
+}
+
+/* The inverse of imest__clarke: phase values from alpha/beta (zero sequence 0). */
+static inline void cm_clarke_inv(float xa, float xb, float x[3])
+{
+  x[0] = IMEST_SQRT2_3_F * xa;
+  x[1] = IMEST_SQRT2_3_F * (-0.5f * xa + IMEST_HALF_SQRT3_F * xb);
+  x[2] = IMEST_SQRT2_3_F * (-0.5f * xa - IMEST_HALF_SQRT3_F * xb);
+}
+
+/* n chars from src to dst, or zeroes if src is NULL (commission_init.c; no memcpy). */
+void imest__cm_copy(void *dst, const void *src, size_t n);
 
 /* ISR side (commission_isr.c and the stage files). */
 void imest__cm_fail(imest_comm_t *c, int reason);

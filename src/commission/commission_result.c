@@ -10,7 +10,7 @@
 int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r)
 {
   if (c == NULL || r == NULL) return IMEST_ERR_NULL;
-  *r = c->res;
+  imest__cm_copy(r, &c->res, sizeof *r);
   r->state = c->state;
   r->reason = c->reason;
   if (c->state == IMEST_COMM_RUNNING || c->state == IMEST_COMM_IDLE) r->stage = (int)c->stage;
@@ -38,6 +38,13 @@ static float quality_rel(const imest_comm_value_t *v)
   return fmaxf(std3_rel(v), isfinite(v->spread_rel) ? v->spread_rel : 0.0f);
 }
 
+/* min(u, IMEST_COMM_UNCERTAINTY_MAX), the maximum for NaN (as fminf, which nothing else in
+   the library links) */
+static float at_most_max(float u)
+{
+  return u < IMEST_COMM_UNCERTAINTY_MAX ? u : IMEST_COMM_UNCERTAINTY_MAX;
+}
+
 /* The rule imest_commission.h states for ls_uncertainty and sigma_uncertainty.
  * curve: the magnetising curve goes to the config, so the estimator takes L_S
  * (and sigma with it) at each window's flux, and their change over the curve
@@ -50,12 +57,12 @@ static void constants_uncertainty(const imest_comm_result_t *r, int curve, imest
   const float q_ls = curve ? std3_rel(&r->ls_h) : quality_rel(&r->ls_h);
   const float u_ls = fmaxf(standstill ? IMEST_COMM_LS_FLOOR_STANDSTILL : IMEST_COMM_LS_FLOOR,
                            fmaxf(q_ls, standstill ? quality_rel(&r->ls_standstill_h) : 0.0f));
-  cfg->ls_uncertainty = fminf(u_ls, IMEST_COMM_UNCERTAINTY_MAX);
+  cfg->ls_uncertainty = at_most_max(u_ls);
   if (r->flags & IMEST_COMM_FLAG_ROTOR_HF) return;
   const float q_sg = curve ? std3_rel(&r->sigma) : quality_rel(&r->sigma);
   const float u_sg = fmaxf(standstill ? IMEST_COMM_SIGMA_FLOOR_STANDSTILL : IMEST_COMM_SIGMA_FLOOR,
                            fmaxf(q_sg, quality_rel(&r->sigma_ls_h) + u_ls));
-  cfg->sigma_uncertainty = fminf(u_sg, IMEST_COMM_UNCERTAINTY_MAX);
+  cfg->sigma_uncertainty = at_most_max(u_sg);
 }
 
 int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)

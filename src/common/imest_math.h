@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The library's one math header: its constants (each number written once),
  * the arithmetic type of the per-sample paths and the helpers they share
- * (absolute value, square root, the 3-2 transform, angle wrapping) without
+ * (absolute value, square root, the 3-2 transform, rotation, angle wrapping) without
  * libm. imest_real_t is float (float64 only in the host-side reference build,
  * IMEST_REAL_DOUBLE, src/CMakeLists.txt). Literals go through RL() so the
  * float build never promotes to double (-Wdouble-promotion). Internal: not
@@ -126,6 +126,16 @@ static inline void imest__clarke(const imest_real_t x[3], imest_real_t *xa, imes
   const imest_real_t k_b = RL(IMEST_SQRT1_2_LIT);
   *xa = k_a * (x[0] - RL(0.5) * (x[1] + x[2]));
   *xb = k_b * (x[1] - x[2]);
+}
+
+/* Rotation by the angle phi (s = sin phi, c = cos phi) into the frame turned by phi
+ * (docs/METHOD.md eq. 2, into the rotor frame): x = c*a + s*b, y = -s*a + c*b.
+ * With -s it turns the other way (a phasor advanced by phi). */
+static inline void imest__rotate(imest_real_t s, imest_real_t c, imest_real_t a, imest_real_t b,
+                                 imest_real_t *x, imest_real_t *y)
+{
+  *x = c * a + s * b;
+  *y = c * b - s * a;
 }
 
 /* x - 2*pi*round(x / 2*pi): wraps into [-pi, pi]. |x| must be < 2^31 * 2pi

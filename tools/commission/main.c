@@ -63,6 +63,9 @@ static void usage(FILE *f)
           "                       deep-bar rotor: give the data sheet's), line 2 the inverter model\n"
           "                       (for --voltage duty)\n"
           "  --verbose            also the per-axis fits\n"
+          "  --result             instead of the table: every field of the result, one per line\n"
+          "                       (name and value to 9 digits), the per-axis fits and, with\n"
+          "                       --online, the online estimator's figures\n"
           "  --sensitivity        instead: the online estimator's T_R and R_S error per 1 %% error of\n"
           "                       L_S and sigma and per 0.1 V of inverter model error (preset at\n"
           "                       --load of rated torque, phase-voltage input)\n"
@@ -136,6 +139,75 @@ static void row(const char *name, double scale, double id, double tr, const char
          note ? note : "");
 }
 
+static void print_value(const char *name, const imest_comm_value_t *v)
+{
+  printf("%s %.9g\n%s.std_rel %.9g\n%s.spread_rel %.9g\n", name, (double)v->value, name, (double)v->std_rel,
+         name, (double)v->spread_rel);
+}
+
+static void print_floats(const char *name, const float *v, unsigned int n)
+{
+  for (unsigned int k = 0; k < n; ++k) printf("%s[%u] %.9g\n", name, k, (double)v[k]);
+}
+
+static void print_online(const char *which, const comm_online_t *v)
+{
+  printf("online.%s.windows %d\nonline.%s.tr_valid %d\nonline.%s.rs_valid %d\n", which, v->windows, which,
+         v->tr_valid, which, v->rs_valid);
+  printf("online.%s.tr_rel %.9g\nonline.%s.rs_rel %.9g\n", which, v->tr_rel, which, v->rs_rel);
+  printf("online.%s.tr_all_rel %.9g\nonline.%s.rs_all_rel %.9g\n", which, v->tr_all_rel, which,
+         v->rs_all_rel);
+}
+
+/* --result: every field of the result, for comparing two builds (name value per line). */
+static void print_result(const imest_comm_result_t *r, const imest_comm_axis_fit_t fit[3])
+{
+  printf("state %d\nreason %d\nstage %d\nvalid %d\nflags %u\n", r->state, r->reason, r->stage, r->valid,
+         r->flags);
+  printf("time_s %.9g\ni_peak_a %.9g\nvdc_v %.9g\n", (double)r->time_s, (double)r->i_peak_a,
+         (double)r->vdc_v);
+  print_floats("i_offset_a", r->i_offset_a, 3u);
+  print_floats("i_gain_rel", r->i_gain_rel, 3u);
+  for (int k = 0; k < 3; ++k) printf("wiring_map[%d] %d\n", k, r->wiring_map[k]);
+  print_value("rs_ohm", &r->rs_ohm);
+  print_floats("rs_axis_ohm", r->rs_axis_ohm, 3u);
+  print_value("sigma_ls_h", &r->sigma_ls_h);
+  print_value("tr_s", &r->tr_s);
+  print_value("rr_ohm", &r->rr_ohm);
+  print_value("ls_standstill_h", &r->ls_standstill_h);
+  const imest_inverter_t *inv = &r->inverter;
+  printf("inverter.dead_time_s %.9g\ninverter.v_switch_v %.9g\ninverter.v_diode_v %.9g\n"
+         "inverter.r_switch_ohm %.9g\ninverter.r_diode_ohm %.9g\ninverter.i_band_a %.9g\n"
+         "inverter.uncertainty %.9g\n",
+         (double)inv->dead_time_s, (double)inv->v_switch_v, (double)inv->v_diode_v, (double)inv->r_switch_ohm,
+         (double)inv->r_diode_ohm, (double)inv->i_band_a, (double)inv->uncertainty);
+  print_value("dead_time_s", &r->dead_time_s);
+  print_value("v_threshold_v", &r->v_threshold_v);
+  print_value("dr_ohm", &r->dr_ohm);
+  printf("dc_fit_rms_v %.9g\nrotor_moved_rad %.9g\n", (double)r->dc_fit_rms_v, (double)r->rotor_moved_rad);
+  print_value("ls_h", &r->ls_h);
+  print_value("sigma", &r->sigma);
+  printf("pole_pairs %u\nencoder_dir %d\nencoder_cpr %.9g\nspeed_ratio %.9g\nslip %.9g\nneg_seq_rel %.9g\n",
+         r->pole_pairs, r->encoder_dir, (double)r->encoder_cpr, (double)r->speed_ratio, (double)r->slip,
+         (double)r->neg_seq_rel);
+  printf("rotating_r_ohm %.9g\nrotating_i_a %.9g\nrotating_f_hz %.9g\nls_curve_points %u\n",
+         (double)r->rotating_r_ohm, (double)r->rotating_i_a, (double)r->rotating_f_hz, r->ls_curve_points);
+  print_floats("ls_curve_i_a", r->ls_curve_i_a, r->ls_curve_points < 4u ? r->ls_curve_points : 4u);
+  print_floats("ls_curve_h", r->ls_curve_h, r->ls_curve_points < 4u ? r->ls_curve_points : 4u);
+  for (int k = 0; k < 3; ++k) {
+    const imest_comm_axis_fit_t *f = &fit[k];
+    const float v[] = {f->r_ohm,     f->r_std,   f->td_s,     f->td_std,  f->vth_v,  f->vth_std,
+                       f->dr_ohm,    f->dr_std,  f->tau_s,    f->tau_std, f->lm_h,   f->slsig_h,
+                       f->slsig_std, f->rhf_ohm, f->gain_dev, f->rms_v,   f->i_top_a};
+    static const char *const names[] = {"r_ohm",     "r_std",   "td_s",     "td_std",  "vth_v",  "vth_std",
+                                        "dr_ohm",    "dr_std",  "tau_s",    "tau_std", "lm_h",   "slsig_h",
+                                        "slsig_std", "rhf_ohm", "gain_dev", "rms_v",   "i_top_a"};
+    for (int j = 0; j < (int)(sizeof v / sizeof v[0]); ++j)
+      printf("fit[%d].%s %.9g\n", k, names[j], (double)v[j]);
+    printf("fit[%d].ok %d\nfit[%d].separable %d\n", k, f->ok, k, f->separable);
+  }
+}
+
 int main(int argc, char **argv)
 {
   comm_sim_opts_t o;
@@ -148,7 +220,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "%s: unknown preset '%s' (%s)\n", k_prog, preset, imsim_preset_names());
     return 2;
   }
-  int csv = 0, apply_args = 0, verbose = 0, sensitivity = 0, online = 0, duty_input = 0;
+  int csv = 0, apply_args = 0, result = 0, verbose = 0, sensitivity = 0, online = 0, duty_input = 0;
   double load = 1.0;
   const char *trace = NULL;
   tool_args_t a;
@@ -234,6 +306,9 @@ int main(int argc, char **argv)
       }
       o.real_off =
           single ? o.real_off | COMM_SIM_OFF_DOUBLE_CAGE : o.real_off & ~(unsigned)COMM_SIM_OFF_DOUBLE_CAGE;
+    } else if (tool_args_is(&a, "--result")) {
+      if (tool_args_flag(&a)) return 2;
+      result = 1;
     } else if (tool_args_is(&a, "--csv")) {
       if (tool_args_flag(&a)) return 2;
       csv = 1;
@@ -331,6 +406,14 @@ int main(int argc, char **argv)
       return 1;
     }
   }
+  if (result) {
+    print_result(r, out.fit);
+    if (online && r->valid) {
+      print_online("identified", &on_id);
+      print_online("true", &on_true);
+    }
+    return r->valid ? 0 : 1;
+  }
   if (csv) {
     printf(
         "preset,state,reason,valid,time_s,i_peak_a,rs_err_pct,rs_winding_err_pct,sigma_ls_err_pct,ls_err_pct,"
@@ -423,9 +506,10 @@ int main(int argc, char **argv)
       printf("\n  axis %d: R %.5f (%.2g) td %.4f us (%.2g) vth %.4f (%.2g) dr %.5f (%.2g) tau %.5f (%.2g) lm "
              "%.5f sl %.6f (%.2g) "
              "rhf %.4f gain %.5f rms %.4f",
-             k, f->r_ohm, f->r_std, f->td_s * 1e6, f->td_std * 1e6, f->vth_v, f->vth_std, f->dr_ohm,
-             f->dr_std, f->tau_s, f->tau_std, f->lm_h, f->slsig_h, f->slsig_std, f->rhf_ohm, f->gain_dev,
-             f->rms_v);
+             k, (double)f->r_ohm, (double)f->r_std, (double)f->td_s * 1e6, (double)f->td_std * 1e6,
+             (double)f->vth_v, (double)f->vth_std, (double)f->dr_ohm, (double)f->dr_std, (double)f->tau_s,
+             (double)f->tau_std, (double)f->lm_h, (double)f->slsig_h, (double)f->slsig_std,
+             (double)f->rhf_ohm, (double)f->gain_dev, (double)f->rms_v);
     }
   if (online && r->valid) {
     const comm_online_t *v[2] = {&on_id, &on_true};

@@ -158,7 +158,7 @@ static double axis_solve(axis_ctx_t *x, double tau)
 static double axis_cost(void *ctx, double u)
 {
   axis_ctx_t *x = (axis_ctx_t *)ctx;
-  return axis_solve(x, x->tau0 * exp(u));
+  return axis_solve(x, x->tau0 * imest__cm_exp(u));
 }
 
 /* (1 - sigma) L_S from the tails of consecutive plateaus (weighted by their current steps). */
@@ -170,8 +170,8 @@ static double tail_lm(const axis_ctx_t *x, double tau, const double d_p[CM_PLATE
   double num = 0.0, den = 0.0;
   for (uint32_t p = 1; p < CM_PLATEAUS; ++p) {
     const double dt = ((double)x->kp[p] + d_p[p] - (double)x->kp[p - 1u] - d_p[p - 1u]) * ts;
-    const double a_now = x->beta[j + p] * exp(-d_p[p] * ts / tau);
-    const double a_before = x->beta[j + p - 1u] * exp(-d_p[p - 1u] * ts / tau - dt / tau);
+    const double a_now = x->beta[j + p] * imest__cm_exp(-d_p[p] * ts / tau);
+    const double a_before = x->beta[j + p - 1u] * imest__cm_exp(-d_p[p - 1u] * ts / tau - dt / tau);
     const double di = i_p[p] - i_p[p - 1u];
     if (di == 0.0) continue;
     num += fabs(di) * tau * (a_now - a_before) / di;
@@ -201,16 +201,16 @@ static void fit_square_wave(imest_comm_t *c, uint32_t nb, imest_comm_axis_fit_t 
   r[2] = s[CM_H_Y];
   const double rhs[3] = {r[0], r[1], r[2]};
   if (n < 16.0 || imest__cm_chol_solve(a, r, 3u, dinv) != 0 || !(r[0] > 0.0)) {
-    f->slsig_h = (double)NAN;
-    f->slsig_std = (double)NAN;
-    f->rhf_ohm = (double)NAN;
+    f->slsig_h = NAN;
+    f->slsig_std = NAN;
+    f->rhf_ohm = NAN;
     return;
   }
   const double sse = s[CM_H_YY] - (r[0] * rhs[0] + r[1] * rhs[1] + r[2] * rhs[2]);
   const double s2 = sse > 0.0 ? sse / (n - 3.0) : 0.0;
-  f->slsig_h = (double)c->ts_s / r[0];
-  f->slsig_std = sqrt(s2 * dinv[0]) / r[0];
-  f->rhf_ohm = -r[1] / r[0];
+  f->slsig_h = (float)((double)c->ts_s / r[0]);
+  f->slsig_std = (float)(sqrt(s2 * dinv[0]) / r[0]);
+  f->rhf_ohm = (float)(-r[1] / r[0]);
 }
 
 /* The DC blocks' sums become means (the fits evaluate them many times); the buffer is the
@@ -259,21 +259,16 @@ static int plateau_means(axis_ctx_t *x, double d_p[CM_PLATEAUS], double i_p[CM_P
 static double sensor_gain_dev(const axis_ctx_t *x)
 {
   const imest_comm_t *c = x->c;
-  double gw = 0, gx = 0, gy = 0, gxx = 0, gxy = 0;
+  cm_line_t line = {0};
   for (uint32_t bi = 0; bi < x->nb; ++bi) {
     const imest_comm_block_t *b = &c->blk[bi];
     if (!dc_block(b)) continue;
-    const double w = (double)b->n;
-    const double xm = (double)b->s[CM_S_MA + x->axis];
     const double z = (double)b->s[CM_S_MA] + (double)b->s[CM_S_MA + 1] + (double)b->s[CM_S_MA + 2];
-    gw += w;
-    gx += w * xm;
-    gy += w * z;
-    gxx += w * xm * xm;
-    gxy += w * xm * z;
+    imest__cm_line_add(&line, (double)b->n, (double)b->s[CM_S_MA + x->axis], z);
   }
-  const double gdet = gw * gxx - gx * gx;
-  return (c->cfg.n_sensors == 3u && gdet > 0.0) ? (gw * gxy - gx * gy) / gdet / 1.5 : 0.0;
+  double slope;
+  (void)imest__cm_line_fit(&line, &slope);
+  return c->cfg.n_sensors == 3u ? slope / 1.5 : 0.0;
 }
 
 /* Adds to skip the clamped blocks whose switching leg's pulse is shorter than 2.1 dead times;
@@ -306,12 +301,12 @@ static double tau_passes(axis_ctx_t *x, double sl, const double d_p[CM_PLATEAUS]
     /* the first pass searches a factor e around the probe's tau, later ones close to the last */
     u = pass == 0 ? imest__cm_golden(axis_cost, x, u0 - 1.0, u0 + 1.0, 24u)
                   : imest__cm_golden(axis_cost, x, u - 0.05, u + 0.05, 16u);
-    sse = axis_solve(x, x->tau0 * exp(u));
+    sse = axis_solve(x, x->tau0 * imest__cm_exp(u));
     if (!x->ok) break;
     const double td = x->lumped ? 0.0 : x->beta[COL_TD];
     uint64_t skip = x->skip;
     const uint32_t clamped = skip_short_pulses(x, td, &skip);
-    const double lm = tail_lm(x, x->tau0 * exp(u), d_p, i_p);
+    const double lm = tail_lm(x, x->tau0 * imest__cm_exp(u), d_p, i_p);
     const double ishift =
         (!x->lumped && sl > 0.0) ? IMEST_SQRT2_3_LIT * (double)c->vdc0 * td / (2.0 * sl) : 0.0;
     const double dyn = lm > 0.0 ? lm * ishift : 0.0;
@@ -334,19 +329,19 @@ static void report_inverter(const axis_ctx_t *x, double s2, imest_comm_axis_fit_
 {
   const double ktd = (double)x->c->fpwm * (double)x->c->vdc0;
   if (!x->lumped) {
-    f->td_s = x->beta[COL_TD];
-    f->td_std = sqrt(s2 * x->dinv[COL_TD]);
-    f->vth_v = x->beta[COL_VTH];
-    f->vth_std = sqrt(s2 * x->dinv[COL_VTH]);
-    f->dr_ohm = x->beta[COL_DR];
-    f->dr_std = sqrt(s2 * x->dinv[COL_DR]);
+    f->td_s = (float)x->beta[COL_TD];
+    f->td_std = (float)sqrt(s2 * x->dinv[COL_TD]);
+    f->vth_v = (float)x->beta[COL_VTH];
+    f->vth_std = (float)sqrt(s2 * x->dinv[COL_VTH]);
+    f->dr_ohm = (float)x->beta[COL_DR];
+    f->dr_std = (float)sqrt(s2 * x->dinv[COL_DR]);
   } else { /* all of it as dead time: it usually dominates, and scales with the bus */
-    f->td_s = x->beta[1] / ktd;
-    f->td_std = sqrt(s2 * x->dinv[1]) / ktd;
-    f->vth_v = 0.0;
-    f->vth_std = (double)NAN;
-    f->dr_ohm = 0.0;
-    f->dr_std = (double)NAN;
+    f->td_s = (float)(x->beta[1] / ktd);
+    f->td_std = (float)(sqrt(s2 * x->dinv[1]) / ktd);
+    f->vth_v = 0.0f;
+    f->vth_std = NAN;
+    f->dr_ohm = 0.0f;
+    f->dr_std = NAN;
   }
 }
 
@@ -360,25 +355,24 @@ static int report_axis(axis_ctx_t *x, double u, double sse, const double d_p[CM_
   uint32_t n_dc = 0u;
   for (uint32_t bi = 0; bi < x->nb; ++bi) n_dc += dc_used(x, bi) ? 1u : 0u;
   if (!x->ok || n_dc <= x->npar) return -1;
-  const double h = 0.02;
-  const double d2 = (axis_cost(x, u + h) - 2.0 * sse + axis_cost(x, u - h)) / (h * h);
-  (void)axis_solve(x, x->tau0 * exp(u));            /* beta at the minimum again */
+  const double d2 = imest__cm_curvature(axis_cost, x, u, sse, 0.02);
+  (void)axis_solve(x, x->tau0 * imest__cm_exp(u));  /* beta at the minimum again */
   const double s2 = sse / (double)(n_dc - x->npar); /* per-sample variance of the voltage */
-  const double tau = x->tau0 * exp(u);
+  const double tau = x->tau0 * imest__cm_exp(u);
   f->separable = !x->lumped;
-  f->r_ohm = x->beta[COL_R];
-  f->r_std = sqrt(s2 * x->dinv[COL_R]);
+  f->r_ohm = (float)x->beta[COL_R];
+  f->r_std = (float)sqrt(s2 * x->dinv[COL_R]);
   report_inverter(x, s2, f);
-  f->tau_s = tau;
-  f->tau_std = d2 > 0.0 ? tau * sqrt(2.0 * s2 / d2) : (double)NAN;
-  f->i_top_a = i_p[2];
+  f->tau_s = (float)tau;
+  f->tau_std = (float)(d2 > 0.0 ? tau * sqrt(2.0 * s2 / d2) : (double)NAN);
+  f->i_top_a = (float)i_p[2];
   {
     double wsum = 0.0;
     for (uint32_t bi = 0; bi < x->nb; ++bi)
       if (dc_used(x, bi)) wsum += (double)c->blk[bi].n;
-    f->rms_v = wsum > 0.0 ? sqrt(sse / wsum) : (double)NAN;
+    f->rms_v = (float)(wsum > 0.0 ? sqrt(sse / wsum) : (double)NAN);
   }
-  f->lm_h = tail_lm(x, tau, d_p, i_p);
+  f->lm_h = (float)tail_lm(x, tau, d_p, i_p);
   return 0;
 }
 
@@ -395,11 +389,11 @@ void imest__cm_fit_axis(imest_comm_t *c, uint32_t axis)
     c->bg_fail = IMEST_COMM_REASON_FIT;
     return;
   }
-  f->gain_dev = sensor_gain_dev(&x);
+  f->gain_dev = (float)sensor_gain_dev(&x);
   fit_square_wave(c, x.nb, f);
 
   x.tau0 = (double)(c->tau > 0.0f ? c->tau : 0.1f);
-  const double sl = f->slsig_h > 0.0 ? f->slsig_h : (double)c->sl_rough;
+  const double sl = (double)(f->slsig_h > 0.0f ? f->slsig_h : c->sl_rough);
   x.skip = 0u;
   x.lumped = 0;
   x.shifted = c->cfg.pwm_on_centred ? CM_PAT_LOW : CM_PAT_HIGH;
@@ -412,5 +406,5 @@ void imest__cm_fit_axis(imest_comm_t *c, uint32_t axis)
     return;
   }
   f->ok = 1;
-  if (f->slsig_h > 0.0) c->bg_sl = (float)f->slsig_h;
+  if (f->slsig_h > 0.0f) c->bg_sl = f->slsig_h;
 }

@@ -14,7 +14,7 @@
 /* Weighted least squares of v_b = c + A g_b: returns the residual sum (weights n_b). */
 static double probe_sse(const imest_comm_t *c, uint32_t nb, double tau, double *amp)
 {
-  double sw = 0, sg = 0, sgg = 0, sv = 0, svg = 0, svv = 0;
+  cm_line_t line = {0};
   cm_decay_t dec;
   imest__cm_decay_init(&dec, (double)c->ts_s, tau);
   for (uint32_t b = 0; b < nb; ++b) {
@@ -22,22 +22,12 @@ static double probe_sse(const imest_comm_t *c, uint32_t nb, double tau, double *
     if (k->n == 0u) continue;
     const double w = (double)k->n, v = (double)k->s[0] / w;
     const double g = imest__cm_decay_pow(&dec, k->k0 - c->probe_k0) * imest__cm_decay_mean(&dec, k->n);
-    sw += w;
-    sg += w * g;
-    sgg += w * g * g;
-    sv += w * v;
-    svg += w * v * g;
-    svv += w * v * v;
+    imest__cm_line_add(&line, w, g, v);
   }
-  const double det = sw * sgg - sg * sg;
-  if (!(det > 0.0)) {
-    if (amp) *amp = 0.0;
-    return svv - (sw > 0.0 ? sv * sv / sw : 0.0);
-  }
-  const double a = (sw * svg - sg * sv) / det;
-  const double c0 = (sv - a * sg) / sw;
+  double a;
+  const double sse = imest__cm_line_fit(&line, &a);
   if (amp) *amp = a;
-  return svv - c0 * sv - a * svg;
+  return sse;
 }
 
 double imest__cm_golden(double (*f)(void *, double), void *ctx, double lo, double hi, unsigned int iters)
@@ -64,6 +54,11 @@ double imest__cm_golden(double (*f)(void *, double), void *ctx, double lo, doubl
   return f1 < f2 ? x1 : x2;
 }
 
+double imest__cm_curvature(double (*f)(void *, double), void *ctx, double u, double f_u, double h)
+{
+  return (f(ctx, u + h) - 2.0 * f_u + f(ctx, u - h)) / (h * h);
+}
+
 /* tau = tau_lo e^u: the search runs in u (no logarithm needed) */
 typedef struct {
   const imest_comm_t *c;
@@ -74,7 +69,7 @@ typedef struct {
 static double probe_cost(void *ctx, double u)
 {
   const probe_ctx_t *p = (const probe_ctx_t *)ctx;
-  return probe_sse(p->c, p->nb, p->tau_lo * exp(u), NULL);
+  return probe_sse(p->c, p->nb, p->tau_lo * imest__cm_exp(u), NULL);
 }
 
 void imest__cm_fit_probe(imest_comm_t *c)
@@ -99,15 +94,14 @@ void imest__cm_fit_probe(imest_comm_t *c)
   if (hi > u_hi) hi = u_hi;
   const double u = imest__cm_golden(probe_cost, &ctx, lo, hi, 30u);
   double amp;
-  const double sse = probe_sse(c, nb, ctx.tau_lo * exp(u), &amp);
+  const double sse = probe_sse(c, nb, ctx.tau_lo * imest__cm_exp(u), &amp);
   /* curvature of the residual in ln tau -> standard error of ln tau */
-  const double h = 0.05;
-  const double d2 = (probe_cost(&ctx, u + h) - 2.0 * sse + probe_cost(&ctx, u - h)) / (h * h);
+  const double d2 = imest__cm_curvature(probe_cost, &ctx, u, sse, 0.05);
   const double s2 = nb > 3u ? sse / (double)(nb - 3u) : 0.0;
   const double var_u = d2 > 0.0 ? 2.0 * s2 / d2 : 1e9;
   const imest_comm_block_t *last = &c->blk[nb - 1u];
   const double span = (double)(last->k0 + last->n - c->probe_k0) * ts;
-  const double tau = ctx.tau_lo * exp(u);
+  const double tau = ctx.tau_lo * imest__cm_exp(u);
   c->bg_tau = (float)tau;
   c->bg_tau_ok = (span >= 2.5 * tau && var_u < 0.01 && amp != 0.0) ? 1 : 0;
 }

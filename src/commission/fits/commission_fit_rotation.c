@@ -22,7 +22,11 @@
  * the current by less than 1 % (the current within 80 % of the staircase's top level: at that
  * limit the run stays below the rated flux). L_S at rated flux is then interpolated between
  * the two levels nearest it in flux. Two more levels, 0.85 and 0.7 i*, complete the magnetising
- * curve (with the rated point and the first level if it ran above 1.05 i*). float64. */
+ * curve (with the rated point and the first level if it ran above 1.05 i*).
+ * float32: the ISR's sums are float32, and what is computed from them here are a few ratios and
+ * products (no sums, no differences of near-equal terms but the slip's Re Z - R_S, whose
+ * rounding, 1e-7 of R_S, is far below its noise); n_p and the counts are integers well
+ * inside float32's 2^24. */
 #include <math.h>
 #include <stddef.h>
 
@@ -30,73 +34,73 @@
 
 /* The demodulated means: Z = U / I at w_e (zr, zi), the current's amplitude and negative
    sequence. IMEST_COMM_REASON_NONE, or why it failed. */
-static int impedance(imest_comm_t *c, double *zr_out, double *zi_out)
+static int impedance(imest_comm_t *c, float *zr_out, float *zi_out)
 {
   imest_comm_result_t *r = &c->res;
   const float *s = c->rot_sum;
-  const double n = (double)s[CM_R_N], ts = (double)c->ts_s, we = (double)s[CM_R_WE];
-  const double id = (double)s[CM_R_ID] / n, iq = (double)s[CM_R_IQ] / n;
-  const double nd = (double)s[CM_R_ND] / n, nq = (double)s[CM_R_NQ] / n;
-  const double hx = 0.5 * we * ts; /* below 0.1 rad: sin(x)/x by its series */
-  const double hold = 1.0 - hx * hx / 6.0 * (1.0 - hx * hx / 20.0);
-  const double ud = (double)s[CM_R_UD] / n * hold, uq = (double)s[CM_R_UQ] / n * hold;
-  const double i2 = id * id + iq * iq;
-  r->rotating_f_hz = (float)(we / (2.0 * IMEST_PI_D));
-  r->rotating_i_a = (float)sqrt(i2);
-  r->neg_seq_rel = i2 > 0.0 ? (float)sqrt((nd * nd + nq * nq) / i2) : (float)NAN;
-  if (!(i2 > 0.0)) return IMEST_COMM_REASON_FIT;
+  const float n = s[CM_R_N], we = s[CM_R_WE];
+  const float id = s[CM_R_ID] / n, iq = s[CM_R_IQ] / n;
+  const float nd = s[CM_R_ND] / n, nq = s[CM_R_NQ] / n;
+  const float hx = 0.5f * we * c->ts_s; /* below 0.1 rad: sin(x)/x by its series */
+  const float hold = 1.0f - hx * hx / 6.0f * (1.0f - hx * hx / 20.0f);
+  const float ud = s[CM_R_UD] / n * hold, uq = s[CM_R_UQ] / n * hold;
+  const float i2 = id * id + iq * iq;
+  r->rotating_f_hz = we * (float)IMEST_INV_2PI_LIT;
+  r->rotating_i_a = imest__sqrt(i2);
+  r->neg_seq_rel = i2 > 0.0f ? imest__sqrt((nd * nd + nq * nq) / i2) : NAN;
+  if (!(i2 > 0.0f)) return IMEST_COMM_REASON_FIT;
   /* Z = U / I */
-  const double zr = (ud * id + uq * iq) / i2, zi = (uq * id - ud * iq) / i2;
-  r->rotating_r_ohm = (float)zr;
+  const float zr = (ud * id + uq * iq) / i2, zi = (uq * id - ud * iq) / i2;
+  r->rotating_r_ohm = zr;
   if (r->neg_seq_rel > 0.5f) return IMEST_COMM_REASON_PHASE_ORDER;
   *zr_out = zr;
   *zi_out = zi;
   return IMEST_COMM_REASON_NONE;
 }
 
+/* floor(v) for 0 <= v < 2^31 without libm (v itself otherwise: NaN stays NaN) */
+static float floor_pos(float v)
+{
+  return v >= 0.0f && v < 2147483648.0f ? (float)(uint32_t)v : v;
+}
+
 /* n_p and the encoder's counts from the speed ratio at zero slip (arho = |rho| (1 - slip)):
    from the nameplate's rated speed if given, else the counts assumed right.
    IMEST_COMM_REASON_NONE, or why it failed. */
-static int pole_pairs(imest_comm_t *c, double arho)
+static int pole_pairs(imest_comm_t *c, float arho)
 {
   imest_comm_result_t *r = &c->res;
-  const double cpr_a = (double)c->cfg.encoder_cpr;
-  double np;
+  const float cpr_a = c->cfg.encoder_cpr;
+  float np;
   if (c->cfg.rated_speed_rpm > 0.0f) {
-    np = floor(60.0 * (double)c->cfg.rated_freq_hz / (double)c->cfg.rated_speed_rpm);
-    if (np < 1.0) np = 1.0;
+    np = floor_pos(60.0f * c->cfg.rated_freq_hz / c->cfg.rated_speed_rpm);
+    if (np < 1.0f) np = 1.0f;
     r->flags |= IMEST_COMM_FLAG_NP_NAMEPLATE;
-    if (cpr_a > 0.0) {
-      const double cpr = floor(np * cpr_a / arho + 0.5);
-      r->encoder_cpr = (float)cpr;
-      if (fabs(cpr - cpr_a) > 0.5) r->flags |= IMEST_COMM_FLAG_CPR_MISMATCH;
+    if (cpr_a > 0.0f) {
+      const float cpr = floor_pos(np * cpr_a / arho + 0.5f);
+      r->encoder_cpr = cpr;
+      if (imest__abs(cpr - cpr_a) > 0.5f) r->flags |= IMEST_COMM_FLAG_CPR_MISMATCH;
     }
   } else {
-    np = floor(arho + 0.5);
-    if (np < 1.0 || fabs(arho / np - 1.0) > 0.02) return IMEST_COMM_REASON_POLE_PAIRS_AMBIGUOUS;
+    np = floor_pos(arho + 0.5f);
+    if (!(np >= 1.0f) || !(imest__abs(arho / np - 1.0f) <= 0.02f))
+      return IMEST_COMM_REASON_POLE_PAIRS_AMBIGUOUS;
     r->flags |= IMEST_COMM_FLAG_NP_ASSUMED_CPR;
-    if (cpr_a > 0.0) r->encoder_cpr = (float)cpr_a;
+    if (cpr_a > 0.0f) r->encoder_cpr = cpr_a;
   }
   r->pole_pairs = (unsigned int)np;
   return IMEST_COMM_REASON_NONE;
 }
 
 /* L_S from lx (its value at zero slip) corrected for the slip x = w_sl T_R */
-static double slip_corrected(double lx, double x, double sl)
+static float slip_corrected(float lx, float x, float sl)
 {
-  double ls = lx;
+  float ls = lx;
   for (int it = 0; it < 3; ++it) {
-    const double sig = sl / ls;
-    ls = lx * (1.0 + x * x) / (1.0 + sig * x * x);
+    const float sig = sl / ls;
+    ls = lx * (1.0f + x * x) / (1.0f + sig * x * x);
   }
   return ls;
-}
-
-/* The levels' arithmetic is float32 (a few ratios of values measured to 0.1 %; float64 would
-   cost the M4F's soft-double calls in flash). */
-static float absf(float x)
-{
-  return x < 0.0f ? -x : x;
 }
 
 /* The rated point from the search levels 0..ns-1: the current i* where L_S(i) i = psi and L_S
@@ -113,8 +117,8 @@ static void rated_point(imest_comm_t *c, uint32_t ns, float psi, float *st)
   float is = psi / la, ls = la;
   /* two levels whose flux increases with the current: L_S linear in the current between them,
      no further than half their distance beyond them */
-  if (absf(ib - ia) > 1e-6f * ia && (pb - pa) / (ib - ia) > 0.0f) {
-    const float h = 0.5f * absf(ib - ia);
+  if (imest__abs(ib - ia) > 1e-6f * ia && (pb - pa) / (ib - ia) > 0.0f) {
+    const float h = 0.5f * imest__abs(ib - ia);
     const float lo = (ia < ib ? ia : ib) - h, hi = (ia < ib ? ib : ia) + h;
     is = ia + (psi - pa) * (ib - ia) / (pb - pa);
     is = is < lo ? lo : (is > hi ? hi : is);
@@ -123,7 +127,7 @@ static void rated_point(imest_comm_t *c, uint32_t ns, float psi, float *st)
   } else if (is > c->psi_im) {
     is = c->psi_im;
   }
-  const float corr = absf(ls - la) / ls;
+  const float corr = imest__abs(ls - la) / ls;
   st[CM_LB_I] = is;
   st[CM_LB_LS] = ls;
   st[CM_LB_STD] = corr > 1e-3f ? corr : 1e-3f;
@@ -144,7 +148,7 @@ static float next_level(imest_comm_t *c, uint32_t k)
   float in = psi / lk;
   if (k > 0u) {
     const float ip = lv[k - 1u].s[CM_LV_I], lp = lv[k - 1u].s[CM_LV_LS];
-    if (absf(ik - ip) > 1e-6f * ik) {
+    if (imest__abs(ik - ip) > 1e-6f * ik) {
       const float slope = (ik * lk - ip * lp) / (ik - ip);
       if (slope > 0.0f) in = ik + (psi - ik * lk) / slope;
     }
@@ -153,7 +157,7 @@ static float next_level(imest_comm_t *c, uint32_t k)
   if (in > i_lim) in = i_lim;
   st[CM_LB_NSEARCH] = (float)(k + 1u);
   const int at_limit = ik >= 0.999f * i_lim && in >= 0.999f * i_lim;
-  if (absf(in - ik) < 0.01f * ik || at_limit || k + 1u >= CM_ROT_SEARCH) {
+  if (imest__abs(in - ik) < 0.01f * ik || at_limit || k + 1u >= CM_ROT_SEARCH) {
     rated_point(c, k + 1u, psi, st);
     return 0.85f * st[CM_LB_I];
   }
@@ -209,7 +213,7 @@ static int report(imest_comm_t *c, uint32_t last)
   /* T_R is the standstill flux tails' (at the staircase's currents): on a saturating motor the
      standstill L_S differs from the rated-flux one, and T_R at rated flux by a similar share */
   {
-    const float ls_ss = r->ls_standstill_h.value, d = absf(ls - ls_ss) / ls;
+    const float ls_ss = r->ls_standstill_h.value, d = imest__abs(ls - ls_ss) / ls;
     if (ls_ss > 0.0f && !(r->tr_s.spread_rel >= d)) r->tr_s.spread_rel = d;
   }
   r->flags |= IMEST_COMM_FLAG_ROTATED;
@@ -227,51 +231,51 @@ void imest__cm_fit_rotation(imest_comm_t *c)
   const uint32_t level = (c->job_kind >> 4) & 0xFu;
   float *next = &c->blk[CM_ROT_LEVELS].s[CM_LB_NEXT];
   *next = 0.0f;
-  const double n = (double)s[CM_R_N], ts = (double)c->ts_s, we = (double)s[CM_R_WE];
-  if (!(n > 0.0) || !(we > 0.0) || level >= CM_ROT_LEVELS) {
+  const float n = s[CM_R_N], we = s[CM_R_WE];
+  if (!(n > 0.0f) || !(we > 0.0f) || level >= CM_ROT_LEVELS) {
     c->final_fail = IMEST_COMM_REASON_FIT;
     return;
   }
-  double zr = 0.0, zi = 0.0;
+  float zr = 0.0f, zi = 0.0f;
   int fail = impedance(c, &zr, &zi);
   if (fail != IMEST_COMM_REASON_NONE) {
     c->final_fail = fail;
     return;
   }
-  const double sl = (double)r->sigma_ls_h.value;
+  const float sl = r->sigma_ls_h.value;
   /* the encoder: travel over the measurement */
-  const double dth = (double)c->rot_th1 - (double)c->rot_th0 + 2.0 * IMEST_PI_D * (double)c->rot_wraps;
-  const double wm = dth / (n * ts);
-  const double lx = zi / we; /* L_S at zero slip */
-  if (!(lx > 3.0 * sl)) {
+  const float dth = c->rot_th1 - c->rot_th0 + IMEST_2PI_F * (float)c->rot_wraps;
+  const float wm = dth / (n * c->ts_s);
+  const float lx = zi / we; /* L_S at zero slip */
+  if (!(lx > 3.0f * sl)) {
     c->final_fail = IMEST_COMM_REASON_ROTOR_BLOCKED; /* the impedance of a rotor that does not turn */
     return;
   }
-  if (!(fabs(wm) > 1e-3 * we)) {
+  if (!(imest__abs(wm) > 1e-3f * we)) {
     c->final_fail = IMEST_COMM_REASON_ENCODER_STILL;
     return;
   }
   /* slip from the resistive part: Re Z - R_S = w_e L_S (1 - sigma) x / (1 + x^2), x = w_sl T_R
      (its noise: the residual inverter error in phase with the current, a few percent of x) */
-  const double tr = (double)r->tr_s.value;
-  const double x = (zr - (double)c->rs_ff) / (we * lx * (1.0 - sl / lx));
-  const double slip = tr > 0.0 ? x / (we * tr) : 0.0;
-  r->slip = (float)slip;
-  if (fabs(x) > 0.05) r->flags |= IMEST_COMM_FLAG_LOAD_ON_SHAFT;
+  const float tr = r->tr_s.value;
+  const float x = (zr - c->rs_ff) / (we * lx * (1.0f - sl / lx));
+  const float slip = tr > 0.0f ? x / (we * tr) : 0.0f;
+  r->slip = slip;
+  if (imest__abs(x) > 0.05f) r->flags |= IMEST_COMM_FLAG_LOAD_ON_SHAFT;
   /* speed ratio at zero slip: dir n_p cpr_assumed / cpr_true */
-  const double rho = we / wm;
-  r->speed_ratio = (float)rho;
-  r->encoder_dir = rho > 0.0 ? 1 : -1;
-  if (rho < 0.0) r->flags |= IMEST_COMM_FLAG_ENCODER_REVERSED;
-  fail = pole_pairs(c, fabs(rho) * (1.0 - slip));
+  const float rho = we / wm;
+  r->speed_ratio = rho;
+  r->encoder_dir = rho > 0.0f ? 1 : -1;
+  if (rho < 0.0f) r->flags |= IMEST_COMM_FLAG_ENCODER_REVERSED;
+  fail = pole_pairs(c, imest__abs(rho) * (1.0f - slip));
   if (fail != IMEST_COMM_REASON_NONE) {
     c->final_fail = fail;
     return;
   }
   imest_comm_block_t *lv = &c->blk[level];
   lv->s[CM_LV_I] = r->rotating_i_a;
-  lv->s[CM_LV_LS] = (float)slip_corrected(lx, x, sl);
-  lv->s[CM_LV_ZR] = (float)zr;
+  lv->s[CM_LV_LS] = slip_corrected(lx, x, sl);
+  lv->s[CM_LV_ZR] = zr;
   const float in = next_level(c, level);
   if (in > 0.0f) {
     *next = in;

@@ -1,10 +1,34 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Small dense symmetric positive definite solve (Cholesky) for the commissioning fits.
- * Background only, float64, fixed loop bounds (n <= CM_LSQ_MAX). */
+/* Least squares for the commissioning fits: a small dense symmetric positive definite solve
+ * (Cholesky) and the weighted straight line. Background only, float64, fixed loop bounds
+ * (n <= CM_LSQ_MAX). */
 #include <math.h>
 #include <stddef.h>
 
-#include "commission_internal.h"
+#include "commission_fit.h"
+
+void imest__cm_line_add(cm_line_t *l, double w, double x, double y)
+{
+  const double wx = w * x, wy = w * y;
+  l->w += w;
+  l->x += wx;
+  l->y += wy;
+  l->xx += wx * x;
+  l->xy += wx * y;
+  l->yy += wy * y;
+}
+
+double imest__cm_line_fit(const cm_line_t *l, double *a)
+{
+  const double det = l->w * l->xx - l->x * l->x;
+  if (!(det > 0.0)) {
+    *a = 0.0;
+    return l->yy - (l->w > 0.0 ? l->y * l->y / l->w : 0.0);
+  }
+  *a = (l->w * l->xy - l->x * l->y) / det;
+  const double c0 = (l->y - *a * l->x) / l->w;
+  return l->yy - c0 * l->y - *a * l->xy;
+}
 
 // The textbook Cholesky loops (factor, two substitutions, the inverse's diagonal) stay one function:
 // split, the arithmetic would cross calls.

@@ -5,7 +5,10 @@
  * says which channel reads which leg, with which sign, and whether a phase is open; its size
  * gives a rough sigma*L_S for the current controller (high by the dead time's loss near zero
  * current, which only lowers the loop's phase margin a little).
- * ISR part float32; the analysis (imest__cm_fit_wiring) runs in the background, float64. */
+ * ISR part float32; the analysis (imest__cm_fit_wiring) runs in the background, also float32:
+ * it scores 48 assignments by sums of nine products with the measured float32 currents
+ * (rounding 1e-7 of a score; the scores of different assignments differ by a share of the
+ * response's size) and takes a median of three. */
 #include <math.h>
 #include <stddef.h>
 
@@ -51,7 +54,7 @@ void imest__cm_stage_wiring(imest_comm_t *c, const float m[3], float vdc)
     if (!((quiet && c->cnt >= 2u * c->pulse_n) || c->cnt > 50u * pulse_len(c))) break;
     const float *r = c->pulse_resp[c->axis];
     const uint32_t a = c->axis;
-    const float resp = IMEST_SQRT2_3_F * (r[a] - 0.5f * (r[(a + 1u) % 3u] + r[(a + 2u) % 3u]));
+    const float resp = cm_axis_component(r, a);
     const float rmax = imest__abs(r[0]) + imest__abs(r[1]) + imest__abs(r[2]);
     if (rmax < 0.1f * c->cfg.i_max_a && c->pulse_v < 0.5f * c->v_lim && c->pulse_tries < 8u) {
       c->pulse_v *= 2.0f; /* too weak: twice the voltage, same axis */
@@ -93,30 +96,30 @@ static const unsigned int k_perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 
 
 /* The response channel ch should show to a pulse on axis k under assignment (perm p, signs
    sgn): +-1 on the channel reading leg k, -+1/2 on the others. */
-static double expected(int p, int sgn, int k, int ch)
+static float expected(int p, int sgn, int k, int ch)
 {
-  return (k_perms[p][ch] == (unsigned int)k ? 1.0 : -0.5) * ((sgn >> ch) & 1 ? -1.0 : 1.0);
+  return (k_perms[p][ch] == (unsigned int)k ? 1.0f : -0.5f) * ((sgn >> ch) & 1 ? -1.0f : 1.0f);
 }
 
 /* Sum of |response| over the channels for a pulse on axis k. */
-static double response_abs(const imest_comm_t *c, int k)
+static float response_abs(const imest_comm_t *c, int k)
 {
-  double a = 0.0;
-  for (int x = 0; x < 3; ++x) a += fabs((double)c->pulse_resp[k][x]);
+  float a = 0.0f;
+  for (int x = 0; x < 3; ++x) a += imest__abs(c->pulse_resp[k][x]);
   return a;
 }
 
 /* The assignment whose expected response correlates best with the measured one. */
 static void best_assignment(const imest_comm_t *c, int *best_p, int *best_s)
 {
-  double best = -1.0;
+  float best = -1.0f;
   *best_p = 0;
   *best_s = 0;
   for (int p = 0; p < 6; ++p)
     for (int sgn = 0; sgn < 8; ++sgn) {
-      double dot = 0.0;
+      float dot = 0.0f;
       for (int k = 0; k < 3; ++k)
-        for (int ch = 0; ch < 3; ++ch) dot += expected(p, sgn, k, ch) * (double)c->pulse_resp[k][ch];
+        for (int ch = 0; ch < 3; ++ch) dot += expected(p, sgn, k, ch) * c->pulse_resp[k][ch];
       if (dot > best) {
         best = dot;
         *best_p = p;
@@ -126,15 +129,15 @@ static void best_assignment(const imest_comm_t *c, int *best_p, int *best_s)
 }
 
 /* residual of the assignment with one amplitude per axis (sum of squares) */
-static double assignment_residual(const imest_comm_t *c, int p, int sgn)
+static float assignment_residual(const imest_comm_t *c, int p, int sgn)
 {
-  double res2 = 0.0;
+  float res2 = 0.0f;
   for (int k = 0; k < 3; ++k) {
-    double num = 0.0;
-    for (int ch = 0; ch < 3; ++ch) num += expected(p, sgn, k, ch) * (double)c->pulse_resp[k][ch];
-    const double amp = num / 1.5; /* |e|^2 = 1.5 */
+    float num = 0.0f;
+    for (int ch = 0; ch < 3; ++ch) num += expected(p, sgn, k, ch) * c->pulse_resp[k][ch];
+    const float amp = num / 1.5f; /* |e|^2 = 1.5 */
     for (int ch = 0; ch < 3; ++ch) {
-      const double r = (double)c->pulse_resp[k][ch] - amp * expected(p, sgn, k, ch);
+      const float r = c->pulse_resp[k][ch] - amp * expected(p, sgn, k, ch);
       res2 += r * r;
     }
   }
@@ -142,30 +145,30 @@ static double assignment_residual(const imest_comm_t *c, int p, int sgn)
 }
 
 /* rough sigma*L_S: volt-seconds of the + half over the current it drove, median of three */
-static double rough_sigma_ls(const imest_comm_t *c)
+static float rough_sigma_ls(const imest_comm_t *c)
 {
-  double sl[3];
+  float sl[3];
   for (int k = 0; k < 3; ++k) {
-    const double di = fabs((double)c->pulse_ik[k]);
-    sl[k] = di > 0.0 ? (double)c->pulse_vk[k] * (double)c->pulse_nk[k] * (double)c->ts_s / di : 0.0;
+    const float di = imest__abs(c->pulse_ik[k]);
+    sl[k] = di > 0.0f ? c->pulse_vk[k] * (float)c->pulse_nk[k] * c->ts_s / di : 0.0f;
   }
-  double med = sl[0];
-  if ((sl[1] - sl[0]) * (sl[1] - sl[2]) <= 0.0) med = sl[1];
-  if ((sl[2] - sl[0]) * (sl[2] - sl[1]) <= 0.0) med = sl[2];
+  float med = sl[0];
+  if ((sl[1] - sl[0]) * (sl[1] - sl[2]) <= 0.0f) med = sl[1];
+  if ((sl[2] - sl[0]) * (sl[2] - sl[1]) <= 0.0f) med = sl[2];
   return med;
 }
 
 /* an axis that draws (almost) nothing (below a tenth of the largest): a leg or phase is open */
 static int axis_open(const imest_comm_t *c)
 {
-  double amax = 0.0;
+  float amax = 0.0f;
   for (int k = 0; k < 3; ++k) {
-    const double a = response_abs(c, k);
+    const float a = response_abs(c, k);
     if (a > amax) amax = a;
   }
   int open = 0;
   for (int k = 0; k < 3; ++k)
-    if (!(response_abs(c, k) > 0.1 * amax) || !(amax > 0.0)) open = 1;
+    if (!(response_abs(c, k) > 0.1f * amax) || !(amax > 0.0f)) open = 1;
   return open;
 }
 
@@ -175,21 +178,21 @@ static int axis_open(const imest_comm_t *c)
    explain it (relative residual < 0.25) and be the identity with positive signs. */
 void imest__cm_fit_wiring(imest_comm_t *c)
 {
-  double norm2 = 0.0;
+  float norm2 = 0.0f;
   for (int k = 0; k < 3; ++k)
-    for (int x = 0; x < 3; ++x) norm2 += (double)c->pulse_resp[k][x] * (double)c->pulse_resp[k][x];
+    for (int x = 0; x < 3; ++x) norm2 += c->pulse_resp[k][x] * c->pulse_resp[k][x];
   c->bg_fail = axis_open(c) ? IMEST_COMM_REASON_OPEN_PHASE : 0;
   int best_p, best_s;
   best_assignment(c, &best_p, &best_s);
-  const double res2 = assignment_residual(c, best_p, best_s);
+  const float res2 = assignment_residual(c, best_p, best_s);
   for (int ch = 0; ch < 3; ++ch) {
     /* wiring_map[leg] = (channel + 1) * sign */
     const unsigned int leg = k_perms[best_p][ch];
     c->res.wiring_map[leg] = (ch + 1) * ((best_s >> ch) & 1 ? -1 : 1);
   }
   if (c->bg_fail == 0 && (best_p != 0 || best_s != 0)) c->bg_fail = IMEST_COMM_REASON_WIRING;
-  if (c->bg_fail == 0 && !(res2 < 0.0625 * norm2)) c->bg_fail = IMEST_COMM_REASON_OPEN_PHASE;
-  const double med = rough_sigma_ls(c);
-  if (c->bg_fail == 0 && !(med > 0.0 && med < 10.0)) c->bg_fail = IMEST_COMM_REASON_IMPLAUSIBLE;
-  c->bg_sl = (float)med;
+  if (c->bg_fail == 0 && !(res2 < 0.0625f * norm2)) c->bg_fail = IMEST_COMM_REASON_OPEN_PHASE;
+  const float med = rough_sigma_ls(c);
+  if (c->bg_fail == 0 && !(med > 0.0f && med < 10.0f)) c->bg_fail = IMEST_COMM_REASON_IMPLAUSIBLE;
+  c->bg_sl = med;
 }

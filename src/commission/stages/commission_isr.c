@@ -148,8 +148,7 @@ void imest__cm_dc_accumulate(imest_comm_t *c, const float m[3], float v_n, float
 /* Axis voltage of the duties d over a bus vdc (alpha/beta units, zero sequence cancels). */
 static float axis_voltage(uint32_t axis, const float d[3], float vdc)
 {
-  const float dn = d[axis] - 0.5f * (d[(axis + 1u) % 3u] + d[(axis + 2u) % 3u]);
-  return IMEST_SQRT2_3_F * vdc * dn;
+  return vdc * cm_axis_component(d, axis);
 }
 
 static int finite_f(float x)
@@ -257,8 +256,8 @@ int imest_comm_isr(imest_comm_t *c, const float i_abc_a[3], float vdc_v, float t
   c->v_app = axis_voltage(c->axis, c->d_app, vdc_v);
 
   /* alpha/beta and the axis frame */
-  const float ia = IMEST_SQRT2_3_F * (m[0] - 0.5f * (m[1] + m[2]));
-  const float ib = IMEST_SQRT2_3_F * IMEST_HALF_SQRT3_F * (m[1] - m[2]);
+  float ia, ib;
+  imest__clarke(m, &ia, &ib);
   static const float cs[3][2] = {{1.0f, 0.0f}, {-0.5f, IMEST_HALF_SQRT3_F}, {-0.5f, -IMEST_HALF_SQRT3_F}};
   const float cn = cs[c->axis][0], sn = cs[c->axis][1];
   const float i_n = ia * cn + ib * sn;

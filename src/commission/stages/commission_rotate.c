@@ -167,7 +167,8 @@ static inline void advance_field(imest_comm_t *c, float ts)
 {
   float co, si;
   cs_small(c->we * ts, &co, &si);
-  const float pc = c->ph_c * co - c->ph_s * si, ps = c->ph_s * co + c->ph_c * si;
+  float pc, ps;
+  imest__rotate(-si, co, c->ph_c, c->ph_s, &pc, &ps);
   const float g = 1.5f - 0.5f * (pc * pc + ps * ps);
   c->ph_c = pc * g;
   c->ph_s = ps * g;
@@ -180,8 +181,10 @@ static inline void measure(imest_comm_t *c, float ia, float ib, float id, float 
   float *r = c->rot_sum;
   r[CM_R_ID] += id;
   r[CM_R_IQ] += iq;
-  r[CM_R_ND] += ia * c->ph_c - ib * c->ph_s;
-  r[CM_R_NQ] += ia * c->ph_s + ib * c->ph_c;
+  float nd, nq; /* the negative sequence: the current turned the other way */
+  imest__rotate(-c->ph_s, c->ph_c, ia, ib, &nd, &nq);
+  r[CM_R_ND] += nd;
+  r[CM_R_NQ] += nq;
   r[CM_R_UD] += ud;
   r[CM_R_UQ] += uq;
   r[CM_R_I2] += ia * ia + ib * ib;
@@ -202,12 +205,11 @@ static inline void modulate(imest_comm_t *c, float ia, float ib, float ud, float
 {
   float co, si;
   cs_small(1.5f * c->we * ts, &co, &si);
-  const float c2 = c->ph_c * co - c->ph_s * si, s2 = c->ph_s * co + c->ph_c * si;
-  const float ua = ud * c2 - uq * s2, ub = ud * s2 + uq * c2;
+  float c2, s2, ua, ub;
+  imest__rotate(-si, co, c->ph_c, c->ph_s, &c2, &s2);
+  imest__rotate(-s2, c2, ud, uq, &ua, &ub);
   float v[3];
-  v[0] = IMEST_SQRT2_3_F * ua;
-  v[1] = IMEST_SQRT2_3_F * (-0.5f * ua + IMEST_HALF_SQRT3_F * ub);
-  v[2] = IMEST_SQRT2_3_F * (-0.5f * ua - IMEST_HALF_SQRT3_F * ub);
+  cm_clarke_inv(ua, ub, v);
   float hi = v[0], lo = v[0];
   for (int x = 1; x < 3; ++x) {
     if (v[x] > hi) hi = v[x];
@@ -216,11 +218,10 @@ static inline void modulate(imest_comm_t *c, float ia, float ib, float ud, float
   /* the inverter model's error at the current expected in that period: the present current
      turned ahead with the field by 1.5 samples (a sign decided 1.5 samples early shifts the
      error's fundamental by w 1.5 T, across the current: into the reactive voltage) */
-  const float pa = ia * co - ib * si, pb = ia * si + ib * co;
+  float pa, pb;
+  imest__rotate(-si, co, ia, ib, &pa, &pb);
   float ip[3];
-  ip[0] = IMEST_SQRT2_3_F * pa;
-  ip[1] = IMEST_SQRT2_3_F * (-0.5f * pa + IMEST_HALF_SQRT3_F * pb);
-  ip[2] = IMEST_SQRT2_3_F * (-0.5f * pa - IMEST_HALF_SQRT3_F * pb);
+  cm_clarke_inv(pa, pb, ip);
   const float v0 = -0.5f * (hi + lo), inv = 1.0f / vdc;
   for (int x = 0; x < 3; ++x) {
     float d = 0.5f + (v[x] + v0) * inv;
@@ -242,7 +243,8 @@ void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
 
   /* current in the field frame, its control (the rated magnetising current on d; ramping down,
      the current follows the frequency to zero) */
-  const float id = ia * c->ph_c + ib * c->ph_s, iq = -ia * c->ph_s + ib * c->ph_c;
+  float id, iq;
+  imest__rotate(c->ph_s, c->ph_c, ia, ib, &id, &iq);
   const float ref = c->step == CM_ROT_DOWN ? c->i_ref * (1.0f - (float)c->cnt / (float)c->n_ramp) : c->i_ref;
   const float ed = ref - id, eq = -iq;
   const float fd = c->rs_ff * ref, fq = c->we * c->ls_ss * ref;

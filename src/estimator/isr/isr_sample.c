@@ -246,8 +246,8 @@ static inline void isr_rotor_frame(imest_t *s, const isr_in_t *in, imest_real_t 
   imest_real_t sn, cs;
   isr_sincos(imest__wrap_pi(s->n * th_r), &sn, &cs);
   imest_real_t ux, uy, ix, iy;
-  isr_rotate(sn, cs, in->ua, in->ub, &ux, &uy);
-  isr_rotate(sn, cs, in->ia, in->ib, &ix, &iy);
+  imest__rotate(sn, cs, in->ua, in->ub, &ux, &uy);
+  imest__rotate(sn, cs, in->ia, in->ib, &ix, &iy);
   g->ux = isr_filter_deriv(s, &s->f_ux, ux);
   g->uy = isr_filter_deriv(s, &s->f_uy, uy);
   g->ix = isr_filter_deriv(s, &s->f_ix, ix);

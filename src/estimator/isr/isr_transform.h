@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* ISR stage 1: rotation into the rotor frame (docs/METHOD.md §1); the 3-2
- * transform itself is common/imest_math.h's imest__clarke(). */
+ * transform and the rotation itself are common/imest_math.h's imest__clarke()
+ * and imest__rotate(). */
 #ifndef IMEST_ISR_TRANSFORM_H
 #define IMEST_ISR_TRANSFORM_H
 
@@ -24,14 +25,6 @@ static inline void isr_sincos(imest_real_t x, imest_real_t *s_out, imest_real_t 
   const imest_real_t c0 = (quad & 1u) ? sp : cp;
   *s_out = (quad & 2u) ? -s0 : s0;
   *c_out = ((quad + 1u) & 2u) ? -c0 : c0;
-}
-
-/* Rotation by the electrical angle phi (eq. 2): x = c*a + s*b, y = -s*a + c*b. */
-static inline void isr_rotate(imest_real_t s, imest_real_t c, imest_real_t a, imest_real_t b, imest_real_t *x,
-                              imest_real_t *y)
-{
-  *x = c * a + s * b;
-  *y = c * b - s * a;
 }
 
 #endif
