@@ -63,7 +63,7 @@ typedef struct {
   uint32_t duty_input;         /**< the window's last sample came through imest_isr_duty */
   imest_real_t vdc_v;          /**< duty input: the bus voltage of the window's last sample [V] */
   imest_real_t off_ia, off_ib; /**< the offsets the high-pass tracked at the window's end [A] */
-  imest_real_t dth_end;        /**< the angle observer's step (speed x T) at the window's end [rad] */
+  imest_real_t dth_end_rad;    /**< the angle observer's step (speed x T) at the window's end [rad] */
 } imest_window_t;
 /** A flag of imest_window_t.flags above the 16 bits a result carries (internal): the angle
  *  observer was engaged in the window (its angle and speed used, src/estimator/isr/isr_angle.h). */
@@ -186,7 +186,8 @@ typedef struct {
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
   float rs_tolerance, tr_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
   uint32_t tr_nominal_known;
-  float obs_lag_s; /* the angle observer's lag after a speed step [s] (0: none; bg_transient.c) */
+  float transient_k; /* a speed step's share of T_R's bound per (rad/s of step / rad/s of slip)
+                        through the angle observer's lag (0: no observer; bg_transient.c) */
   float ls_curve_i_a[IMEST_LS_CURVE_POINTS]; /* the magnetising curve as configured (bg_flux.c) */
   float ls_curve_h[IMEST_LS_CURVE_POINTS];
   uint32_t ls_curve_points;  /* 0: no curve */

@@ -335,11 +335,9 @@ static void init_isr_constants(imest_t *s, const imest_config_t *cfg, double m)
   imest__bg_noise_gains(&s->bw, (double)fs, s->noise_g);
   design_aa(&s->aa, (double)cfg->aa_hz, (double)fs);
   s->aa_on = cfg->aa_hz > 0.0f;
-  {
-    const float fn = cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz;
-    design_angle(&s->obs, fn, fs);
-    s->obs_lag_s = imest__bg_transient_lag_s(fn); /* the judge's bound of a transient (bg_transient.c) */
-  }
+  const float fn = cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz;
+  design_angle(&s->obs, fn, fs);
+  s->transient_k = imest__bg_transient_k(fn, s->n, cfg->window_s); /* the judge's (bg_transient.c) */
   design_duty(&s->duty, cfg);
 }
 

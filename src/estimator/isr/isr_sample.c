@@ -113,7 +113,7 @@ static int isr_close_window(imest_t *s)
   w->vdc_v = s->vdc_prev;
   w->off_ia = s->off_ia;
   w->off_ib = s->off_ib;
-  w->dth_end = s->obs.dth; /* the speed at the window's end (the tracker always runs) */
+  w->dth_end_rad = s->obs.dth; /* the speed at the window's end (the tracker always runs) */
   s->seq++;
   s->obs_rot = w->rot; /* for the observer's decision (isr_engage_observer) */
   s->obs_used = w->used;

@@ -26,50 +26,18 @@
 #include "bg_transient.h"
 #include "common/imest_math.h"
 
-/* integral |e_w| dt / dw x w_o of the triple-pole tracker (imest_init.c,
- * design_angle) after a speed step: 1.655 at 25 Hz and 8 kHz, 1.630 at 4 kHz
- * (the sampled loop, its response summed), for any f_n/fs the design allows;
- * the larger is kept. */
-#define OBS_LAG_WO 1.66f
 /* a change of speed below this fraction of the speed is not a step: the
  * observer's end speed carries the encoder's quantisation (between steady
  * windows 0.003 to 0.03 rad/s, 0.002 to 0.03 % of the speed, with 4096 to
  * 16384 counts at 4 and 8 kHz) */
 #define TRANSIENT_MIN_DW_REL 1e-3f
-/* the first-order share's factor (the measured move over the first order, above) */
-#define TRANSIENT_MARGIN 2.0f
-/* a share below this fraction of both tolerances is not counted: the bounds
- * are first-order figures, and a steady window (the observer's own speed noise
- * from the encoder's counts) keeps its bounds exactly */
-#define TRANSIENT_DEADBAND 0.1f
 
-float imest__bg_transient_lag_s(float fn_hz)
+float imest__bg_transient_dw(imest_t *s, const imest_window_t *w, float w_mean_rad_s)
 {
-  return fn_hz > 0.0f ? OBS_LAG_WO / (2.0f * IMEST_PI_F * fn_hz) : 0.0f;
-}
-
-float imest__bg_transient_dw(imest_t *s, const imest_window_t *w, double w_mean)
-{
-  const float w_end = (float)w->dth_end * (float)s->fs;
+  const float w_end_rad_s = (float)w->dth_end_rad * (float)s->fs, w_mean = w_mean_rad_s;
   const int start_known = s->w_prev_valid && !(w->flags & IMEST_FLAG_OVERRUN);
-  const float dw = start_known ? w_end - s->w_end_prev_rad_s : 2.0f * (w_end - (float)w_mean);
-  s->w_end_prev_rad_s = w_end;
-  const int step = fabsf(dw) > TRANSIENT_MIN_DW_REL * fabsf((float)w_mean);
-  return (w->flags & IMEST_WFLAG_OBSERVER) && w->used > 0u && step ? fabsf(dw) : 0.0f;
-}
-
-void imest__bg_transient_share(const imest_t *s, const bg_impedance_t *z, float dw, float ws, float tr,
-                               float rs, float *tr_rel, float *rs_rel)
-{
-  *tr_rel = 0.0f;
-  *rs_rel = 0.0f;
-  if (!(dw > 0.0f) || !(s->obs_lag_s > 0.0f)) return;
-  const float t_win = (float)s->window_n / (float)s->fs;
-  /* no slip: any speed error is all of it */
-  const float eps = fabsf(ws) > 0.0f ? TRANSIENT_MARGIN * (float)s->n * dw * s->obs_lag_s / (fabsf(ws) * t_win)
-                                     : INFINITY;
-  const float t = eps, r = sqrtf(z->dr * z->dr + z->di * z->di) * tr * eps / rs;
-  if (!(t > TRANSIENT_DEADBAND * s->tr_tolerance) && !(r > TRANSIENT_DEADBAND * s->rs_tolerance)) return;
-  *tr_rel = t;
-  *rs_rel = r;
+  const float dw_rad_s = start_known ? w_end_rad_s - s->w_end_prev_rad_s : 2.0f * (w_end_rad_s - w_mean);
+  s->w_end_prev_rad_s = w_end_rad_s;
+  const int step = fabsf(dw_rad_s) > TRANSIENT_MIN_DW_REL * fabsf(w_mean);
+  return (w->flags & IMEST_WFLAG_OBSERVER) && step ? fabsf(dw_rad_s) : 0.0f;
 }

@@ -166,8 +166,8 @@ static float voltage_uncertainty(const imest_t *s, const imest_window_t *w, cons
  * uncertainty whose harmonics T_R sees (duty input; 0 otherwise). */
 static void systematic_bounds(const imest_t *s, const imest_window_t *w, const op_point_t *op,
                               float slip_rate, float tr, float rs, float dv_v, float harm_v, float *tr_rel,
-                              float *rs_rel, float *c_tr_rel, float *c_rs_rel, float dw, float *x_tr_rel,
-                              float *x_rs_rel)
+                              float *rs_rel, float *c_tr_rel, float *c_rs_rel, float dw_rad_s,
+                              float *x_tr_rel, float *x_rs_rel)
 {
   const float we = op->we, ls = s->ls_h, sg = s->sigma;
   bg_impedance_t z;
@@ -192,7 +192,7 @@ static void systematic_bounds(const imest_t *s, const imest_window_t *w, const o
     *c_rs_rel += fabsf(r);
   }
   /* a speed step through the angle observer (bg_transient.c) */
-  imest__bg_transient_share(s, &z, dw, slip_rate, tr, rs, x_tr_rel, x_rs_rel);
+  imest__bg_transient_share(s, &z, dw_rad_s, slip_rate, tr, rs, x_tr_rel, x_rs_rel);
   *tr_rel = dt / tr + *c_tr_rel + *x_tr_rel;
   const float dr_volt = dv_v < 0.0f ? INFINITY : FOUR_OVER_PI_F * dv_v / op->i_pk;
   *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs + *c_rs_rel + *x_rs_rel;
@@ -485,7 +485,7 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
     float harm_v;
     const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &harm_v);
     systematic_bounds(j->s, j->w, &j->op, (float)j->st->slip_rate, (float)r->tr_s, rs, dv_v, harm_v, &j->tr_b,
-                      &j->rs_b, &j->c_tr, &j->c_rs, j->st->dw_obs, &j->x_tr, &j->x_rs);
+                      &j->rs_b, &j->c_tr, &j->c_rs, j->st->dw_obs_rad_s, &j->x_tr, &j->x_rs);
     /* the magnetising curve's share (bg_flux.c), where T_R's bound is finite;
      * nothing without a curve (the outputs stay as without it) */
     if (fx != NULL && j->s->ls_curve_points != 0u && isfinite(j->tr_b)) {
