@@ -337,7 +337,7 @@ static void init_isr_constants(imest_t *s, const imest_config_t *cfg, double m)
   s->aa_on = cfg->aa_hz > 0.0f;
   const float fn = cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz;
   design_angle(&s->obs, fn, fs);
-  s->transient_k = imest__bg_transient_k(fn, s->n, cfg->window_s); /* the judge's (bg_transient.c) */
+  s->transient_k = imest__bg_transient_k(fn, (float)s->n, cfg->window_s); /* the judge's (bg_transient.c) */
   design_duty(&s->duty, cfg);
 }
 
