@@ -1239,24 +1239,24 @@ TEST(VerdictTransient, SpeedStepSharesAndReason)
   const double per_dw = 2.0 * sc.m.np * t_lag / (x.ws * (double)sc.cfg.window_s); // T_R share per rad/s
   EXPECT_NEAR((double)x.s.transient_k / x.ws, per_dw, 1e-6 * per_dw);
   // a small step: its share is counted and matches the formula
-  x.st.dw_obs_rad_s = 0.5f;
+  x.st.dw_rad_s = 0.5f;
   const imest_result_t r1 = judge(x);
   EXPECT_NEAR(r1.tr_bound_rel - r0.tr_bound_rel, per_dw * 0.5, 1e-3 * per_dw);
   EXPECT_GT(r1.rs_bound_rel, r0.rs_bound_rel);
   // R_S refused for the transient alone, T_R still valid
   const double rs_share = r1.rs_bound_rel - r0.rs_bound_rel;
-  x.st.dw_obs_rad_s = (float)(1.01 * 0.5 * (double)sc.cfg.rs_tolerance / rs_share);
+  x.st.dw_rad_s = (float)(1.01 * 0.5 * (double)sc.cfg.rs_tolerance / rs_share);
   imest_result_t r = judge(x);
   ASSERT_LT(r.tr_bound_rel, (double)sc.cfg.tr_tolerance);
   EXPECT_EQ(r.tr_valid, 1);
   EXPECT_RS_REASON(r, IMEST_REASON_TRANSIENT);
-  x.st.dw_obs_rad_s = (float)(0.99 * 0.5 * (double)sc.cfg.rs_tolerance / rs_share);
+  x.st.dw_rad_s = (float)(0.99 * 0.5 * (double)sc.cfg.rs_tolerance / rs_share);
   r = judge(x);
   EXPECT_NE(r.rs_reason, IMEST_REASON_TRANSIENT);
   // T_R refused: transient before tr_uncertain
-  x.st.dw_obs_rad_s = (float)(1.01 * (double)sc.cfg.tr_tolerance / per_dw);
+  x.st.dw_rad_s = (float)(1.01 * (double)sc.cfg.tr_tolerance / per_dw);
   EXPECT_TR_REASON(judge(x), IMEST_REASON_TRANSIENT);
-  x.st.dw_obs_rad_s = (float)(0.99 * (double)sc.cfg.tr_tolerance / per_dw);
+  x.st.dw_rad_s = (float)(0.99 * (double)sc.cfg.tr_tolerance / per_dw);
   EXPECT_NE(judge(x).tr_reason, IMEST_REASON_TRANSIENT);
 }
 
@@ -1267,14 +1267,14 @@ TEST(VerdictTransient, DeadBandAndNoObserverLeaveTheBounds)
   Scene sc = paper_scene();
   Win x = build(sc);
   const imest_result_t r0 = judge(x);
-  x.st.dw_obs_rad_s = 0.001f;
+  x.st.dw_rad_s = 0.001f;
   const imest_result_t r1 = judge(x);
   EXPECT_EQ(r1.tr_bound_rel, r0.tr_bound_rel);
   EXPECT_EQ(r1.rs_bound_rel, r0.rs_bound_rel);
   sc.cfg.angle_observer_hz = -1.0f;
   Win y = build(sc);
   EXPECT_EQ(y.s.transient_k, 0.0f);
-  y.st.dw_obs_rad_s = 100.0f;
+  y.st.dw_rad_s = 100.0f;
   const imest_result_t r2 = judge(y);
   EXPECT_VALID(r2);
   EXPECT_EQ(r2.tr_bound_rel, r0.tr_bound_rel);

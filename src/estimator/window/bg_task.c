@@ -60,7 +60,7 @@ static void window_sums(imest_t *s, const imest_window_t *w, double m, bg_step_t
       w->used > 0u && s->w_prev_valid &&
       fabs(x->st.w_mean - w_before) <=
           IMEST_STEADY_REL_LIT * fmax(fabs(x->st.w_mean), fabs(w_before)) + IMEST_STEADY_ABS_RAD_S_LIT;
-  x->st.dw_obs_rad_s = imest__bg_transient_dw(s, w, (float)x->st.w_mean); /* before w_prev_valid moves on */
+  x->st.dw_rad_s = imest__bg_transient_dw(s, w, (float)x->st.w_mean); /* before w_prev_valid moves on */
   s->w_prev_rad_s = (float)x->st.w_mean;
   s->w_prev_valid = w->used > 0u;
   imest__bg_noise_estimate(s, w, &x->st, &x->sums, x->steady, &x->nz);

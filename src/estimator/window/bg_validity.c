@@ -485,7 +485,7 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
     float harm_v;
     const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &harm_v);
     systematic_bounds(j->s, j->w, &j->op, (float)j->st->slip_rate, (float)r->tr_s, rs, dv_v, harm_v, &j->tr_b,
-                      &j->rs_b, &j->c_tr, &j->c_rs, j->st->dw_obs_rad_s, &j->x_tr, &j->x_rs);
+                      &j->rs_b, &j->c_tr, &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
     /* the magnetising curve's share (bg_flux.c), where T_R's bound is finite;
      * nothing without a curve (the outputs stay as without it) */
     if (fx != NULL && j->s->ls_curve_points != 0u && isfinite(j->tr_b)) {

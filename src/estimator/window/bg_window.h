@@ -16,7 +16,7 @@ typedef struct {
   double slip_rate; /* mean rotation rate of the rotor-frame current [rad/s]:
                        the slip frequency in steady state */
   double u_ms;      /* mean square of u_alpha [V^2] */
-  float dw_obs_rad_s;     /* the speed's change inside the window through the angle observer [rad/s]
+  float dw_rad_s;   /* the speed's change inside the window through the angle observer [rad/s]
                        (bg_transient.c; set by the task) */
 } bg_window_stats_t;
 
