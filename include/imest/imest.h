@@ -152,7 +152,10 @@ typedef enum {
   /** the constants' stated uncertainty (ls_uncertainty, sigma_uncertainty) alone moves T_R (or
    *  R_S) by more than its tolerance: commission the motor (imest_commission.h) or state what the
    *  constants are known to */
-  IMEST_REASON_CONSTANTS_UNCERTAIN = 28
+  IMEST_REASON_CONSTANTS_UNCERTAIN = 28,
+  /** a load or speed step inside the window, seen through the angle observer, alone moves T_R (or
+   *  R_S) by more than its tolerance: a transient; the next steady window is estimated again */
+  IMEST_REASON_TRANSIENT = 29
 } imest_reason_t;
 
 /** Short lower-case name of a reason ("ok", "warmup", "zero_slip", ...). */

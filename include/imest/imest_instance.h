@@ -63,7 +63,11 @@ typedef struct {
   uint32_t duty_input;         /**< the window's last sample came through imest_isr_duty */
   imest_real_t vdc_v;          /**< duty input: the bus voltage of the window's last sample [V] */
   imest_real_t off_ia, off_ib; /**< the offsets the high-pass tracked at the window's end [A] */
+  imest_real_t dth_end_rad;    /**< the angle observer's step (speed x T) at the window's end [rad] */
 } imest_window_t;
+/** A flag of imest_window_t.flags above the 16 bits a result carries (internal): the angle
+ *  observer was engaged in the window (its angle and speed used, src/estimator/isr/isr_angle.h). */
+#define IMEST_WFLAG_OBSERVER 0x10000u
 
 /** Butterworth-3 as a first-order and a second-order section (transposed DF-II).
  *  Bilinear low-pass sections have binomial numerators, so only their gains
@@ -123,7 +127,7 @@ typedef struct {
 } imest_combo_t;
 
 /** Estimator instance. All fields are private; sizes are what the ISR needs.
- *  sizeof(imest_t) is 1984 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
+ *  sizeof(imest_t) is 2000 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
  *  fw/README.md) and on an x86-64 host too (every member is 32-bit: no pointers, no padding that
  *  differs); the test tools_documented_defaults checks this figure against the host's sizeof. */
 typedef struct {
@@ -182,6 +186,8 @@ typedef struct {
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
   float rs_tolerance, tr_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
   uint32_t tr_nominal_known;
+  float transient_k; /* a speed step's share of T_R's bound per (rad/s of step / rad/s of slip)
+                        through the angle observer's lag (0: no observer; bg_transient.c) */
   float ls_curve_i_a[IMEST_LS_CURVE_POINTS]; /* the magnetising curve as configured (bg_flux.c) */
   float ls_curve_h[IMEST_LS_CURVE_POINTS];
   uint32_t ls_curve_points;  /* 0: no curve */
@@ -191,6 +197,7 @@ typedef struct {
   float noise_g[6];   /* the front end's noise gains (bg_noise.h) */
   float w_prev_rad_s; /* the previous processed window's mean speed (noise model) */
   uint32_t w_prev_valid;
+  float w_end_prev_rad_s; /* the previous processed window's speed at its end (bg_transient.c) */
   imest_combo_t combo;    /* windows combined where one has too little information */
   float last_k1, last_k2; /* last valid estimate: centring of later windows */
 } imest_t;

@@ -32,6 +32,9 @@ void imsim_config_default(imsim_config_t *c)
   c->load_nm = 0.0;
   c->load_on_s = 0.0;
   c->load_ramp_s = 0.0;
+  c->load_step_nm = 0.0;
+  c->load_step_on_s = (double)INFINITY; /* no second change */
+  c->load_step_ramp_s = 0.0;
 
   c->supply = IMSIM_SUPPLY_SINE;
   c->vll_v = 230.0;
@@ -50,6 +53,9 @@ void imsim_config_default(imsim_config_t *c)
   c->ifoc_flux_wb = 0.0;
   c->speed_ref_rpm = 1750.0;
   c->speed_ramp_s = 0.5;
+  c->speed_step_rpm = 0.0;
+  c->speed_step_on_s = (double)INFINITY; /* no second reference */
+  c->speed_step_ramp_s = 0.0;
   c->torque_ref_nm = 0.0;
   c->torque_limit_nm = 4.0;
   c->current_bw_hz = 250.0;

@@ -20,6 +20,12 @@ void ims_ifoc_update(imsim_t *s)
   if (c->ifoc_mode == IMSIM_IFOC_SPEED) {
     double wref = s->speed_ref;
     if (c->speed_ramp_s > 0.0 && s->t < c->speed_ramp_s) wref *= s->t / c->speed_ramp_s;
+    if (s->t >= c->speed_step_on_s) { /* the second reference (INFINITY: none) */
+      const double w2 = c->speed_step_rpm * 2.0 * PI / 60.0;
+      const double f =
+          c->speed_step_ramp_s > 0.0 ? fmin(1.0, (s->t - c->speed_step_on_s) / c->speed_step_ramp_s) : 1.0;
+      wref = s->speed_ref + (w2 - s->speed_ref) * f;
+    }
     const double kp = c->j_kgm2 * 2.0 * PI * c->speed_bw_hz;
     const double ki = kp * 2.0 * PI * c->speed_bw_hz / 4.0;
     const double e = wref - s->w_meas;

@@ -85,9 +85,15 @@ static const char USAGE[] =
     "                        a rotor at rest while the motor's torque is below it (a fan, pump,\n"
     "                        conveyor); active: NM opposes positive rotation at any speed and\n"
     "                        drives a stopped rotor backwards (a hoist's weight) (passive)\n"
+    "  --load-step NM  --load-step-on S  --load-step-ramp S (0)   a second change of the load:\n"
+    "                        from S, linearly from --load-nm to NM over the ramp (0 = a step);\n"
+    "                        none unless --load-step-on is given\n"
     "IFOC (--supply ifoc):\n"
     "  --ifoc-mode speed|torque (speed)\n"
     "  --speed-ref RPM (exp1 1750, exp2 850)  --speed-ramp S (exp1 0.5, exp2 1)\n"
+    "  --speed-step RPM  --speed-step-on S  --speed-step-ramp S (0)   speed mode: a second\n"
+    "                        reference from S, reached linearly from --speed-ref over the ramp\n"
+    "                        (0 = a step); none unless --speed-step-on is given\n"
     "  --torque-ref NM (0)  --torque-limit NM (4)\n"
     "  --ifoc-tr S           the controller's T_R (default: the motor's cold T_R)\n"
     "  --ifoc-flux WB        rotor-flux reference (default: the steady-state flux at --vll/--freq)\n"
@@ -191,6 +197,9 @@ static const real_flag REAL_FLAGS[] = {
     {"--load-nm", CFG(load_nm), NONE_LO, NONE_HI, true, true, "N m"},
     {"--load-on", CFG(load_on_s), 0.0, NONE_HI, false, true, ">= 0 s"},
     {"--load-ramp", CFG(load_ramp_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--load-step", CFG(load_step_nm), NONE_LO, NONE_HI, true, true, "N m"},
+    {"--load-step-on", CFG(load_step_on_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--load-step-ramp", CFG(load_step_ramp_s), 0.0, NONE_HI, false, true, ">= 0 s"},
     {"--carrier-hz", CFG(carrier_hz), 0.0, NONE_HI, true, true, "> 0 Hz"},
     {"--vdc", CFG(vdc_v), 0.0, NONE_HI, true, true, "> 0 V"},
     {"--dead-time", CFG(dead_time_s), 0.0, NONE_HI, false, true, ">= 0 s"},
@@ -203,6 +212,9 @@ static const real_flag REAL_FLAGS[] = {
     {"--ifoc-flux", CFG(ifoc_flux_wb), 0.0, NONE_HI, true, true, "> 0 Wb"},
     {"--speed-ref", CFG(speed_ref_rpm), NONE_LO, NONE_HI, true, true, "rpm"},
     {"--speed-ramp", CFG(speed_ramp_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--speed-step", CFG(speed_step_rpm), NONE_LO, NONE_HI, true, true, "rpm"},
+    {"--speed-step-on", CFG(speed_step_on_s), 0.0, NONE_HI, false, true, ">= 0 s"},
+    {"--speed-step-ramp", CFG(speed_step_ramp_s), 0.0, NONE_HI, false, true, ">= 0 s"},
     {"--torque-ref", CFG(torque_ref_nm), NONE_LO, NONE_HI, true, true, "N m"},
     {"--torque-limit", CFG(torque_limit_nm), 0.0, NONE_HI, true, true, "> 0 N m"},
     {"--i-range", CFG(i_range_a), 0.0, NONE_HI, true, true, "> 0 A"},

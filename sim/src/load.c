@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Load torque. The profile: 0 before load_on_s, linear ramp over load_ramp_s, then load_nm;
- * imsim_set_load() overrides it. How it acts on the rotor (load_kind):
+ * from load_step_on_s (if finite) a second linear change to load_step_nm over load_step_ramp_s
+ * (0: a step); imsim_set_load() overrides it. How it acts on the rotor (load_kind):
  *
  * ACTIVE: the profile's value, opposing positive rotation at any speed (it drives a rotor that
  * stops backwards, as a hoist's weight does).
@@ -27,7 +28,10 @@ double ims_load_at(const imsim_t *s, double t)
   if (t < c->load_on_s) return 0.0;
   if (c->load_ramp_s > 0.0 && t < c->load_on_s + c->load_ramp_s)
     return c->load_nm * (t - c->load_on_s) / c->load_ramp_s;
-  return c->load_nm;
+  if (!(t >= c->load_step_on_s)) return c->load_nm; /* INFINITY: no second change */
+  if (c->load_step_ramp_s > 0.0 && t < c->load_step_on_s + c->load_step_ramp_s)
+    return c->load_nm + (c->load_step_nm - c->load_nm) * (t - c->load_step_on_s) / c->load_step_ramp_s;
+  return c->load_step_nm;
 }
 
 double ims_load_torque(const imsim_t *s, double l_nm)

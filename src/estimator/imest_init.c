@@ -6,6 +6,7 @@
 
 #include "bg_flux.h"
 #include "bg_noise.h"
+#include "bg_transient.h"
 #include "common/imest_handoff.h"
 #include "common/imest_math.h"
 
@@ -334,7 +335,9 @@ static void init_isr_constants(imest_t *s, const imest_config_t *cfg, double m)
   imest__bg_noise_gains(&s->bw, fs, s->noise_g);
   design_aa(&s->aa, (double)cfg->aa_hz, (double)fs);
   s->aa_on = cfg->aa_hz > 0.0f;
-  design_angle(&s->obs, cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz, fs);
+  const float fn = cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz;
+  design_angle(&s->obs, fn, fs);
+  s->transient_k = imest__bg_transient_k(fn, (float)s->n, cfg->window_s); /* the judge's (bg_transient.c) */
   design_duty(&s->duty, cfg);
 }
 
@@ -465,6 +468,7 @@ const char *imest_reason_name(int reason)
   case IMEST_REASON_GAIN_MISMATCH: return "gain_mismatch";
   case IMEST_REASON_TR_UNCERTAIN: return "tr_uncertain";
   case IMEST_REASON_CONSTANTS_UNCERTAIN: return "constants_uncertain";
+  case IMEST_REASON_TRANSIENT: return "transient";
   default: return "unknown";
   }
 }

@@ -189,7 +189,7 @@ TEST(CanCodec, SignalTableIsConsistent)
     case IMEST_CAN_SCALED: EXPECT_GT(t[k].scale, 1u) << k; break;
     case IMEST_CAN_COUNT: EXPECT_LE(t[k].len, 16u) << k << ": unsigned int has 16 bits on C2000"; break;
     case IMEST_CAN_ENUM:
-      EXPECT_GE(1u << t[k].len, IMEST_REASON_CONSTANTS_UNCERTAIN + 2u) << k << ": every reason must fit";
+      EXPECT_GE(1u << t[k].len, IMEST_REASON_TRANSIENT + 2u) << k << ": every reason must fit";
       break;
     case IMEST_CAN_BOOL:
     case IMEST_CAN_FLAG:
@@ -385,7 +385,7 @@ TEST(CanCodec, VerdictsReasonsFlagsAndCounts)
   r.windows = 1000; // saturates at 255
   EXPECT_EQ(roundtrip(r).result.windows, 255u);
   // every reason travels as its stable number
-  for (int reason = IMEST_REASON_WARMUP; reason <= IMEST_REASON_CONSTANTS_UNCERTAIN; reason++) {
+  for (int reason = IMEST_REASON_WARMUP; reason <= IMEST_REASON_TRANSIENT; reason++) {
     r.status = r.tr_reason = r.rs_reason = reason;
     w = roundtrip(r);
     EXPECT_EQ(w.result.status, reason);

@@ -12,6 +12,7 @@
 
 extern "C" {
 #include "imest/imest.h"
+#include "bg_transient.h"
 #include "bg_validity.h"
 }
 
@@ -159,7 +160,7 @@ void set_gain_mismatch(Win &x, double mism)
 
 bool is_reason(int v)
 {
-  return v == IMEST_REASON_NONE || (v >= IMEST_REASON_WARMUP && v <= IMEST_REASON_CONSTANTS_UNCERTAIN);
+  return v == IMEST_REASON_NONE || (v >= IMEST_REASON_WARMUP && v <= IMEST_REASON_TRANSIENT);
 }
 
 // Runs the judge on the fixture (on a copy of its result; the instance keeps
@@ -1259,6 +1260,85 @@ TEST(VerdictDuty, TrUncertainFromInverterHarmonics)
   EXPECT_TR_REASON(r, IMEST_REASON_TR_UNCERTAIN);
   Win m = build(sc); // the same window from measured voltages: T_R valid
   EXPECT_EQ(judge(m).tr_reason, IMEST_REASON_NONE);
+}
+
+// A speed step inside the window through the angle observer (bg_transient.c):
+// T_R's share 2 n_p dw t_lag / (w_s T_window), t_lag = 1.66 / (2 pi f_o) of
+// the observer at filter_hz / 4; R_S's the same slip error through
+// |dZ/dT_R| T_R / R_S. transient where the share alone exceeds the tolerance.
+TEST(VerdictTransient, SpeedStepSharesAndReason)
+{
+  Scene sc = paper_scene();
+  Win x = build(sc);
+  const imest_result_t r0 = judge(x);
+  EXPECT_VALID(r0);
+  const double t_lag = 1.66 / (2.0 * M_PI * 0.25 * (double)sc.cfg.filter_hz);
+  const double per_dw = 2.0 * sc.m.np * t_lag / (x.ws * (double)sc.cfg.window_s); // T_R share per rad/s
+  EXPECT_NEAR((double)x.s.transient_k / x.ws, per_dw, 1e-6 * per_dw);
+  // a small step: its share is counted and matches the formula
+  x.st.dw_rad_s = 0.5f;
+  const imest_result_t r1 = judge(x);
+  EXPECT_NEAR(r1.tr_bound_rel - r0.tr_bound_rel, per_dw * 0.5, 1e-3 * per_dw);
+  EXPECT_GT(r1.rs_bound_rel, r0.rs_bound_rel);
+  // R_S refused for the transient alone, T_R still valid
+  const double rs_share = r1.rs_bound_rel - r0.rs_bound_rel;
+  x.st.dw_rad_s = (float)(1.01 * 0.5 * (double)sc.cfg.rs_tolerance / rs_share);
+  imest_result_t r = judge(x);
+  ASSERT_LT(r.tr_bound_rel, (double)sc.cfg.tr_tolerance);
+  EXPECT_EQ(r.tr_valid, 1);
+  EXPECT_RS_REASON(r, IMEST_REASON_TRANSIENT);
+  x.st.dw_rad_s = (float)(0.99 * 0.5 * (double)sc.cfg.rs_tolerance / rs_share);
+  r = judge(x);
+  EXPECT_NE(r.rs_reason, IMEST_REASON_TRANSIENT);
+  // T_R refused: transient before tr_uncertain
+  x.st.dw_rad_s = (float)(1.01 * (double)sc.cfg.tr_tolerance / per_dw);
+  EXPECT_TR_REASON(judge(x), IMEST_REASON_TRANSIENT);
+  x.st.dw_rad_s = (float)(0.99 * (double)sc.cfg.tr_tolerance / per_dw);
+  EXPECT_NE(judge(x).tr_reason, IMEST_REASON_TRANSIENT);
+}
+
+// Below a tenth of both tolerances a step is not counted: the bounds are the steady window's,
+// bit for bit. No observer (angle_observer_hz < 0): no share at all.
+TEST(VerdictTransient, DeadBandAndNoObserverLeaveTheBounds)
+{
+  Scene sc = paper_scene();
+  Win x = build(sc);
+  const imest_result_t r0 = judge(x);
+  x.st.dw_rad_s = 0.001f;
+  const imest_result_t r1 = judge(x);
+  EXPECT_EQ(r1.tr_bound_rel, r0.tr_bound_rel);
+  EXPECT_EQ(r1.rs_bound_rel, r0.rs_bound_rel);
+  sc.cfg.angle_observer_hz = -1.0f;
+  Win y = build(sc);
+  EXPECT_EQ(y.s.transient_k, 0.0f);
+  y.st.dw_rad_s = 100.0f;
+  const imest_result_t r2 = judge(y);
+  EXPECT_VALID(r2);
+  EXPECT_EQ(r2.tr_bound_rel, r0.tr_bound_rel);
+}
+
+// The window's change of speed: end minus start (the previous window's end) while the observer
+// was engaged; twice end minus mean without a known start; 0 without the observer or below
+// 0.1 % of the speed (the encoder's quantisation in the observer's end speed).
+TEST(VerdictTransient, SpeedChangeFromTheWindow)
+{
+  Scene sc = paper_scene();
+  Win x = build(sc);
+  const float fs = sc.cfg.fs_hz;
+  x.w.flags = IMEST_WFLAG_OBSERVER;
+  x.s.w_prev_valid = 1u;
+  x.s.w_end_prev_rad_s = 100.0f;
+  x.w.dth_end_rad = 97.0f / fs;
+  EXPECT_NEAR(imest__bg_transient_dw(&x.s, &x.w, 98.5), 3.0, 1e-3);
+  EXPECT_NEAR(x.s.w_end_prev_rad_s, 97.0, 1e-3) << "the next window starts where this one ended";
+  x.w.dth_end_rad = 97.05f / fs; // 0.05 rad/s: below 0.1 % of 97 rad/s
+  EXPECT_EQ(imest__bg_transient_dw(&x.s, &x.w, 97.0), 0.0f);
+  x.w.flags = IMEST_WFLAG_OBSERVER | IMEST_FLAG_OVERRUN; // the start unknown
+  x.w.dth_end_rad = 96.0f / fs;
+  EXPECT_NEAR(imest__bg_transient_dw(&x.s, &x.w, 97.0), 2.0, 1e-3);
+  x.w.flags = 0u; // the observer not engaged: the encoder's speed, the model holds
+  x.w.dth_end_rad = 90.0f / fs;
+  EXPECT_EQ(imest__bg_transient_dw(&x.s, &x.w, 97.0), 0.0f);
 }
 
 } // namespace

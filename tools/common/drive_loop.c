@@ -6,7 +6,7 @@
 
 #define TWO_PI 6.283185307179586476925
 
-_Static_assert(IMEST_REASON_CONSTANTS_UNCERTAIN < DRIVE_NSTATUS, "drive_t.by_status too small");
+_Static_assert(IMEST_REASON_TRANSIENT < DRIVE_NSTATUS, "drive_t.by_status too small");
 
 void drive_init(drive_t *d, imest_t *est, drive_window_fn on_window, void *ctx)
 {

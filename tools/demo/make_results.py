@@ -710,7 +710,7 @@ VERDICT_COLOURS = {
     "rs_uncertain": "tab:blue", "constants_mismatch": "olive", "wiring_mismatch": "black",
     "input_fault": "darkred", "adc_saturation": "magenta", "encoder_fault": "navy",
     "numeric": "0.2", "rs_out_of_range": "saddlebrown", "gain_mismatch": "teal",
-    "constants_uncertain": "darkkhaki",
+    "constants_uncertain": "darkkhaki", "transient": "sandybrown",
 }
 VERDICT_SPARE = ["lightcoral", "khaki", "lightsteelblue", "plum", "darkseagreen"]
 

@@ -150,6 +150,12 @@ const char *replay_remedy(int status)
            "0.1, and --sigma-uncertainty, default 0.2: data-sheet values) moves T_R or R_S by "
            "more than their tolerance: commission the motor and give its constants with the "
            "uncertainty it states, or state how well --ls and --sigma are known";
+  case IMEST_REASON_TRANSIENT:
+    return "the speed changed inside the window (a load or speed step) faster than the angle "
+           "observer follows, which moves T_R or R_S by more than their tolerance: the windows "
+           "at steady speed around it are estimated; if most windows are transients, use "
+           "windows shorter than the time between steps (--window), or turn the observer off "
+           "(--angle-observer-hz -1) where the encoder is fine enough (16384 counts)";
   case IMEST_REASON_GAIN_MISMATCH:
     return "the three current sensors' gains differ by more than R_S tolerates: calibrate them";
   default: return NULL;

@@ -110,6 +110,10 @@ typedef struct {
      positive rotation at any speed. */
   double load_nm, load_on_s, load_ramp_s;
   imsim_load_kind_t load_kind;
+  /* A second change of the load (a load step inside a run): from load_step_on_s the profile
+     goes linearly from load_nm to load_step_nm over load_step_ramp_s (0 = a step), then holds.
+     load_step_on_s INFINITY (default): none, the profile above alone. */
+  double load_step_nm, load_step_on_s, load_step_ramp_s;
 
   /* Supply. vll_v = line-to-line rms, freq_hz = electrical frequency. The V/f ramp (VF, PWM)
      raises frequency and voltage linearly from 0 over vf_ramp_s (0 = apply at once);
@@ -140,6 +144,9 @@ typedef struct {
   double ifoc_flux_wb;   /* rotor flux reference (<= 0: rated flux of the preset)          */
   double speed_ref_rpm;  /* speed mode: reference, reached by a linear ramp over speed_ramp_s */
   double speed_ramp_s;
+  /* speed mode: a second reference, from speed_step_on_s reached linearly from speed_ref_rpm over
+     speed_step_ramp_s (0 = a step). speed_step_on_s INFINITY (default): none. */
+  double speed_step_rpm, speed_step_on_s, speed_step_ramp_s;
   double torque_ref_nm; /* torque mode: reference (applied after flux build-up, see README) */
   double torque_limit_nm;
   double current_bw_hz, speed_bw_hz, speed_filter_hz;

@@ -83,6 +83,7 @@ isr_engage_observer(imest_t *s)
   s->w_win_prev = w_mean;
   s->w_win_prev_ok = s->obs_used > 0u;
   s->obs.engaged = (s->obs.enabled && steady) ? 1u : 0u;
+  if (s->obs.engaged) s->win[s->published & 1u].flags |= IMEST_WFLAG_OBSERVER; /* the background's judge */
   s->obs_pending = 0u;
 }
 
@@ -112,6 +113,7 @@ static int isr_close_window(imest_t *s)
   w->vdc_v = s->vdc_prev;
   w->off_ia = s->off_ia;
   w->off_ib = s->off_ib;
+  w->dth_end_rad = s->obs.dth; /* the speed at the window's end (the tracker always runs) */
   s->seq++;
   s->obs_rot = w->rot; /* for the observer's decision (isr_engage_observer) */
   s->obs_used = w->used;

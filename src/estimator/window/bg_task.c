@@ -10,6 +10,7 @@
 #include "bg_flux.h"
 #include "common/imest_handoff.h"
 #include "bg_noise.h"
+#include "bg_transient.h"
 #include "bg_validity.h"
 
 /* Fewer used samples than this: the sums cannot determine the 7 columns. */
@@ -61,6 +62,7 @@ static void window_sums(imest_t *s, const imest_window_t *w, double m, bg_step_t
   x->steady = w->used > 0u && s->w_prev_valid &&
               fabsf(w_now - w_before) <= (float)IMEST_STEADY_REL_LIT * fmaxf(fabsf(w_now), fabsf(w_before)) +
                                              (float)IMEST_STEADY_ABS_RAD_S_LIT;
+  x->st.dw_rad_s = imest__bg_transient_dw(s, w, w_now); /* before w_prev_valid moves on */
   s->w_prev_rad_s = w_now;
   s->w_prev_valid = w->used > 0u;
   imest__bg_noise_estimate(s, w, &x->st, &x->sums, x->steady, &x->nz);

@@ -12,6 +12,7 @@
 #include <stddef.h>
 
 #include "bg_impedance.h"
+#include "bg_transient.h"
 #include "bg_validity.h"
 #include "common/imest_math.h"
 
@@ -165,7 +166,8 @@ static float voltage_uncertainty(const imest_t *s, const imest_window_t *w, cons
  * uncertainty whose harmonics T_R sees (duty input; 0 otherwise). */
 static void systematic_bounds(const imest_t *s, const imest_window_t *w, const op_point_t *op,
                               float slip_rate, float tr, float rs, float dv_v, float harm_v, float *tr_rel,
-                              float *rs_rel, float *c_tr_rel, float *c_rs_rel)
+                              float *rs_rel, float *c_tr_rel, float *c_rs_rel, float dw_rad_s,
+                              float *x_tr_rel, float *x_rs_rel)
 {
   const float we = op->we, ls = s->ls_h, sg = s->sigma;
   bg_impedance_t z;
@@ -189,9 +191,11 @@ static void systematic_bounds(const imest_t *s, const imest_window_t *w, const o
     *c_tr_rel += fabsf(t);
     *c_rs_rel += fabsf(r);
   }
-  *tr_rel = dt / tr + *c_tr_rel;
+  /* a speed step through the angle observer (bg_transient.c) */
+  imest__bg_transient_share(s, &z, dw_rad_s, slip_rate, tr, rs, x_tr_rel, x_rs_rel);
+  *tr_rel = dt / tr + *c_tr_rel + *x_tr_rel;
   const float dr_volt = dv_v < 0.0f ? INFINITY : FOUR_OVER_PI_F * dv_v / op->i_pk;
-  *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs + *c_rs_rel;
+  *rs_rel = (dzr + fabsf(dr) * dt + dr_volt) / rs + *c_rs_rel + *x_rs_rel;
 }
 
 /* The current sensors' gain mismatch from the zero sequence (three sensors:
@@ -261,6 +265,7 @@ typedef struct {
   int steady;
   float tr_b, rs_b, g_b; /* T_R's and R_S's systematic bounds, the gain mismatch's share */
   float c_tr, c_rs;      /* the constants' share of tr_b and rs_b (in them) */
+  float x_tr, x_rs;      /* a transient's share of tr_b and rs_b (in them; bg_transient.c) */
   /* The bounds are steady-state figures: T_R's is judged only below the
    * pull-out slip (a sigma < 1), where a drive runs steadily; beyond it the
    * window is a transient (a run-up) whose dynamics determine T_R. */
@@ -385,6 +390,12 @@ static inline int tr_constants_uncertain(judge_t *j)
 {
   return j->tr_judged && !(j->c_tr <= j->s->tr_tolerance);
 }
+/* tr_tolerance: a load or speed step inside the window alone (judged where
+ * T_R's bound is) */
+static inline int tr_transient(judge_t *j)
+{
+  return j->tr_judged && !(j->x_tr <= j->s->tr_tolerance);
+}
 /* tr_tolerance */
 static inline int tr_uncertain(judge_t *j)
 {
@@ -394,6 +405,11 @@ static inline int tr_uncertain(judge_t *j)
 static inline int rs_gain_mismatch(judge_t *j)
 {
   return !(j->rs_b + j->g_b <= j->s->rs_tolerance) && j->g_b > j->rs_b;
+}
+/* rs_tolerance: a load or speed step inside the window alone */
+static inline int rs_transient(judge_t *j)
+{
+  return !(j->x_rs <= j->s->rs_tolerance);
 }
 /* rs_tolerance, ls_uncertainty, sigma_uncertainty: the constants' share alone */
 static inline int rs_constants_uncertain(judge_t *j)
@@ -430,12 +446,14 @@ static inline int rs_uncertain(judge_t *j)
   X(IMEST_REASON_CONSTANTS_MISMATCH, rs_off_nominal)                                                         \
   X(IMEST_REASON_CONSTANTS_MISMATCH, tr_off_nominal)                                                         \
   X(IMEST_REASON_NUMERIC, not_finite)                                                                        \
+  X(IMEST_REASON_TRANSIENT, tr_transient)                                                                    \
   X(IMEST_REASON_CONSTANTS_UNCERTAIN, tr_constants_uncertain)                                                \
   X(IMEST_REASON_TR_UNCERTAIN, tr_uncertain)
 
 /* R_S's own checks, once T_R's verdict is valid. */
 #define RS_CHECKS(X)                                                                                         \
   X(IMEST_REASON_GAIN_MISMATCH, rs_gain_mismatch)                                                            \
+  X(IMEST_REASON_TRANSIENT, rs_transient)                                                                    \
   X(IMEST_REASON_CONSTANTS_UNCERTAIN, rs_constants_uncertain)                                                \
   X(IMEST_REASON_RS_UNCERTAIN, rs_uncertain)
 
@@ -471,12 +489,14 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
   j->g_b = 0.0f;
   j->c_tr = 0.0f; /* without an estimate the total's INFINITY says tr_uncertain */
   j->c_rs = 0.0f;
+  j->x_tr = 0.0f;
+  j->x_rs = 0.0f;
   if (have && imest__bg_finite(r->rs_ohm) && j->rs > 0.0f) {
     const float rs = j->rs;
     float harm_v;
     const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &harm_v);
     systematic_bounds(j->s, j->w, &j->op, j->st->slip_rate, j->tr, rs, dv_v, harm_v, &j->tr_b, &j->rs_b,
-                      &j->c_tr, &j->c_rs);
+                      &j->c_tr, &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
     /* the magnetising curve's share (bg_flux.c), where T_R's bound is finite;
      * nothing without a curve (the outputs stay as without it) */
     if (fx != NULL && j->s->ls_curve_points != 0u && isfinite(j->tr_b)) {

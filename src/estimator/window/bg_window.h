@@ -20,6 +20,8 @@ typedef struct {
   float slip_rate; /* mean rotation rate of the rotor-frame current [rad/s]:
                       the slip frequency in steady state */
   float u_ms;      /* mean square of u_alpha [V^2] */
+  float dw_rad_s;  /* the speed's change inside the window through the angle observer [rad/s]
+                      (bg_transient.c; set by the task) */
 } bg_window_stats_t;
 
 /* One window's ISR sums -> full 8x8 float64 sums (undoes the centring and
