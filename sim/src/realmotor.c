@@ -365,7 +365,7 @@ void ims_rm_fill(imsim_t *s, imsim_sample_t *o)
      iron loss, ideal inverter: 88 W at the instant, 144 W dissipated, 135 W at the fundamental).
      The first sample has no period behind it and takes the instant's value. */
   const double dt = s->t - rm->t_prev_s;
-  o->p_fe_w = !rm->fe ? 0.0
+  o->p_fe_w = !rm->fe                    ? 0.0
               : rm->has_prev && dt > 0.0 ? (rm->e_fe_j - rm->e_fe_prev_j) / dt
                                          : rm->rfe_ohm * cabs2(k.ife);
   rm->e_fe_prev_j = rm->e_fe_j;
