@@ -34,6 +34,10 @@ void ims_drive_init(imsim_t *s)
     /* what the drive computed at t_-1 for [t_0, t_1) (continuity for a steady start) */
     duties_from(s, vf_command(s, -s->ts_s), s->duty);
     for (int k = 0; k < 3; ++k) s->duty_next[k] = s->duty[k];
+  } else if (s->c.supply == IMSIM_SUPPLY_IFOC && s->c.start == IMSIM_START_STEADY) {
+    /* the steady controller's command for [t_0, t_1) (ims_ifoc_steady), at its centre */
+    duties_from(s, ims_ifoc_vref(s, 0.5 * s->ts_s), s->duty);
+    for (int k = 0; k < 3; ++k) s->duty_next[k] = s->duty[k];
   }
 }
 

@@ -94,3 +94,86 @@ void imsim_set_torque_ref(imsim_t *s, double nm)
 {
   s->c.torque_ref_nm = nm;
 }
+
+/* The current magnitude the IFOC imposes at slip w_sl, the supply that drives it at speed w, and
+   the torque surplus there (ims_ifoc_steady). */
+typedef struct {
+  const imsim_t *s;
+  double w, id, tl;
+} ifoc_ss_ctx_t;
+
+static double ifoc_surplus(const ifoc_ss_ctx_t *x, double w_sl, double *vll, imsim_steady_t *st)
+{
+  const imsim_config_t *c = &x->s->c;
+  const double we = (double)c->pole_pairs * x->w + w_sl;
+  const double iq = w_sl * x->s->ifoc_tr * x->id;
+  const double i_amp = sqrt(x->id * x->id + iq * iq);
+  /* |i| grows with the voltage at a fixed speed and frequency: double, then bisect */
+  double lo = 0.0, hi = 1.0;
+  for (int k = 0; k < 60; ++k) {
+    ims_steady_at(c, &x->s->rm, hi, we, x->w, st, NULL);
+    if (st->i_rms_phase * sqrt(3.0) >= i_amp) break;
+    lo = hi;
+    hi *= 2.0;
+  }
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    ims_steady_at(c, &x->s->rm, mid, we, x->w, st, NULL);
+    if (st->i_rms_phase * sqrt(3.0) < i_amp)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  *vll = 0.5 * (lo + hi);
+  ims_steady_at(c, &x->s->rm, *vll, we, x->w, st, NULL);
+  return st->torque_nm - x->tl;
+}
+
+int ims_ifoc_steady(imsim_t *s, double *vll_v, double *we, imsim_steady_t *st)
+{
+  const imsim_config_t *c = &s->c;
+  if (c->ifoc_mode != IMSIM_IFOC_SPEED) return -1;
+  const double np = (double)c->pole_pairs;
+  const double m = s->m_h;
+  const double w = s->speed_ref;
+  if (!(w > 0.0)) return -1;
+  /* the speed loop settles where the motor's torque meets the load and the friction */
+  const ifoc_ss_ctx_t x = {s, w, s->ifoc_flux / m, c->load_nm + c->b_nms * w};
+  /* the slip of the torque limit (iq_ref = te L_R / (n_p M psi_ref), w_sl = iq / (T_R id)) */
+  const double iq_max = c->torque_limit_nm * c->lr_h / (np * m * s->ifoc_flux);
+  double lo = -iq_max / (s->ifoc_tr * x.id), hi = -lo;
+  if (np * w + lo <= 0.0) lo = 0.5 * (-np * w); /* the field keeps turning forwards */
+  double v;
+  if (!(ifoc_surplus(&x, lo, &v, st) < 0.0) || !(ifoc_surplus(&x, hi, &v, st) > 0.0)) return -1;
+  for (int k = 0; k < 80; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    if (ifoc_surplus(&x, mid, &v, st) < 0.0)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  const double w_sl = 0.5 * (lo + hi);
+  (void)ifoc_surplus(&x, w_sl, vll_v, st);
+  ims_steady_at(c, &s->rm, *vll_v, np * w + w_sl, w, st, s->rm.on ? s->rm.fl : NULL);
+  *we = np * w + w_sl;
+  /* the controller's state there: references, the speed loop's integral (its output at zero
+     error), the measured speed */
+  s->id_ref = x.id;
+  s->iq_ref = w_sl * s->ifoc_tr * x.id;
+  s->te_ref = s->iq_ref * np * m * s->ifoc_flux / c->lr_h;
+  s->integ_w = s->te_ref;
+  s->w_meas = w;
+  /* the field angle that puts the current at (id_ref, iq_ref), and the voltage command there:
+     the current loops' integrals are what the command is at zero error, less the decoupling */
+  const double rho = atan2(st->i_ab[1], st->i_ab[0]) - atan2(s->iq_ref, s->id_ref);
+  const cpx v_dq = cmul(cx(*vll_v, 0.0), cexpj(-rho));
+  const double sl = c->sigma * c->ls_h;
+  s->v_dq[0] = v_dq.re;
+  s->v_dq[1] = v_dq.im;
+  s->integ_d = v_dq.re + *we * sl * s->iq_ref;
+  s->integ_q = v_dq.im - *we * (sl * s->id_ref + m / c->lr_h * s->ifoc_flux);
+  s->rho = rho;
+  s->we_ctrl = *we;
+  s->t_ctrl = 0.0;
+  return 0;
+}

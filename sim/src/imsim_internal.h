@@ -133,6 +133,13 @@ void ims_rm_fill(imsim_t *s, imsim_sample_t *o);
 int ims_speed_root(double (*surplus)(const void *ctx, double w), const void *ctx, double wsync, double *w);
 int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double freq_hz,
                   double load_nm, imsim_steady_t *out, cpx fl[4]);
+/* The phasor steady state at a given speed w (rad/s) and supply (u = vll + j0 at t = 0, we rad/s):
+   ims_rm_steady_at with the effects, ims_steady_at either (rm NULL or off: the linear machine;
+   fl: the effects' flux states, may be NULL). */
+void ims_rm_steady_at(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double we, double w,
+                      imsim_steady_t *out, cpx fl[4]);
+void ims_steady_at(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double we, double w,
+                   imsim_steady_t *out, cpx fl[4]);
 
 /* ---- integration ---------------------------------------------------------------------------- */
 
@@ -204,5 +211,11 @@ void ims_drive_advance(imsim_t *s);
 /* ifoc.c */
 void ims_ifoc_update(imsim_t *s);
 cpx ims_ifoc_vref(const imsim_t *s, double t);
+/* --start steady with IFOC (speed mode): the operating point its loops hold at the speed
+   reference and the load (the slip where the imposed current's torque meets the load, the
+   supply vll_v / we that drives that current), the machine's phasors there (st, and the real
+   motor's flux states), and the controller's state at it. -1: torque mode, no positive speed
+   reference, or a load beyond the torque limit. */
+int ims_ifoc_steady(imsim_t *s, double *vll_v, double *we, imsim_steady_t *st);
 
 #endif /* IMSIM_INTERNAL_H */

@@ -463,10 +463,18 @@ int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v,
   if (!(freq_hz > 0.0)) return -1;
   const double we = 2.0 * PI * freq_hz;
   const double wsync = we / (double)c->pole_pairs;
-  rm_phasor_t ph;
   const rm_ctx_t x = {c, rm, vll_v, we, load_nm};
   double w;
   if (ims_speed_root(rm_torque_surplus, &x, wsync, &w) != 0) return -1;
+  ims_rm_steady_at(c, rm, vll_v, we, w, out, fl);
+  return 0;
+}
+
+void ims_rm_steady_at(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double we, double w,
+                      imsim_steady_t *out, cpx fl[4])
+{
+  const double wsync = we / (double)c->pole_pairs;
+  rm_phasor_t ph;
   phasor_at(c, rm, vll_v, we, w, &ph);
   const cpx ir = cadd(ph.i1, ph.i2);
   const cpx psir = cadd(ph.psim, cscale(ir, rm->llr_h));
@@ -489,7 +497,6 @@ int ims_rm_steady(const imsim_config_t *c, const imsim_real_t *rm, double vll_v,
     fl[2] = rm->dc ? cadd(ph.psim, cscale(ph.i2, rm->l2_h)) : cx(0.0, 0.0);
     fl[3] = ph.psim;
   }
-  return 0;
 }
 
 int imsim_real_params(const imsim_config_t *c, imsim_real_params_t *out)

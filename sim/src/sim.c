@@ -111,8 +111,6 @@ int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first)
   s->ifoc_tr = c->ifoc_tr_s > 0.0 ? c->ifoc_tr_s : c->tr_s;
   s->speed_ref = c->speed_ref_rpm * 2.0 * PI / 60.0;
   if (c->supply == IMSIM_SUPPLY_IFOC) {
-    if (c->start == IMSIM_START_STEADY)
-      return fail(s, "start 'steady' is not available with IFOC, which starts from rest (--start rest)");
     if (c->ifoc_flux_wb > 0.0) {
       s->ifoc_flux = c->ifoc_flux_wb;
     } else {
@@ -125,24 +123,32 @@ int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first)
   }
   s->te_ref = NAN_D;
 
+  const bool ifoc_steady = c->start == IMSIM_START_STEADY && c->supply == IMSIM_SUPPLY_IFOC;
   if (c->start == IMSIM_START_STEADY) {
     imsim_steady_t st;
-    if (c->supply == IMSIM_SUPPLY_IFOC) return fail(s, "steady start not available with IFOC");
-    if (imsim_steady_state(c, c->vll_v, c->freq_hz, c->load_nm, &st) != 0)
-      return fail(s, "steady start: load exceeds the breakdown torque");
+    double vll = c->vll_v, we = 2.0 * PI * c->freq_hz; /* the supply of the steady state */
+    if (ifoc_steady) {
+      if (ims_ifoc_steady(s, &vll, &we, &st) != 0)
+        return fail(s, "steady start with IFOC needs speed mode, a positive --speed-ref and a load "
+                       "within --torque-limit");
+      s->c.speed_ramp_s = 0.0;
+    } else {
+      if (imsim_steady_state(c, c->vll_v, c->freq_hz, c->load_nm, &st) != 0)
+        return fail(s, "steady start: load exceeds the breakdown torque");
+      if (s->rm.on) (void)ims_rm_steady(c, &s->rm, c->vll_v, c->freq_hz, c->load_nm, &st, s->rm.fl);
+    }
     s->x[0] = cx(st.i_ab[0], st.i_ab[1]);
     s->x[1] = cx(st.psi_ab[0], st.psi_ab[1]);
     s->w = st.speed_rad_s;
-    if (s->rm.on) (void)ims_rm_steady(c, &s->rm, c->vll_v, c->freq_hz, c->load_nm, &st, s->rm.fl);
     /* AA filter states in sinusoidal steady state: f1 = H(j we) x, f2 = (j we / wc) f1 */
     if (c->aa_hz > 0.0 && !c->ideal_sensors) {
-      const double wc = 2.0 * PI * c->aa_hz, we = 2.0 * PI * c->freq_hz;
+      const double wc = 2.0 * PI * c->aa_hz;
       const cpx den = cx(wc * wc - we * we, SQRT2 * wc * we);
       const double dd = cabs2(den);
       const cpx hh = cx(wc * wc * den.re / dd, -wc * wc * den.im / dd);
       s->x[2] = cmul(hh, s->x[0]);
       s->x[3] = cmul(cx(0.0, we / wc), s->x[2]);
-      s->x[4] = cmul(hh, cx(c->vll_v, 0.0));
+      s->x[4] = cmul(hh, cx(vll, 0.0));
       s->x[5] = cmul(cx(0.0, we / wc), s->x[4]);
     }
     s->c.load_on_s = 0.0;
@@ -164,6 +170,11 @@ int imsim_init(imsim_t *s, const imsim_config_t *cfg, imsim_sample_t *first)
   imsim_sample_t tmp;
   ims_fill_sample(s, first != NULL ? first : &tmp);
   s->th_meas_prev = s->th_meas;
+  if (ifoc_steady) {
+    /* the field angle from the encoder's, and its speed from the angle a sample before */
+    s->slip_angle = s->rho - (double)c->pole_pairs * s->th_meas;
+    s->th_meas_prev = s->th_meas - s->w * s->ts_s;
+  }
   return 0;
 }
 

@@ -75,11 +75,24 @@ int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, do
   const double m = sqrt((1.0 - c->sigma) * c->ls_h * c->lr_h);
   const double we = 2.0 * PI * freq_hz;
   const double wsync = we / (double)c->pole_pairs;
-  cpx i, psi;
-  double te;
   const lin_ctx_t x = {c, m, vll_v, we, load_nm};
   double w;
   if (ims_speed_root(lin_torque_surplus, &x, wsync, &w) != 0) return -1;
+  ims_steady_at(c, NULL, vll_v, we, w, out, NULL);
+  return 0;
+}
+
+void ims_steady_at(const imsim_config_t *c, const imsim_real_t *rm, double vll_v, double we, double w,
+                   imsim_steady_t *out, cpx fl[4])
+{
+  if (rm != NULL && rm->on) {
+    ims_rm_steady_at(c, rm, vll_v, we, w, out, fl);
+    return;
+  }
+  const double m = sqrt((1.0 - c->sigma) * c->ls_h * c->lr_h);
+  const double wsync = we / (double)c->pole_pairs;
+  cpx i, psi;
+  double te;
   steady_at(c, m, c->tr_s, w, vll_v, we, &i, &psi, &te);
   out->speed_rad_s = w;
   out->speed_rpm = w * 60.0 / (2.0 * PI);
@@ -92,5 +105,4 @@ int imsim_steady_state(const imsim_config_t *c, double vll_v, double freq_hz, do
   out->psi_ab[0] = psi.re;
   out->psi_ab[1] = psi.im;
   out->psi_m_wb = out->lm_h = out->p_fe_w = 0.0;
-  return 0;
 }
