@@ -51,6 +51,12 @@ def main():
     r = simulate.replay_args(p)
     check(r[r.index("--ls") + 1] == "0.2" and r[r.index("--rs") + 1] == "1.5" and
           r[r.index("--tr-nominal") + 1] == "0.12" and "--sigma" in r, "commissioned constants not in replay args")
+    q = next(x for x in real if x["family"] == "real_ifoc_duty")
+    a = simulate.sim_args(q, 8.0)
+    last = len(a) - 1 - a[::-1].index("--supply")  # a later flag overrides the preset's
+    check(a[last + 1] == "ifoc" and
+          abs(float(a[a.index("--speed-ref") + 1]) - q["speed_rad_s"] * 30.0 / 3.141592653589793) < 1e-3,
+          "real_ifoc_duty: no IFOC at the point's speed in sim args")
     q = next(x for x in real if x["input"] == "duty_inv")
     r = simulate.replay_args(dict(q, consts=dict(args=args, inverter=inv, sigma=None)))
     check(r[r.index("--v-switch") + 1] == "0.9", "duty input: not the commissioned inverter model")

@@ -55,6 +55,8 @@ REAL_FAMILIES = [
     ("real_deepbar", "--real-motor --saturation 0 --iron-loss 0", "phase"),
     ("real_all", "--real-motor", "phase"),
     ("real_all_duty", "--real-motor", "duty_inv"),
+    # a speed-controlled IFOC driving the inverter (IFOC_FAMILIES)
+    ("real_ifoc_duty", "--real-motor", "duty_inv"),
     # field weakening: above base speed at the rated voltage, constant power (FIELD_WEAKENING)
     ("real_fw_linear", "", "phase"),
     ("real_fw_sat", "--real-motor --iron-loss 0 --rotor single", "phase"),
@@ -67,6 +69,12 @@ REAL_LOADS = [25, 50, 100]
 # voltage limit; the flux falls as 1/f), loads of FW_POWERS % of rated power (the torque
 # FW_POWERS % x f_n / f of rated: the constant-power range of a drive).
 FIELD_WEAKENING = {"real_fw_linear", "real_fw_sat", "real_fw_all"}
+# The closed-loop families: a speed-controlled IFOC (its T_R the motor's data-sheet value, the
+# slip relation's error with the effects uncorrected, as a drive runs before any estimate)
+# drives the inverter with dead time and drops, and the estimator reads its duties; the closed
+# loop's own ripple and the current loops' response to the inverter's error are in the data
+# (imest-sim --supply ifoc --start steady at the point's speed and load).
+IFOC_FAMILIES = {"real_ifoc_duty"}
 FW_FREQ = 150
 FW_POWERS = [25, 50, 75, 100]
 

@@ -357,6 +357,7 @@ def render_real(fam, rows, table, meta):
     L.append("|---|---|---|")
     for f, eff, inp in points.REAL_FAMILIES:
         if f in fam:
+            eff = (eff + " --supply ifoc").strip() if f in points.IFOC_FAMILIES else eff
             L.append(f"| {f} | `{eff or '(linear motor)'}` | "
                      f"{'duty cycle, 2 µs dead time + drops, model given' if inp == 'duty_inv' else 'phase voltage'} |")
     goals = real_goals(fam, rows)
