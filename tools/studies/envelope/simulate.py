@@ -49,7 +49,7 @@ def sim_args(p, duration_s):
         a += ["--adc-bits", "16"]
     if p["input"] == "duty_inv":
         a += inverter_flags(points.INVERTER)
-    if p["family"] in points.IFOC_FAMILIES:  # the speed loop holds the point's speed
+    if p.get("family") in points.IFOC_FAMILIES:  # the speed loop holds the point's speed
         a += ["--supply", "ifoc", "--speed-ref", f"{p['speed_rad_s'] * 30.0 / 3.141592653589793:.8g}"]
     return a
 
