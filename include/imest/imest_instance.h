@@ -126,6 +126,12 @@ typedef struct {
   uint32_t centred; /**< every window had the same centring: rwe, ree hold */
 } imest_combo_t;
 
+/** imest_t.align: the ISR's optional alignment stages, one bit each, so that a
+ *  drive that uses none pays one test per sample (src/estimator/isr/isr_sample.c). */
+#define IMEST_ALIGN_DELAY_I 1u /**< the currents and the angle delayed (the voltage lags) */
+#define IMEST_ALIGN_DELAY_U 2u /**< the voltage delayed (it leads) */
+#define IMEST_ALIGN_AA      4u /**< the angle through the anti-alias filter's model */
+
 /** Estimator instance. All fields are private; sizes are what the ISR needs.
  *  sizeof(imest_t) is 2000 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
  *  fw/README.md) and on an x86-64 host too (every member is 32-bit: no pointers, no padding that
@@ -137,7 +143,7 @@ typedef struct {
   imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max; /* dth_max: largest angle step [rad] */
   uint32_t window_n, warmup_n;
   uint32_t warmup_fault_n; /* samples the filters settle after a fault */
-  uint32_t aa_on;          /* anti-alias model in use */
+  uint32_t align;          /* the alignment stages in use: IMEST_ALIGN_* bits (0: none) */
   imest_bw3_t bw;
   imest_sos_t aa;
   imest_real_t dly_i;      /* voltage lags: currents and angle delayed by this fraction of a sample */

@@ -334,7 +334,8 @@ static void init_isr_constants(imest_t *s, const imest_config_t *cfg, double m)
   design_bw3(&s->bw, (double)cfg->filter_hz, (double)fs);
   imest__bg_noise_gains(&s->bw, fs, s->noise_g);
   design_aa(&s->aa, (double)cfg->aa_hz, (double)fs);
-  s->aa_on = cfg->aa_hz > 0.0f;
+  s->align = (s->dly_i != 0.0f ? IMEST_ALIGN_DELAY_I : 0u) | (s->dly_u != 0.0f ? IMEST_ALIGN_DELAY_U : 0u) |
+             (cfg->aa_hz > 0.0f ? IMEST_ALIGN_AA : 0u);
   const float fn = cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz;
   design_angle(&s->obs, fn, fs);
   s->transient_k = imest__bg_transient_k(fn, (float)s->n, cfg->window_s); /* the judge's (bg_transient.c) */

@@ -63,11 +63,14 @@ static void isr_open_window(imest_t *s, imest_window_t *w, uint32_t pending_flag
  * when the window before had the mean speed of the one before that. The ISR
  * decides it from its own sums (the test of the background's noise model,
  * bg_task.c, in float32), so the decision is the same whenever the
- * background runs. It runs on the next window's first even sample (the
- * lighter kind: the odd ones complete the regressor's sums) after its angle
- * step, not on the window's last sample, which is the ISR's longest: the
- * observer follows from the next sample on. Not inlined: the other samples
- * pay only the test of obs_pending. */
+ * background runs. It takes effect from the sample after the next window's
+ * first used even sample (the observer follows from there on), and is made
+ * just before that sample's angle step (OBS_DECIDE), not on the window's
+ * last sample, the ISR's longest, nor on the even sample, the heavier of a
+ * pair (it forms the regressor): the odd one only completes its sums. Not
+ * inlined: the other samples pay only the test of obs_pending. */
+#define OBS_WINDOW_ENDED 1u /* obs_pending: a window ended; at its first used even sample: */
+#define OBS_DECIDE       2u /* decide before the next angle step (isr_step, or a window's end) */
 #if defined(__GNUC__)
 __attribute__((noinline))
 #endif
@@ -115,9 +118,10 @@ static int isr_close_window(imest_t *s)
   w->off_ib = s->off_ib;
   w->dth_end_rad = s->obs.dth; /* the speed at the window's end (the tracker always runs) */
   s->seq++;
+  if (s->obs_pending == OBS_DECIDE) isr_engage_observer(s); /* a fault closed the window: the one it decides */
   s->obs_rot = w->rot; /* for the observer's decision (isr_engage_observer) */
   s->obs_used = w->used;
-  s->obs_pending = 1u;
+  s->obs_pending = OBS_WINDOW_ENDED;
   const uint32_t pub = s->published; /* the ISR's own index */
   if (pub == IMEST_LOAD_ACQUIRE(&s->released)) {
     /* the window's contents before the index; the ISR now fills the other buffer */
@@ -217,7 +221,9 @@ static inline void isr_noise(imest_t *s, const isr_in_t *in, imest_real_t *d3i_o
 static inline void isr_align(imest_t *s, isr_in_t *in, imest_real_t ia_prev, imest_real_t ua_prev,
                              imest_real_t step, imest_real_t *th_r, imest_real_t *w_raw)
 {
-  if (s->dly_i != RL(0)) {
+  const uint32_t align = s->align;
+  if (align == 0u) return; /* one test for a drive that aligns nothing */
+  if (align & IMEST_ALIGN_DELAY_I) {
     /* the voltage lags: delay currents and angle to match */
     const imest_real_t a = s->dly_i, w_now = *w_raw;
     in->ia = in->ia - a * (in->ia - ia_prev);
@@ -227,14 +233,14 @@ static inline void isr_align(imest_t *s, isr_in_t *in, imest_real_t ia_prev, ime
     *th_r = *th_r - a * step;
     s->wr_prev = w_now;
   }
-  if (s->dly_u != RL(0)) {
+  if (align & IMEST_ALIGN_DELAY_U) {
     /* the voltage leads: delay it to match */
     const imest_real_t ub_now = in->ub;
     in->ua = in->ua - s->dly_u * (in->ua - ua_prev);
     in->ub = in->ub - s->dly_u * (in->ub - s->ub1);
     s->ub1 = ub_now;
   }
-  if (s->aa_on) {
+  if (align & IMEST_ALIGN_AA) {
     /* the angle through a model of the electrical channels' AA filter */
     *w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, *w_raw);
   }
@@ -270,7 +276,7 @@ static inline void isr_window_sample(imest_t *s, imest_window_t *w, const isr_in
     return;
   }
   if ((s->k & 1u) == 0u) {
-    if (s->obs_pending) isr_engage_observer(s); /* the first even sample after a window's end */
+    s->obs_pending <<= 1; /* OBS_WINDOW_ENDED -> OBS_DECIDE; 0 stays (OBS_DECIDE is done by now) */
     isr_regressor(s, g, w->c0, s->zx, s->zy);
     isr_extra_t x;
     /* i x di/dt: in steady state |i|^2 times the slip frequency */
@@ -316,6 +322,7 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
   /* The encoder angle through the tracking observer (which keeps quantisation
    * steps out of the rotation and the speed alike); its step is the speed. */
   imest_real_t step;
+  if (s->obs_pending == OBS_DECIDE) isr_engage_observer(s);
   imest_real_t th_r = th + isr_angle_update(&s->obs, dth, &step);
   imest_real_t w_raw = step * s->fs;
   isr_align(s, &in, ia_prev, ua_prev, step, &th_r, &w_raw);
