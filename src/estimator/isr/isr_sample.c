@@ -221,9 +221,9 @@ static inline void isr_noise(imest_t *s, const isr_in_t *in, imest_real_t *d3i_o
 static inline void isr_align(imest_t *s, isr_in_t *in, imest_real_t ia_prev, imest_real_t ua_prev,
                              imest_real_t step, imest_real_t *th_r, imest_real_t *w_raw)
 {
-  const uint32_t align = s->align;
-  if (align == 0u) return; /* one test for a drive that aligns nothing */
-  if (align & IMEST_ALIGN_DELAY_I) {
+  const uint32_t align = s->stages;
+  if ((align & IMEST_STAGE_ALIGN) == 0u) return; /* one test for a drive that aligns nothing */
+  if (align & IMEST_STAGE_DELAY_I) {
     /* the voltage lags: delay currents and angle to match */
     const imest_real_t a = s->dly_i, w_now = *w_raw;
     in->ia = in->ia - a * (in->ia - ia_prev);
@@ -233,14 +233,14 @@ static inline void isr_align(imest_t *s, isr_in_t *in, imest_real_t ia_prev, ime
     *th_r = *th_r - a * step;
     s->wr_prev = w_now;
   }
-  if (align & IMEST_ALIGN_DELAY_U) {
+  if (align & IMEST_STAGE_DELAY_U) {
     /* the voltage leads: delay it to match */
     const imest_real_t ub_now = in->ub;
     in->ua = in->ua - s->dly_u * (in->ua - ua_prev);
     in->ub = in->ub - s->dly_u * (in->ub - s->ub1);
     s->ub1 = ub_now;
   }
-  if (align & IMEST_ALIGN_AA) {
+  if (align & IMEST_STAGE_AA) {
     /* the angle through a model of the electrical channels' AA filter */
     *w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, *w_raw);
   }
@@ -377,32 +377,52 @@ int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float
   const imest_duty_model_t *m = &s->duty;
   const imest_real_t vdc = (imest_real_t)vdc_v, vdc_prev = s->vdc_prev;
   s->vdc_prev = vdc;
-  /* per sample, shared by the legs: the weighted bus voltages, the dead-time
-   * error at their mean plus the diode threshold, and the zero-crossing band */
+  const imest_real_t wp = m->w_prev, wn = RL(1) - wp;
+  /* per sample, shared by the legs: the weighted bus voltages, the dead
+   * time's volt-seconds, the ripple's scale and the devices' band */
   isr_duty_k_t k;
-  k.kp = m->w_prev * vdc_prev;
-  k.kn = m->w_now * vdc;
+  k.kp = wp * vdc_prev;
+  k.kn = wn * vdc;
   k.vdc = vdc;
   k.vdc_prev = vdc_prev;
   const imest_real_t vbar = k.kp + k.kn;
-  k.e0 = m->td_f * vbar + m->v_d;
-  const imest_real_t band = m->band_per_v * vbar;
+  k.kt = m->td_f_half * vbar;
+  const imest_real_t kr = m->ripple_per_v * vbar;
+  const imest_real_t band = m->band_per_kr * kr;
   k.band2 = band * band + m->band2;
   const imest_real_t ia = (imest_real_t)i_abc_a[0], ib = (imest_real_t)i_abc_a[1],
                      ic = (imest_real_t)i_abc_a[2];
   const imest_real_t da = (imest_real_t)duty_abc[0], db = (imest_real_t)duty_abc[1],
                      dc = (imest_real_t)duty_abc[2];
-  imest_real_t step[3];
-  const imest_real_t va = isr_duty_leg(m, &k, &s->dleg[0], da, ia, &step[0]);
-  const imest_real_t vb = isr_duty_leg(m, &k, &s->dleg[1], db, ib, &step[1]);
-  const imest_real_t vc = isr_duty_leg(m, &k, &s->dleg[2], dc, ic, &step[2]);
+  const imest_real_t pa = s->dleg[0], pb = s->dleg[1], pc = s->dleg[2];
+  s->dleg[0] = da;
+  s->dleg[1] = db;
+  s->dleg[2] = dc;
+  /* written out per leg: a compiler need not unroll a loop over three */
+  const imest_real_t dbar[3] = {wp * pa + wn * da, wp * pb + wn * db, wp * pc + wn * dc};
+  imest_real_t e[3];
+  if (s->stages & IMEST_STAGE_DUTY_EDGES) { /* configuration only: the same path every sample */
+    imest_real_t r[3];
+    isr_duty_ripple(kr, dbar, r);
+    e[0] = isr_duty_error(m, &k, dbar[0], ia, r[0]);
+    e[1] = isr_duty_error(m, &k, dbar[1], ib, r[1]);
+    e[2] = isr_duty_error(m, &k, dbar[2], ic, r[2]);
+  } else {
+    e[0] = isr_duty_error_smooth(m, &k, dbar[0], ia);
+    e[1] = isr_duty_error_smooth(m, &k, dbar[1], ib);
+    e[2] = isr_duty_error_smooth(m, &k, dbar[2], ic);
+  }
+  const imest_real_t u[3] = {(k.kp * pa + k.kn * da) - e[0], (k.kp * pb + k.kn * db) - e[1],
+                             (k.kp * pc + k.kn * dc) - e[2]};
+  /* the leg voltages' steps at the sample */
+  const imest_real_t step[3] = {vdc * da - vdc_prev * pa, vdc * db - vdc_prev * pb, vdc * dc - vdc_prev * pc};
+  const imest_real_t i[3] = {ia, ib, ic};
   /* the ADC limit applies to the currents; the duties and the bus voltage
    * only have to be numbers: one test catches NaN, Inf or absurd duties and
    * a bus voltage near u_absurd_v (both weighted into one sum of squares) */
   const int in_range = (imest__abs(ia) < s->i_lim) & (imest__abs(ib) < s->i_lim) &
                        (imest__abs(ic) < s->i_lim) &
                        (((da * da + db * db) + dc * dc) + m->vdc2_w * (vdc * vdc) < RL(12));
-  const imest_real_t u[3] = {va, vb, vc}, i[3] = {ia, ib, ic};
   imest_real_t ua, ub, ia_ab, ib_ab, sa, sb;
   imest__clarke(u, &ua, &ub); /* the zero sequence (the legs' common part) drops out */
   imest__clarke(i, &ia_ab, &ib_ab);
