@@ -131,11 +131,11 @@ typedef struct {
 
 /** imest_t.stages: the ISR's optional stages, one bit each, so that a drive that
  *  uses none pays one test per sample (src/estimator/isr/isr_sample.c). */
-#define IMEST_STAGE_DELAY_I     1u /**< the currents and the angle delayed (the voltage lags) */
-#define IMEST_STAGE_DELAY_U     2u /**< the voltage delayed (it leads) */
-#define IMEST_STAGE_AA          4u /**< the angle through the anti-alias filter's model */
-#define IMEST_STAGE_ALIGN       7u /**< any of the three above */
-#define IMEST_STAGE_DUTY_EDGES  8u /**< duty input: the switching-instant inverter model */
+#define IMEST_STAGE_DELAY_I    1u /**< the currents and the angle delayed (the voltage lags) */
+#define IMEST_STAGE_DELAY_U    2u /**< the voltage delayed (it leads) */
+#define IMEST_STAGE_AA         4u /**< the angle through the anti-alias filter's model */
+#define IMEST_STAGE_ALIGN      7u /**< any of the three above */
+#define IMEST_STAGE_DUTY_EDGES 8u /**< duty input: the switching-instant inverter model */
 
 /** Estimator instance. All fields are private; sizes are what the ISR needs.
  *  sizeof(imest_t) is 2000 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,

@@ -54,7 +54,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->inverter.v_diode_v = 0.0f;
   cfg->inverter.r_diode_ohm = 0.0f;
   cfg->inverter.i_band_a = 0.0f;
-  cfg->inverter.edge_band_a = 0.0f; /* the smooth sign (docs/METHOD.md §17.1) */
+  cfg->inverter.edge_band_a = 0.0f;  /* the smooth sign (docs/METHOD.md §17.1) */
   cfg->inverter.uncertainty = -1.0f; /* unknown until the user (or commissioning) says */
   cfg->rs_tolerance = 0.05f;
   cfg->tr_tolerance = 0.02f;

@@ -291,9 +291,10 @@ struct DutyDrive {
     auto sgn = [b](double x) { return x / std::sqrt(x * x + b * b); };
     const double se = 0.5 * (sgn(i + r) + sgn(i - r));
     // the smooth sign's mean over the ramp i - r .. i + r: its integral is sqrt(x^2 + b^2)
-    const double m = std::fabs(r) > 1e-9
-                         ? (std::sqrt((i + r) * (i + r) + b * b) - std::sqrt((i - r) * (i - r) + b * b)) / (2.0 * r)
-                         : sgn(i);
+    const double m =
+        std::fabs(r) > 1e-9
+            ? (std::sqrt((i + r) * (i + r) + b * b) - std::sqrt((i - r) * (i - r) + b * b)) / (2.0 * r)
+            : sgn(i);
     return td * fpwm * vdc * se + 0.5 * (vsw + vd) * m + 0.5 * (rsw + rd) * i +
            (dbar - 0.5) * ((vsw - vd) + (rsw - rd) * std::fabs(i));
   }

@@ -28,7 +28,8 @@ typedef struct {
 static inline void isr_duty_ripple(imest_real_t kr, const imest_real_t d[3], imest_real_t r[3])
 {
   const imest_real_t mean = ((d[0] + d[1]) + d[2]) * RL(IMEST_ONE_THIRD_LIT);
-  const imest_real_t pab = imest__abs(d[0] - d[1]), pbc = imest__abs(d[1] - d[2]), pca = imest__abs(d[2] - d[0]);
+  const imest_real_t pab = imest__abs(d[0] - d[1]), pbc = imest__abs(d[1] - d[2]),
+                     pca = imest__abs(d[2] - d[0]);
   r[0] = kr * ((d[0] - mean) * (d[0] - RL(0.5)) - (pab + pca) * RL(IMEST_ONE_SIXTH_LIT));
   r[1] = kr * ((d[1] - mean) * (d[1] - RL(0.5)) - (pab + pbc) * RL(IMEST_ONE_SIXTH_LIT));
   r[2] = kr * ((d[2] - mean) * (d[2] - RL(0.5)) - (pbc + pca) * RL(IMEST_ONE_SIXTH_LIT));
@@ -46,8 +47,8 @@ static inline void isr_duty_ripple(imest_real_t kr, const imest_real_t d[3], ime
  * the two square roots the edges' signs need already (no division by r). The
  * drops' slope part is a resistance: its mean is r_sw,d times the current
  * itself. s(x) = x / sqrt(x^2 + b^2). */
-static inline imest_real_t isr_duty_error(const imest_duty_model_t *m, const isr_duty_k_t *k, imest_real_t dbar,
-                                          imest_real_t i, imest_real_t r)
+static inline imest_real_t isr_duty_error(const imest_duty_model_t *m, const isr_duty_k_t *k,
+                                          imest_real_t dbar, imest_real_t i, imest_real_t r)
 {
   const imest_real_t ip = i + r, im = i - r;
   const imest_real_t qp = imest__sqrt(ip * ip + k->band2), qm = imest__sqrt(im * im + k->band2);

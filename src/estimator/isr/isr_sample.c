@@ -118,8 +118,9 @@ static int isr_close_window(imest_t *s)
   w->off_ib = s->off_ib;
   w->dth_end_rad = s->obs.dth; /* the speed at the window's end (the tracker always runs) */
   s->seq++;
-  if (s->obs_pending == OBS_DECIDE) isr_engage_observer(s); /* a fault closed the window: the one it decides */
-  s->obs_rot = w->rot; /* for the observer's decision (isr_engage_observer) */
+  if (s->obs_pending == OBS_DECIDE)
+    isr_engage_observer(s); /* a fault closed the window: the one it decides */
+  s->obs_rot = w->rot;      /* for the observer's decision (isr_engage_observer) */
   s->obs_used = w->used;
   s->obs_pending = OBS_WINDOW_ENDED;
   const uint32_t pub = s->published; /* the ISR's own index */
