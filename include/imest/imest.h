@@ -218,7 +218,12 @@ typedef enum {
  *  for i < 0) and s(i) = i / sqrt(i^2 + i_band_a^2) the sign of i faded over about
  *  |i| < i_band_a (the current ripple crosses zero inside the period there, so the
  *  error fades rather than jumping). All zero: an ideal (or fully compensated) inverter. The library's
- *  standstill commissioning measures these numbers. */
+ *  standstill commissioning measures these numbers. edge_band_a > 0 selects the
+ *  switching-instant model instead (docs/METHOD.md §17.1): the dead time's volt-seconds take
+ *  the sign of the current at the leg's two switching instants (the sample plus and minus
+ *  the phase ripple there, closed form from the three duties, V_dc and sigma L_S), the
+ *  device drops the current's own sign over each conducting interval and their slopes
+ *  the current itself. */
 typedef struct {
   float dead_time_s;  /**< effective dead time, switching delays included [s] */
   float v_switch_v;   /**< switch (IGBT, MOSFET) threshold voltage V_sw0 [V] */
@@ -228,6 +233,13 @@ typedef struct {
   /** half-width of the zero-crossing transition [A] (0: the current ripple's peak, V_dc / (8 sigma
    *  L_S f_pwm)) */
   float i_band_a;
+  /** > 0: the switching-instant model (docs/METHOD.md §17.1), with the devices' own smoothing
+   *  of the sign at a switching instant b = edge_band_a [A] beyond the ripple it computes (the
+   *  output capacitance C_oss smooths over about C_oss V_dc / t_d; the simulator's ideal
+   *  switches fit a tenth of the ripple's peak); i_band_a is then unused. 0: the smooth sign
+   *  above (default): with the model's numbers 20 % off the switching-instant model gave valid
+   *  T_R up to 7 % off on the dead-time table, where the smooth sign gives none */
+  float edge_band_a;
   /** relative uncertainty of this model's error (e.g. 0.2 for 20 %); negative: the error is unknown
    *  (default), so R_S is never valid with the duty-cycle input. R_S's bound takes it as stated;
    *  T_R's takes at least 0.2 (the error's shape near the zero crossings is not the model's even

@@ -90,15 +90,18 @@ typedef struct {
 } imest_sos_t;
 
 /** Constants of the duty-cycle input (imest_isr_duty): how the two periods
- *  around a sample are weighted, and the inverter model per leg. */
+ *  around a sample are weighted, and the inverter model per leg
+ *  (src/estimator/isr/isr_duty.h, docs/METHOD.md §17.1). */
 typedef struct {
-  imest_real_t w_prev, w_now; /**< weights of the previous and this call's leg voltages */
-  imest_real_t td_f;          /**< dead time x carrier frequency */
-  imest_real_t v_d, r_d;      /**< diode threshold [V] and slope [ohm] */
-  imest_real_t dv, dr;        /**< switch minus diode: threshold [V] and slope [ohm] */
-  imest_real_t band2;         /**< i_band^2 of a fixed zero-crossing band [A^2] (0: from the ripple) */
-  imest_real_t band_per_v;    /**< i_band / V_dc from the current ripple [A/V] (0: fixed band) */
-  imest_real_t vdc2_w;        /**< 12 / u_absurd_v^2: the bus voltage's weight in the absurdity test */
+  imest_real_t w_prev;       /**< weight of the previous call's leg voltage (this call's: 1 - w_prev) */
+  imest_real_t td_f_half;    /**< dead time x carrier frequency / 2 */
+  imest_real_t v_sum;        /**< switch plus diode threshold [V] */
+  imest_real_t r_mean;       /**< mean of the switch's and the diode's slope [ohm] */
+  imest_real_t dv, dr;       /**< switch minus diode: threshold [V] and slope [ohm] */
+  imest_real_t ripple_per_v; /**< T / (2 sigma L_S): the phase ripple's scale per bus volt [A/V] */
+  imest_real_t band2;        /**< b^2 of a fixed band (i_band_a, edge_band_a) [A^2] */
+  imest_real_t band_per_kr;  /**< the band per ripple scale (0: a fixed band) */
+  imest_real_t vdc2_w;       /**< 12 / u_absurd_v^2: the bus voltage's weight in the absurdity test */
   imest_real_t zoh; /**< T / (12 sigma L_S): the staircase's aliased share of a sampled current [A/V] */
 } imest_duty_model_t;
 
@@ -126,6 +129,14 @@ typedef struct {
   uint32_t centred; /**< every window had the same centring: rwe, ree hold */
 } imest_combo_t;
 
+/** imest_t.stages: the ISR's optional stages, one bit each, so that a drive that
+ *  uses none pays one test per sample (src/estimator/isr/isr_sample.c). */
+#define IMEST_STAGE_DELAY_I    1u /**< the currents and the angle delayed (the voltage lags) */
+#define IMEST_STAGE_DELAY_U    2u /**< the voltage delayed (it leads) */
+#define IMEST_STAGE_AA         4u /**< the angle through the anti-alias filter's model */
+#define IMEST_STAGE_ALIGN      7u /**< any of the three above */
+#define IMEST_STAGE_DUTY_EDGES 8u /**< duty input: the switching-instant inverter model */
+
 /** Estimator instance. All fields are private; sizes are what the ISR needs.
  *  sizeof(imest_t) is 2000 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
  *  fw/README.md) and on an x86-64 host too (every member is 32-bit: no pointers, no padding that
@@ -137,7 +148,7 @@ typedef struct {
   imest_real_t i_lim, u_lim, i_abs, u_abs, dth_max; /* dth_max: largest angle step [rad] */
   uint32_t window_n, warmup_n;
   uint32_t warmup_fault_n; /* samples the filters settle after a fault */
-  uint32_t aa_on;          /* anti-alias model in use */
+  uint32_t stages;         /* the optional ISR stages in use: IMEST_STAGE_* bits (0: none) */
   imest_bw3_t bw;
   imest_sos_t aa;
   imest_real_t dly_i;      /* voltage lags: currents and angle delayed by this fraction of a sample */

@@ -50,7 +50,8 @@ _REASON_WIDTH = max(len(s) for s in _REASON_NAMES.values())
 # values it takes for what its options do not set. Kept equal to replay's by the test
 # test/python/test_imest.py, which compares the two on the same logs.
 _INVERTER_MODEL = ("inverter.dead_time_s", "inverter.v_switch_v", "inverter.r_switch_ohm",
-                   "inverter.v_diode_v", "inverter.r_diode_ohm", "inverter.i_band_a")
+                   "inverter.v_diode_v", "inverter.r_diode_ohm", "inverter.i_band_a",
+                   "inverter.edge_band_a")
 _INVERTER_UNCERTAINTY_GIVEN = 0.2   # a model given without its uncertainty: a data sheet's
 _ENCODER_COUNT_STILL_RAD = 2.0 * math.pi / 4096.0 * 1.0001  # one count of a 4096-count encoder
 _FS_IMPLAUSIBLE_HZ = 100.0

@@ -53,6 +53,7 @@ enum { KIND_FLOAT = 0, KIND_INT = 1, KIND_UINT = 2, KIND_PWM_TIMING = 3, KIND_RE
   X(inverter.v_diode_v, KIND_FLOAT)                                                                          \
   X(inverter.r_diode_ohm, KIND_FLOAT)                                                                        \
   X(inverter.i_band_a, KIND_FLOAT)                                                                           \
+  X(inverter.edge_band_a, KIND_FLOAT)                                                                        \
   X(inverter.uncertainty, KIND_FLOAT)                                                                        \
   X(tr_nominal_s, KIND_FLOAT)                                                                                \
   X(tr_nominal_known, KIND_INT)                                                                              \

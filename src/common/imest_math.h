@@ -21,6 +21,8 @@
 #define IMEST_SQRT3_2_LIT    1.22474487139158904910 /* sqrt(3/2) */
 #define IMEST_HALF_SQRT3_LIT 0.86602540378443864676 /* sqrt(3)/2 */
 #define IMEST_SQRT2_LIT      1.41421356237309504880
+#define IMEST_ONE_THIRD_LIT  0.33333333333333333333
+#define IMEST_ONE_SIXTH_LIT  0.16666666666666666667
 
 /* A window's speed is steady when its mean is within this share of the
  * previous window's, plus this many rad/s: the angle observer (ISR) and the

@@ -54,6 +54,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->inverter.v_diode_v = 0.0f;
   cfg->inverter.r_diode_ohm = 0.0f;
   cfg->inverter.i_band_a = 0.0f;
+  cfg->inverter.edge_band_a = 0.0f;  /* the smooth sign (docs/METHOD.md §17.1) */
   cfg->inverter.uncertainty = -1.0f; /* unknown until the user (or commissioning) says */
   cfg->rs_tolerance = 0.05f;
   cfg->tr_tolerance = 0.02f;
@@ -113,6 +114,7 @@ static const check_t k_checks[] = {
     CHK(inverter.v_diode_v, C_NONNEG, 0.0f, 0.0f),
     CHK(inverter.r_diode_ohm, C_NONNEG, 0.0f, 0.0f),
     CHK(inverter.i_band_a, C_NONNEG, 0.0f, 0.0f),
+    CHK(inverter.edge_band_a, C_NONNEG, 0.0f, 0.0f),
     CHK(inverter.uncertainty, C_ANY, 0.0f, 0.0f),
     CHK(rs_tolerance, C_POS, 0.0f, 0.0f),
     CHK(tr_tolerance, C_POS, 0.0f, 0.0f),
@@ -253,7 +255,7 @@ static void design_angle(imest_angle_t *o, float fn, float fs)
 }
 
 /* Duty-cycle input: the weights of the two periods around a sample
- * (pwm_timing) and the inverter model per leg. */
+ * (pwm_timing) and the inverter model per leg (isr_duty.h). */
 static void design_duty(imest_duty_model_t *d, const imest_config_t *cfg)
 {
   const float fpwm = cfg->pwm_hz > 0.0f ? cfg->pwm_hz : cfg->fs_hz;
@@ -262,18 +264,22 @@ static void design_duty(imest_duty_model_t *d, const imest_config_t *cfg)
    * alone (LAST_PERIOD's half-sample lag is taken up by the delay, init). */
   const int next = cfg->pwm_timing == IMEST_PWM_NEXT_PERIOD;
   d->w_prev = next ? 0.5f : 0.0f;
-  d->w_now = next ? 0.5f : 1.0f;
   const imest_inverter_t *v = &cfg->inverter;
-  d->td_f = v->dead_time_s * fpwm;
-  d->v_d = v->v_diode_v;
-  d->r_d = v->r_diode_ohm;
+  d->td_f_half = 0.5f * v->dead_time_s * fpwm;
+  d->v_sum = v->v_switch_v + v->v_diode_v;
+  d->r_mean = 0.5f * (v->r_switch_ohm + v->r_diode_ohm);
   d->dv = v->v_switch_v - v->v_diode_v;
   d->dr = v->r_switch_ohm - v->r_diode_ohm;
-  /* the current ripple's peak at 50 % duty, V_dc / (8 sigma L_S f_pwm) per
-   * carrier period: where the sign of the error is decided inside the period */
-  d->band2 = v->i_band_a * v->i_band_a;
+  d->ripple_per_v = 1.0f / (2.0f * cfg->sigma * cfg->ls_h * fpwm);
+  /* the sign's band: the switching-instant model's is the devices' own
+   * (edge_band_a); the smooth sign's i_band_a or, at 0, the current ripple's
+   * peak at 50 % duty, a quarter of its scale, where the ripple crosses zero
+   * inside the period. A micro-ampere at least keeps 0 / 0 out of the signs at
+   * zero bus and zero current. */
+  const float band = v->edge_band_a > 0.0f ? v->edge_band_a : v->i_band_a;
+  d->band_per_kr = band > 0.0f ? 0.0f : 0.25f;
+  d->band2 = band > 0.0f ? band * band : 1e-12f;
   d->vdc2_w = 12.0f / (cfg->u_absurd_v * cfg->u_absurd_v);
-  d->band_per_v = v->i_band_a > 0.0f ? 0.0f : 1.0f / (8.0f * cfg->sigma * cfg->ls_h * fpwm);
   /* the staircase's images alias into the samples when the steps' edges are
    * the sample instants (NEXT_PERIOD; docs/METHOD.md §17) */
   d->zoh = next ? 1.0f / (12.0f * cfg->fs_hz * cfg->sigma * cfg->ls_h) : 0.0f;
@@ -334,7 +340,9 @@ static void init_isr_constants(imest_t *s, const imest_config_t *cfg, double m)
   design_bw3(&s->bw, (double)cfg->filter_hz, (double)fs);
   imest__bg_noise_gains(&s->bw, fs, s->noise_g);
   design_aa(&s->aa, (double)cfg->aa_hz, (double)fs);
-  s->aa_on = cfg->aa_hz > 0.0f;
+  s->stages = (s->dly_i != 0.0f ? IMEST_STAGE_DELAY_I : 0u) | (s->dly_u != 0.0f ? IMEST_STAGE_DELAY_U : 0u) |
+              (cfg->aa_hz > 0.0f ? IMEST_STAGE_AA : 0u) |
+              (cfg->inverter.edge_band_a > 0.0f ? IMEST_STAGE_DUTY_EDGES : 0u);
   const float fn = cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz;
   design_angle(&s->obs, fn, fs);
   s->transient_k = imest__bg_transient_k(fn, (float)s->n, cfg->window_s); /* the judge's (bg_transient.c) */

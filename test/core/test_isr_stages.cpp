@@ -9,6 +9,7 @@
 extern "C" {
 #include "imest/imest.h"
 #include "isr_accumulate.h"
+#include "isr_duty.h"
 #include "isr_regressor.h"
 #include "isr_transform.h"
 }
@@ -247,4 +248,148 @@ TEST(IsrAccumulate, FoldedBlocksEqualFloat64SumsToFewUlps)
   EXPECT_NEAR(entry(IMEST_ACC_NOISE_U), 8000.0, 1e-3);
   EXPECT_NEAR(entry(IMEST_ACC_I0A), 4000.0, 1e-3);
   EXPECT_NEAR(entry(IMEST_ACC_I0B), -2000.0, 1e-3);
+}
+
+// The duty-cycle input's inverter model (isr_duty.h, docs/METHOD.md §17.1).
+namespace {
+// A 4 kW-like drive: 560 V, 8 kHz, sigma L_S = 11.5 mH (ripple scale 3 A), devices of
+// different threshold and slope, so every term of the model counts.
+struct DutyDrive {
+  imest_t s;
+  double vdc = 560.0, fpwm = 8000.0, sl = 0.0645168 * 0.178039;
+  double td = 2e-6, vsw = 1.2, rsw = 0.03, vd = 0.9, rd = 0.02;
+  double edge_band = 0.075; // the devices' band, about a tenth of the ripple's peak kr / 4
+  explicit DutyDrive(bool edges = true)
+  {
+    if (!edges) edge_band = 0.0;
+    imest_config_t cfg;
+    imest_config_default(&cfg);
+    cfg.pole_pairs = 2;
+    cfg.ls_h = 0.178039f;
+    cfg.sigma = 0.0645168f;
+    cfg.fs_hz = (float)fpwm;
+    cfg.inverter.dead_time_s = (float)td;
+    cfg.inverter.v_switch_v = (float)vsw;
+    cfg.inverter.r_switch_ohm = (float)rsw;
+    cfg.inverter.v_diode_v = (float)vd;
+    cfg.inverter.r_diode_ohm = (float)rd;
+    cfg.inverter.uncertainty = 0.2f;
+    cfg.inverter.edge_band_a = (float)edge_band;
+    EXPECT_EQ(imest_init(&s, &cfg), IMEST_OK);
+  }
+  double kr() const { return vdc / (2.0 * sl * fpwm); } // V_dc T / (2 sigma L_S)
+  // the formulas of METHOD §17.1 in float64, in their defining form
+  double ripple(const double d[3], int x) const
+  {
+    const double mean = (d[0] + d[1] + d[2]) / 3.0;
+    const int y = (x + 1) % 3, z = (x + 2) % 3;
+    return kr() * ((d[x] - mean) * (d[x] - 0.5) - (std::fabs(d[x] - d[y]) + std::fabs(d[x] - d[z])) / 6.0);
+  }
+  double error(double dbar, double i, double r) const
+  {
+    const double b = edge_band;
+    auto sgn = [b](double x) { return x / std::sqrt(x * x + b * b); };
+    const double se = 0.5 * (sgn(i + r) + sgn(i - r));
+    // the smooth sign's mean over the ramp i - r .. i + r: its integral is sqrt(x^2 + b^2)
+    const double m =
+        std::fabs(r) > 1e-9
+            ? (std::sqrt((i + r) * (i + r) + b * b) - std::sqrt((i - r) * (i - r) + b * b)) / (2.0 * r)
+            : sgn(i);
+    return td * fpwm * vdc * se + 0.5 * (vsw + vd) * m + 0.5 * (rsw + rd) * i +
+           (dbar - 0.5) * ((vsw - vd) + (rsw - rd) * std::fabs(i));
+  }
+  // the smooth sign's model (edge_band_a 0, the default), as imest.h writes it
+  double error_smooth(double dbar, double i) const
+  {
+    const double b = 0.25 * kr(); // the ripple's peak
+    const double sg = i / std::sqrt(i * i + b * b), a = std::fabs(i);
+    const double dc = 0.5 + sg * (dbar - 0.5);
+    return sg * (td * fpwm * vdc + vd + rd * a + dc * ((vsw - vd) + (rsw - rd) * a));
+  }
+  double ref_scale(double i) const { return td * fpwm * vdc + vsw + vd + (rsw + rd) * std::fabs(i); }
+};
+} // namespace
+
+// The closed-form ripple against the phase current integrated over one period of
+// centre-aligned PWM with a floating neutral (every leg high at the period's ends).
+TEST(IsrDuty, RippleIsThePhaseCurrentsAtTheEdges)
+{
+  const DutyDrive dd;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.02, 0.98);
+  const int n = 20000; // steps per period
+  double worst = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const double d[3] = {u(rng), u(rng), u(rng)};
+    auto high = [&](int x, double t) { return t < 0.5 * d[x] || t >= 1.0 - 0.5 * d[x]; }; // t in periods
+    for (int x = 0; x < 3; ++x) {
+      // ripple = integral of (v_x - its mean) / (sigma L_S); at the falling edge -D, rising +D
+      double acc = 0, at_fall = 0, at_rise = 0;
+      for (int k = 0; k < n; ++k) {
+        const double t = (k + 0.5) / n;
+        const double h = (high(0, t) + high(1, t) + high(2, t)) / 3.0;
+        const double vx = dd.vdc * (high(x, t) - h) - dd.vdc * (d[x] - (d[0] + d[1] + d[2]) / 3.0);
+        acc += vx / (dd.sl * dd.fpwm * n);
+        if (t < 0.5 * d[x]) at_fall = acc;
+        if (t < 1.0 - 0.5 * d[x]) at_rise = acc;
+      }
+      const double r = dd.ripple(d, x);
+      worst = std::max({worst, std::fabs(at_fall + r), std::fabs(at_rise - r)});
+    }
+  }
+  EXPECT_LT(worst, 0.002 * dd.kr()); // the integration's step: V_dc / (sigma L_S f n) = kr / 10^4
+}
+
+// isr_duty_ripple and isr_duty_error in float32 against the same formulas in float64,
+// the drops' mean sign in its defining (subtractive) form: within 2e-6 of the error's
+// scale t_d f V_dc + V_sw0 + V_d0 + (r_sw + r_d) |i| (float32 rounding of about ten
+// operations, 6e-8 each, and of the currents near the ripple).
+TEST(IsrDuty, ErrorMatchesFloat64Formula)
+{
+  DutyDrive dd;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.02, 0.98), cur(-1.0, 1.0);
+  isr_duty_k_t k{};
+  k.kt = dd.s.duty.td_f_half * (float)dd.vdc;
+  const float kr = dd.s.duty.ripple_per_v * (float)dd.vdc;
+  const float band = dd.s.duty.band_per_kr * kr;
+  k.band2 = band * band + dd.s.duty.band2;
+  double worst = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double d[3] = {u(rng), u(rng), u(rng)};
+    const float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
+    float rf[3];
+    isr_duty_ripple(kr, df, rf);
+    // currents from deep inside the ripple to ten times it
+    const double scale = (trial % 3 == 0) ? 0.5 : (trial % 3 == 1 ? 3.0 : 30.0);
+    for (int x = 0; x < 3; ++x) {
+      const double i = scale * cur(rng);
+      const double r = dd.ripple(d, x);
+      const double e = dd.error(d[x], i, r);
+      const float ef = isr_duty_error(&dd.s.duty, &k, df[x], (float)i, rf[x]);
+      worst = std::max(worst, std::fabs((double)ef - e) / dd.ref_scale(i));
+      ASSERT_NEAR(rf[x], r, 1e-5 * dd.kr()) << trial;
+    }
+  }
+  EXPECT_LT(worst, 2e-6);
+}
+
+// The default (smooth-sign) form in float32 against imest.h's formula in float64, the same
+// tolerance.
+TEST(IsrDuty, SmoothErrorMatchesFloat64Formula)
+{
+  DutyDrive dd(false);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(0.02, 0.98), cur(-1.0, 1.0);
+  isr_duty_k_t k{};
+  k.kt = dd.s.duty.td_f_half * (float)dd.vdc;
+  const float band = dd.s.duty.band_per_kr * (dd.s.duty.ripple_per_v * (float)dd.vdc);
+  k.band2 = band * band + dd.s.duty.band2;
+  double worst = 0;
+  for (int trial = 0; trial < 60000; ++trial) {
+    const double d = u(rng), i = ((trial % 3 == 0) ? 0.5 : (trial % 3 == 1 ? 3.0 : 30.0)) * cur(rng);
+    const float ef = isr_duty_error_smooth(&dd.s.duty, &k, (float)d, (float)i);
+    worst = std::max(worst, std::fabs((double)ef - dd.error_smooth(d, i)) / dd.ref_scale(i));
+  }
+  EXPECT_LT(worst, 2e-6);
 }

@@ -8,7 +8,7 @@
 
 #include "imest/imest.h"
 
-_Static_assert(sizeof(imest_config_t) == 53 * sizeof(float),
+_Static_assert(sizeof(imest_config_t) == 54 * sizeof(float),
                "imest_config_t changed: list the new field below");
 
 #define F(name) printf(#name " %a\n", (double)cfg.name)
@@ -41,6 +41,7 @@ int main(void)
   F(inverter.v_diode_v);
   F(inverter.r_diode_ohm);
   F(inverter.i_band_a);
+  F(inverter.edge_band_a);
   F(inverter.uncertainty);
   F(tr_nominal_s);
   I(tr_nominal_known);

@@ -42,6 +42,7 @@ static const struct {
     F(inverter.v_diode_v),
     F(inverter.r_diode_ohm),
     F(inverter.i_band_a),
+    F(inverter.edge_band_a),
     F(inverter.uncertainty),
     F(tr_nominal_s),
     F(tr_min_s),

@@ -266,3 +266,41 @@ TEST(ReplayDuty, StartFromRestIsRecognised)
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_NE(o.err.find("started at rest"), std::string::npos) << o.err;
 }
+
+// The inverter model 20 % off must never give a valid estimate that is wrong (T_R more than
+// 2 % off, R_S more than 5 %). The point is the dead-time table's hardest (docs/METHOD.md
+// §17.1): the 2.2 kW motor with drops only (1 V + 0.5 V at the rated peak current), 10 Hz,
+// 25 % load, where the switching-instant model (--edge-band) with its numbers 20 % high gave
+// T_R valid and 7 % off. The default model must hold there; a wrong verdict fails this.
+TEST(ReplayDuty, ModelTwentyPercentOffIsNeverValidAndWrong)
+{
+  const std::string drive =
+      " --dead-time 0 --v-switch 1 --r-switch 0.0727117 --v-diode 1 --r-diode 0.0727117";
+  const std::string &csv = sim_csv(
+      "2k2_drops_10hz.csv", "--preset 4kw --pole-pairs 2 --ls 0.245 --lr 0.224 --sigma 0.085714 --rs 3.7 "
+                            "--tr 0.106667 --j 0.015 --b 9.7e-4 --i-range 18 --no-thermal --start steady "
+                            "--vdc 560 --freq 10 --vll 81.5191 --load-nm 3.65 --duration 5 --seed 5001 "
+                            "--encoder-counts 16384 --no-progress" +
+                                drive);
+  const std::string est = std::string(REPLAY_BIN) + " --pole-pairs 2 --ls 0.245 --sigma 0.085714 "
+                                                    "--ls-uncertainty 0 --sigma-uncertainty 0 --from-rest no "
+                                                    "--quiet --voltage duty --dead-time 0 --v-switch %V "
+                                                    "--r-switch %R --v-diode %V --r-diode %R ";
+  for (double scale : {0.8, 1.2}) {
+    std::string cmd = est;
+    for (const auto &[key, v] :
+         {std::pair<std::string, double>{"%V", 1.0 * scale}, {"%R", 0.0727117 * scale}})
+      for (size_t at; (at = cmd.find(key)) != std::string::npos;) cmd.replace(at, 2, std::to_string(v));
+    const Out o = run(cmd + csv);
+    ASSERT_EQ(o.code, 0) << o.err;
+    const Windows w = parse(o);
+    ASSERT_GE(w.tr.size(), 4u) << o.out;
+    const std::vector<double> tr = truth_per_window(csv, "T_R_true_s", w.t_end, 1.0);
+    const std::vector<double> ers = rs_error(csv, w);
+    for (size_t k = 0; k < w.tr.size(); ++k) {
+      if (w.tr_valid[k])
+        EXPECT_LT(std::fabs(w.tr[k] / tr[k] - 1.0), 0.02) << "scale " << scale << " window " << k;
+      if (w.rs_valid[k]) EXPECT_LT(std::fabs(ers[k]), 0.05) << "scale " << scale << " window " << k;
+    }
+  }
+}

@@ -81,8 +81,11 @@ static void usage(FILE *o)
              "  --r-diode OHM       diode slope resistance [ohm]\n"
              "  --i-band A          half-width of the current band around a zero crossing in\n"
              "                      which the error fades (default: the ripple's peak)\n"
+             "  --edge-band A       > 0: the switching-instant model with the devices' own\n"
+             "                      band A at an edge (docs/METHOD.md 17.1; default 0: the\n"
+             "                      smooth sign)\n"
              "  --inverter-uncertainty X  relative uncertainty of that model's voltage error\n"
-             "                      (default 0.2 when any of --dead-time .. --i-band is\n"
+             "                      (default 0.2 when any of --dead-time .. --edge-band is\n"
              "                      given; without them the error is unknown and R_S is not\n"
              "                      valid; negative: unknown)\n"
              "estimator:\n"
@@ -206,6 +209,7 @@ static const struct {
     {"--v-diode", "inverter.v_diode_v", offsetof(imest_config_t, inverter.v_diode_v), FOR_INVERTER},
     {"--r-diode", "inverter.r_diode_ohm", offsetof(imest_config_t, inverter.r_diode_ohm), FOR_INVERTER},
     {"--i-band", "inverter.i_band_a", offsetof(imest_config_t, inverter.i_band_a), FOR_INVERTER},
+    {"--edge-band", "inverter.edge_band_a", offsetof(imest_config_t, inverter.edge_band_a), FOR_INVERTER},
 };
 #define N_NUMERIC (sizeof k_numeric / sizeof k_numeric[0])
 _Static_assert(N_NUMERIC <= 32, "replay_opts_t.given holds one bit per numeric option");

@@ -15,31 +15,62 @@
 typedef struct {
   imest_real_t kp, kn; /* w_prev V_dc,prev and w_now V_dc: a leg's voltage is kp dp + kn d */
   imest_real_t vdc, vdc_prev;
-  imest_real_t e0;    /* t_d f V_dc + V_d0 at the weighted bus voltage */
-  imest_real_t band2; /* i_band^2 */
+  imest_real_t kt;    /* t_d f V_dc / 2 at the weighted bus voltage */
+  imest_real_t band2; /* b^2: the devices' own smoothing, or the smooth sign's band */
 } isr_duty_k_t;
 
-/* Voltage delivered by one leg [V], relative to the negative rail, from the
- * previous call's duty *dprev (replaced by d) and this call's d, for the
- * phase current i:
- *   e = s(i) [ t_d f V_dc + V_d0 + r_d |i| + d_c ((V_sw0 - V_d0) + (r_sw - r_d) |i|) ]
- * with d_c = 1/2 + s (d - 1/2) (d for i > 0, 1 - d for i < 0) and the smooth
- * sign s(i) = i / sqrt(i^2 + i_band^2): the current ripple crosses zero inside
- * the period near a zero crossing, so the error fades instead of jumping. */
-static inline imest_real_t isr_duty_leg(const imest_duty_model_t *m, const isr_duty_k_t *k,
-                                        imest_real_t *dprev, imest_real_t d, imest_real_t i,
-                                        imest_real_t *step)
+/* The phase current's ripple at each leg's edges [A] (docs/METHOD.md §17.1):
+ * centre-aligned PWM, floating neutral, against the line between the
+ * currents at the period's ends, the ripple is +D_x at leg x's rising edge
+ * and -D_x at its falling edge,
+ *   D_x = V_dc T / (2 sigma L_S) [(d_x - dbar)(d_x - 1/2) - (|d_x - d_y| + |d_x - d_z|) / 6],
+ * dbar the mean of the three duties; kr = V_dc T / (2 sigma L_S). */
+static inline void isr_duty_ripple(imest_real_t kr, const imest_real_t d[3], imest_real_t r[3])
 {
-  const imest_real_t dp = *dprev;
-  *dprev = d;
-  *step = k->vdc * d - k->vdc_prev * dp; /* the leg voltage's step at the sample */
-  const imest_real_t v = k->kp * dp + k->kn * d;
-  const imest_real_t dbar = m->w_prev * dp + m->w_now * d;
+  const imest_real_t mean = ((d[0] + d[1]) + d[2]) * RL(IMEST_ONE_THIRD_LIT);
+  const imest_real_t pab = imest__abs(d[0] - d[1]), pbc = imest__abs(d[1] - d[2]),
+                     pca = imest__abs(d[2] - d[0]);
+  r[0] = kr * ((d[0] - mean) * (d[0] - RL(0.5)) - (pab + pca) * RL(IMEST_ONE_SIXTH_LIT));
+  r[1] = kr * ((d[1] - mean) * (d[1] - RL(0.5)) - (pab + pbc) * RL(IMEST_ONE_SIXTH_LIT));
+  r[2] = kr * ((d[2] - mean) * (d[2] - RL(0.5)) - (pbc + pca) * RL(IMEST_ONE_SIXTH_LIT));
+}
+
+/* The error of one leg [V] (how much less it delivers than d V_dc) for the
+ * sampled phase current i, the leg's duty dbar around the sample and its
+ * ripple r at the edges:
+ *   e = t_d f V_dc s_e + (V_sw0 + V_d0)/2 m + (r_sw + r_d)/2 i + (dbar - 1/2) (dV + dr |i|)
+ * The dead time's volt-seconds follow the current at the two edges, i + r and
+ * i - r: s_e = (s(i + r) + s(i - r)) / 2. The drops follow the current's own
+ * sign over each conducting interval, along which the current runs from
+ * i - r to i + r: m is the smooth sign's mean over that ramp, exactly
+ * (sqrt((i + r)^2 + b^2) - sqrt((i - r)^2 + b^2)) / 2r = 2 i / (q+ + q-),
+ * the two square roots the edges' signs need already (no division by r). The
+ * drops' slope part is a resistance: its mean is r_sw,d times the current
+ * itself. s(x) = x / sqrt(x^2 + b^2). */
+static inline imest_real_t isr_duty_error(const imest_duty_model_t *m, const isr_duty_k_t *k,
+                                          imest_real_t dbar, imest_real_t i, imest_real_t r)
+{
+  const imest_real_t ip = i + r, im = i - r;
+  const imest_real_t qp = imest__sqrt(ip * ip + k->band2), qm = imest__sqrt(im * im + k->band2);
+  const imest_real_t se2 = ip / qp + im / qm; /* 2 s_e */
+  const imest_real_t mh = i / (qp + qm);      /* m / 2 */
+  return ((k->kt * se2 + m->v_sum * mh) + m->r_mean * i) + (dbar - RL(0.5)) * (m->dv + m->dr * imest__abs(i));
+}
+
+/* The smooth sign's error of one leg [V] (imest_inverter_t, edge_band_a 0):
+ *   e = s(i) [ t_d f V_dc + V_d0 + r_d |i| + d_c ((V_sw0 - V_d0) + (r_sw - r_d) |i|) ]
+ * with d_c = 1/2 + s (dbar - 1/2) (dbar for i > 0, 1 - dbar for i < 0) and the
+ * smooth sign s(i) = i / sqrt(i^2 + b^2), b the ripple's peak or i_band_a: the
+ * current ripple crosses zero inside the period near a zero crossing, so the
+ * error fades instead of jumping. In the constants of the other model:
+ * V_d0 + d_c dV = (V_sw0 + V_d0)/2 + s (dbar - 1/2) dV, the same for the slopes. */
+static inline imest_real_t isr_duty_error_smooth(const imest_duty_model_t *m, const isr_duty_k_t *k,
+                                                 imest_real_t dbar, imest_real_t i)
+{
   const imest_real_t a = imest__abs(i);
   const imest_real_t sgn = i / imest__sqrt(i * i + k->band2);
-  const imest_real_t dc = RL(0.5) + sgn * (dbar - RL(0.5));
-  const imest_real_t mag = (k->e0 + m->r_d * a) + dc * (m->dv + m->dr * a);
-  return v - sgn * mag;
+  const imest_real_t mag = ((k->kt + k->kt) + RL(0.5) * m->v_sum) + m->r_mean * a;
+  return sgn * (mag + sgn * ((dbar - RL(0.5)) * (m->dv + m->dr * a)));
 }
 
 #endif

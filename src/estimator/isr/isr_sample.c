@@ -63,11 +63,14 @@ static void isr_open_window(imest_t *s, imest_window_t *w, uint32_t pending_flag
  * when the window before had the mean speed of the one before that. The ISR
  * decides it from its own sums (the test of the background's noise model,
  * bg_task.c, in float32), so the decision is the same whenever the
- * background runs. It runs on the next window's first even sample (the
- * lighter kind: the odd ones complete the regressor's sums) after its angle
- * step, not on the window's last sample, which is the ISR's longest: the
- * observer follows from the next sample on. Not inlined: the other samples
- * pay only the test of obs_pending. */
+ * background runs. It takes effect from the sample after the next window's
+ * first used even sample (the observer follows from there on), and is made
+ * just before that sample's angle step (OBS_DECIDE), not on the window's
+ * last sample, the ISR's longest, nor on the even sample, the heavier of a
+ * pair (it forms the regressor): the odd one only completes its sums. Not
+ * inlined: the other samples pay only the test of obs_pending. */
+#define OBS_WINDOW_ENDED 1u /* obs_pending: a window ended; at its first used even sample: */
+#define OBS_DECIDE       2u /* decide before the next angle step (isr_step, or a window's end) */
 #if defined(__GNUC__)
 __attribute__((noinline))
 #endif
@@ -115,9 +118,11 @@ static int isr_close_window(imest_t *s)
   w->off_ib = s->off_ib;
   w->dth_end_rad = s->obs.dth; /* the speed at the window's end (the tracker always runs) */
   s->seq++;
-  s->obs_rot = w->rot; /* for the observer's decision (isr_engage_observer) */
+  if (s->obs_pending == OBS_DECIDE)
+    isr_engage_observer(s); /* a fault closed the window: the one it decides */
+  s->obs_rot = w->rot;      /* for the observer's decision (isr_engage_observer) */
   s->obs_used = w->used;
-  s->obs_pending = 1u;
+  s->obs_pending = OBS_WINDOW_ENDED;
   const uint32_t pub = s->published; /* the ISR's own index */
   if (pub == IMEST_LOAD_ACQUIRE(&s->released)) {
     /* the window's contents before the index; the ISR now fills the other buffer */
@@ -217,7 +222,9 @@ static inline void isr_noise(imest_t *s, const isr_in_t *in, imest_real_t *d3i_o
 static inline void isr_align(imest_t *s, isr_in_t *in, imest_real_t ia_prev, imest_real_t ua_prev,
                              imest_real_t step, imest_real_t *th_r, imest_real_t *w_raw)
 {
-  if (s->dly_i != RL(0)) {
+  const uint32_t align = s->stages;
+  if ((align & IMEST_STAGE_ALIGN) == 0u) return; /* one test for a drive that aligns nothing */
+  if (align & IMEST_STAGE_DELAY_I) {
     /* the voltage lags: delay currents and angle to match */
     const imest_real_t a = s->dly_i, w_now = *w_raw;
     in->ia = in->ia - a * (in->ia - ia_prev);
@@ -227,14 +234,14 @@ static inline void isr_align(imest_t *s, isr_in_t *in, imest_real_t ia_prev, ime
     *th_r = *th_r - a * step;
     s->wr_prev = w_now;
   }
-  if (s->dly_u != RL(0)) {
+  if (align & IMEST_STAGE_DELAY_U) {
     /* the voltage leads: delay it to match */
     const imest_real_t ub_now = in->ub;
     in->ua = in->ua - s->dly_u * (in->ua - ua_prev);
     in->ub = in->ub - s->dly_u * (in->ub - s->ub1);
     s->ub1 = ub_now;
   }
-  if (s->aa_on) {
+  if (align & IMEST_STAGE_AA) {
     /* the angle through a model of the electrical channels' AA filter */
     *w_raw = isr_aa(&s->aa, &s->aa_s1, &s->aa_s2, *w_raw);
   }
@@ -270,7 +277,7 @@ static inline void isr_window_sample(imest_t *s, imest_window_t *w, const isr_in
     return;
   }
   if ((s->k & 1u) == 0u) {
-    if (s->obs_pending) isr_engage_observer(s); /* the first even sample after a window's end */
+    s->obs_pending <<= 1; /* OBS_WINDOW_ENDED -> OBS_DECIDE; 0 stays (OBS_DECIDE is done by now) */
     isr_regressor(s, g, w->c0, s->zx, s->zy);
     isr_extra_t x;
     /* i x di/dt: in steady state |i|^2 times the slip frequency */
@@ -316,6 +323,7 @@ static int isr_step(imest_t *s, imest_real_t ua, imest_real_t ub, imest_real_t i
   /* The encoder angle through the tracking observer (which keeps quantisation
    * steps out of the rotation and the speed alike); its step is the speed. */
   imest_real_t step;
+  if (s->obs_pending == OBS_DECIDE) isr_engage_observer(s);
   imest_real_t th_r = th + isr_angle_update(&s->obs, dth, &step);
   imest_real_t w_raw = step * s->fs;
   isr_align(s, &in, ia_prev, ua_prev, step, &th_r, &w_raw);
@@ -370,32 +378,52 @@ int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float
   const imest_duty_model_t *m = &s->duty;
   const imest_real_t vdc = (imest_real_t)vdc_v, vdc_prev = s->vdc_prev;
   s->vdc_prev = vdc;
-  /* per sample, shared by the legs: the weighted bus voltages, the dead-time
-   * error at their mean plus the diode threshold, and the zero-crossing band */
+  const imest_real_t wp = m->w_prev, wn = RL(1) - wp;
+  /* per sample, shared by the legs: the weighted bus voltages, the dead
+   * time's volt-seconds, the ripple's scale and the devices' band */
   isr_duty_k_t k;
-  k.kp = m->w_prev * vdc_prev;
-  k.kn = m->w_now * vdc;
+  k.kp = wp * vdc_prev;
+  k.kn = wn * vdc;
   k.vdc = vdc;
   k.vdc_prev = vdc_prev;
   const imest_real_t vbar = k.kp + k.kn;
-  k.e0 = m->td_f * vbar + m->v_d;
-  const imest_real_t band = m->band_per_v * vbar;
+  k.kt = m->td_f_half * vbar;
+  const imest_real_t kr = m->ripple_per_v * vbar;
+  const imest_real_t band = m->band_per_kr * kr;
   k.band2 = band * band + m->band2;
   const imest_real_t ia = (imest_real_t)i_abc_a[0], ib = (imest_real_t)i_abc_a[1],
                      ic = (imest_real_t)i_abc_a[2];
   const imest_real_t da = (imest_real_t)duty_abc[0], db = (imest_real_t)duty_abc[1],
                      dc = (imest_real_t)duty_abc[2];
-  imest_real_t step[3];
-  const imest_real_t va = isr_duty_leg(m, &k, &s->dleg[0], da, ia, &step[0]);
-  const imest_real_t vb = isr_duty_leg(m, &k, &s->dleg[1], db, ib, &step[1]);
-  const imest_real_t vc = isr_duty_leg(m, &k, &s->dleg[2], dc, ic, &step[2]);
+  const imest_real_t pa = s->dleg[0], pb = s->dleg[1], pc = s->dleg[2];
+  s->dleg[0] = da;
+  s->dleg[1] = db;
+  s->dleg[2] = dc;
+  /* written out per leg: a compiler need not unroll a loop over three */
+  const imest_real_t dbar[3] = {wp * pa + wn * da, wp * pb + wn * db, wp * pc + wn * dc};
+  imest_real_t e[3];
+  if (s->stages & IMEST_STAGE_DUTY_EDGES) { /* configuration only: the same path every sample */
+    imest_real_t r[3];
+    isr_duty_ripple(kr, dbar, r);
+    e[0] = isr_duty_error(m, &k, dbar[0], ia, r[0]);
+    e[1] = isr_duty_error(m, &k, dbar[1], ib, r[1]);
+    e[2] = isr_duty_error(m, &k, dbar[2], ic, r[2]);
+  } else {
+    e[0] = isr_duty_error_smooth(m, &k, dbar[0], ia);
+    e[1] = isr_duty_error_smooth(m, &k, dbar[1], ib);
+    e[2] = isr_duty_error_smooth(m, &k, dbar[2], ic);
+  }
+  const imest_real_t u[3] = {(k.kp * pa + k.kn * da) - e[0], (k.kp * pb + k.kn * db) - e[1],
+                             (k.kp * pc + k.kn * dc) - e[2]};
+  /* the leg voltages' steps at the sample */
+  const imest_real_t step[3] = {vdc * da - vdc_prev * pa, vdc * db - vdc_prev * pb, vdc * dc - vdc_prev * pc};
+  const imest_real_t i[3] = {ia, ib, ic};
   /* the ADC limit applies to the currents; the duties and the bus voltage
    * only have to be numbers: one test catches NaN, Inf or absurd duties and
    * a bus voltage near u_absurd_v (both weighted into one sum of squares) */
   const int in_range = (imest__abs(ia) < s->i_lim) & (imest__abs(ib) < s->i_lim) &
                        (imest__abs(ic) < s->i_lim) &
                        (((da * da + db * db) + dc * dc) + m->vdc2_w * (vdc * vdc) < RL(12));
-  const imest_real_t u[3] = {va, vb, vc}, i[3] = {ia, ib, ic};
   imest_real_t ua, ub, ia_ab, ib_ab, sa, sb;
   imest__clarke(u, &ua, &ub); /* the zero sequence (the legs' common part) drops out */
   imest__clarke(i, &ia_ab, &ib_ab);
