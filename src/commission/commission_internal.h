@@ -10,7 +10,7 @@
 #include "common/imest_math.h" /* constants, imest__abs, imest__clarke, IMEST_BARRIER */
 
 /* Block kinds (tag & 0xF), plateau (tag >> 4 & 0xF), pattern (tag >> 8 & 0xF). */
-enum { CM_KIND_DC = 1u, CM_KIND_HF = 2u, CM_KIND_PROBE = 3u };
+enum { CM_KIND_DC = 1u, CM_KIND_HF = 2u, CM_KIND_PROBE = 3u, CM_KIND_SLIP = 4u };
 #define CM_TAG(kind, plateau, pattern)                                                                       \
   ((uint32_t)(kind) | ((uint32_t)(plateau) << 4) | ((uint32_t)(pattern) << 8))
 #define CM_TAG_KIND(t)    ((t)&0xFu)
@@ -31,6 +31,18 @@ enum { CM_S_V = 0, CM_S_MA = 1, CM_S_TD = 4, CM_S_VTH = 5, CM_S_DR = 6, CM_S_DEL
 #define CM_PLATEAU_PATTERNS 2u
 /* Square-wave block sums: y = current step over a period, x1 = voltage, x2 = mean current. */
 enum { CM_H_X11 = 0, CM_H_X12, CM_H_X1, CM_H_X22, CM_H_X2, CM_H_YX1, CM_H_YX2, CM_H_Y, CM_H_YY };
+
+/* Slip-frequency block sums: per tone t (0: f1, 1: 2 f1) the current less the DC one and the
+   voltage less the DC one, each times cos and sin of the tone's phase (commission_slip.c). */
+enum { CM_L_IC = 0, CM_L_IS = 1, CM_L_VC = 2, CM_L_VS = 3, CM_L_TONE = 4 };
+/* The test's lower tone at w T_R = CM_SLIP_X: where 1 % of T_R moves sigma*L_S by 0.4 %
+   (imest_commission.h, "What is measured"); each tone's amplitude a share of the DC current
+   that keeps the sum of both 0.3 of it from zero (no phase current changes sign); the
+   settling before the blocks in T_R; the blocks, one period of f1 each. */
+#define CM_SLIP_X       6.0f
+#define CM_SLIP_AMP     0.35f
+#define CM_SLIP_SETTLE  2.0f
+#define CM_SLIP_BLOCKS  3u
 
 #define CM_PLATEAUS     5u /* levels 1, 2, 3, 2, 1 thirds */
 #define CM_BLK_PLATEAU  9u /* blocks per plateau: 3 cycles of the 3 patterns */
@@ -113,6 +125,7 @@ void imest__cm_block_flush(imest_comm_t *c);
 void imest__cm_probe_begin(imest_comm_t *c);
 void imest__cm_staircase_begin(imest_comm_t *c, uint32_t axis);
 void imest__cm_pulses_begin(imest_comm_t *c);
+void imest__cm_slip_begin(imest_comm_t *c);
 void imest__cm_rotate_begin(imest_comm_t *c);
 void imest__cm_finish(imest_comm_t *c);
 
@@ -123,6 +136,7 @@ void imest__cm_stage_wiring(imest_comm_t *c, const float m[3], float vdc);
 void imest__cm_stage_probe(imest_comm_t *c, const float m[3], float vdc, float i_n, float v_n);
 void imest__cm_stage_staircase(imest_comm_t *c, const float m[3], float vdc, float i_n, float v_n);
 void imest__cm_stage_pulses(imest_comm_t *c, float vdc, float i_n, float v_ended);
+void imest__cm_stage_slip(imest_comm_t *c, float vdc, float i_n, float v_n);
 void imest__cm_stage_demagnetise(imest_comm_t *c, float vdc, float i_n);
 void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc);
 

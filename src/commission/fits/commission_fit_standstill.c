@@ -37,6 +37,7 @@ static void set_value(imest_comm_value_t *out, float value, float std_rel, float
 typedef struct {
   float rm, rsp, slm, slsp, taum, tausp, lmm, lmsp, tdm, tdsp, vthm, vthsp, drm, drsp;
   float r_var, sl_var, td_var, vth_var, dr_var, tau_var, rms2;
+  float sfm, sfsp, sf_var, sf_d; /* slip-frequency sigma*L_S: mean, spread, variance, mean D */
 } axes_t;
 
 /* Sensor gains relative to their mean (three sensors only), and the correction factor each
@@ -65,8 +66,9 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
 {
   imest_comm_result_t *r = &c->res;
   const imest_comm_axis_fit_t *f = c->fit;
-  float rk[3], slk[3], tauk[3], lmk[3], tdk[3], vthk[3], drk[3];
+  float rk[3], slk[3], tauk[3], lmk[3], tdk[3], vthk[3], drk[3], sfk[3];
   a->r_var = a->sl_var = a->td_var = a->vth_var = a->dr_var = a->tau_var = a->rms2 = 0.0f;
+  a->sf_var = a->sf_d = 0.0f;
   for (int k = 0; k < 3; ++k) {
     rk[k] = f[k].r_ohm * corr[k];
     slk[k] = f[k].slsig_h * corr[k];
@@ -75,6 +77,9 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
     tdk[k] = f[k].td_s;
     vthk[k] = f[k].vth_v;
     drk[k] = f[k].dr_ohm * corr[k];
+    sfk[k] = f[k].slip_h * corr[k];
+    a->sf_var += (f[k].slip_std * sfk[k]) * (f[k].slip_std * sfk[k]);
+    a->sf_d += f[k].slip_d_h * corr[k] / 3.0f;
     a->r_var += f[k].r_std * f[k].r_std;
     a->sl_var += (f[k].slsig_std * f[k].slsig_h) * (f[k].slsig_std * f[k].slsig_h);
     a->td_var += f[k].td_std * f[k].td_std;
@@ -91,6 +96,7 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
   mean_spread(tdk, &a->tdm, &a->tdsp);
   mean_spread(vthk, &a->vthm, &a->vthsp);
   mean_spread(drk, &a->drm, &a->drsp);
+  mean_spread(sfk, &a->sfm, &a->sfsp);
 }
 
 /* The standstill values with their qualities; returns R_S. */
@@ -100,12 +106,28 @@ static float report_values(imest_comm_t *c, const axes_t *a)
   const float rs = a->rm - 0.5f * imest__abs(a->drm) - c->cfg.r_series_ohm;
   for (int k = 0; k < 3; ++k) r->rs_axis_ohm[k] -= 0.5f * imest__abs(a->drm);
   set_value(&r->rs_ohm, rs, imest__sqrt(a->r_var) / 3.0f / rs, a->rsp * a->rm / rs);
-  set_value(&r->sigma_ls_h, a->slm, imest__sqrt(a->sl_var) / 3.0f / a->slm, a->slsp);
+  set_value(&r->sigma_ls_hf_h, a->slm, imest__sqrt(a->sl_var) / 3.0f / a->slm, a->slsp);
+  r->slip_test_hz = c->sl_w * (float)IMEST_INV_2PI_LIT;
+  /* the frequency dependence left over rotor frequencies 0..f1: |D| / 6 */
+  const float dep = imest__abs(a->sf_d) / 6.0f / a->sfm;
+  set_value(&r->sigma_ls_slip_h, a->sfm, imest__sqrt(a->sf_var) / 3.0f / a->sfm, a->sfsp > dep ? a->sfsp : dep);
+  if (r->flags & IMEST_COMM_FLAG_ROTOR_HF) {
+    if (a->sfm > 0.0f) { /* (NaN fails) */
+      imest__cm_copy(&r->sigma_ls_h, &r->sigma_ls_slip_h, sizeof r->sigma_ls_h);
+      r->flags |= IMEST_COMM_FLAG_SIGMA_SLIP;
+    } else { /* no slip-frequency value: the square wave's, marked as not the one needed */
+      imest__cm_copy(&r->sigma_ls_h, &r->sigma_ls_hf_h, sizeof r->sigma_ls_h);
+      if (!(r->sigma_ls_h.spread_rel >= 0.5f)) r->sigma_ls_h.spread_rel = 0.5f;
+    }
+  } else {
+    imest__cm_copy(&r->sigma_ls_h, &r->sigma_ls_hf_h, sizeof r->sigma_ls_h);
+  }
   set_value(&r->tr_s, a->taum, imest__sqrt(a->tau_var) / 3.0f / a->taum, a->tausp);
   set_value(&r->dead_time_s, a->tdm, imest__sqrt(a->td_var) / 3.0f / imest__abs(a->tdm), a->tdsp);
   set_value(&r->v_threshold_v, a->vthm, imest__sqrt(a->vth_var) / 3.0f / imest__abs(a->vthm), a->vthsp);
   set_value(&r->dr_ohm, a->drm, imest__sqrt(a->dr_var) / 3.0f / imest__abs(a->drm), a->drsp);
-  const float ls_ss = a->slm + a->lmm;
+  /* the flux tails' L_S: their (1 - sigma) L_S plus the sigma*L_S of the same (slow) rotor */
+  const float ls_ss = r->sigma_ls_h.value + a->lmm;
   set_value(&r->ls_standstill_h, ls_ss, NAN, (a->lmsp * a->lmm) / ls_ss);
   set_value(&r->rr_ohm, a->lmm / a->taum, NAN, NAN);
   r->dc_fit_rms_v = imest__sqrt(a->rms2 / 3.0f);
@@ -142,7 +164,7 @@ static void prepare_rotation(imest_comm_t *c, const axes_t *a, float rs)
 {
   imest_comm_result_t *r = &c->res;
   const imest_inverter_t *inv = &r->inverter;
-  const float ls_ss = a->slm + a->lmm;
+  const float ls_ss = r->ls_standstill_h.value;
   c->rs_ff = rs + c->cfg.r_series_ohm;
   c->inv_td_f = a->tdm * c->fpwm;
   c->inv_v = a->vthm;
@@ -153,7 +175,7 @@ static void prepare_rotation(imest_comm_t *c, const axes_t *a, float rs)
   c->ls_ss = ls_ss;
   if (!c->cfg.allow_rotation) {
     set_value(&r->ls_h, ls_ss, NAN, NAN);
-    set_value(&r->sigma, a->slm / ls_ss, NAN, r->sigma_ls_h.spread_rel);
+    set_value(&r->sigma, r->sigma_ls_h.value / ls_ss, NAN, r->sigma_ls_h.spread_rel);
     r->flags |= IMEST_COMM_FLAG_LS_STANDSTILL;
     c->final_ready = 1;
   }
@@ -167,6 +189,11 @@ void imest__cm_fit_standstill(imest_comm_t *c)
   axes_t a;
   sensor_gains(c, corr);
   combine_axes(c, corr, &a);
+  /* the rotor's resistance at the square wave's frequency against R_R' from the flux tails: far
+     above it (deep bars, a double cage; single cages stay below 2.2 x, saturated or not), the
+     square wave's sigma*L_S is the rotor's high-frequency leakage, below the slip-frequency one */
+  if ((f[0].rhf_ohm + f[1].rhf_ohm + f[2].rhf_ohm) / 3.0f - a.rm > 3.0f * a.lmm / a.taum)
+    r->flags |= IMEST_COMM_FLAG_ROTOR_HF;
   const float rs = report_values(c, &a);
   inverter_model(c, &a);
   if (a.rsp > 0.03f || a.slsp > 0.03f) r->flags |= IMEST_COMM_FLAG_AXIS_SPREAD;
@@ -180,13 +207,6 @@ void imest__cm_fit_standstill(imest_comm_t *c)
   if (!ok) {
     c->bg_fail = IMEST_COMM_REASON_IMPLAUSIBLE;
     return;
-  }
-  /* the rotor's resistance at the square wave's frequency against R_R' from the flux tails: far
-     above it (deep bars, a double cage; single cages stay below 2.2 x, saturated or not), the
-     square wave's sigma*L_S is the rotor's high-frequency leakage, below the slip-frequency one */
-  if ((f[0].rhf_ohm + f[1].rhf_ohm + f[2].rhf_ohm) / 3.0f - a.rm > 3.0f * a.lmm / a.taum) {
-    r->flags |= IMEST_COMM_FLAG_ROTOR_HF;
-    if (!(r->sigma_ls_h.spread_rel >= 0.5f)) r->sigma_ls_h.spread_rel = 0.5f;
   }
   prepare_rotation(c, &a, rs);
 }
