@@ -378,9 +378,10 @@ typedef struct {
   imest_comm_value_t sigma_ls_h;
   imest_comm_value_t sigma_ls_hf_h; /**< sigma*L_S from the square wave at fs/8 [H] */
   /** sigma*L_S at the rotor's slip frequency [H] (stage 5, the two-tone test): the middle of
-   *  its range over rotor frequencies from 0 to slip_test_hz. std_rel: the three axes' fit
-   *  errors (the blocks' scatter); spread_rel: the larger of the axes' spread and the remaining
-   *  frequency dependence over that range (from the two tones; see "What is measured") */
+   *  its range over rotor frequencies from 0 to slip_test_hz. std_rel: NaN (one value per
+   *  axis: their scatter is in the spread); spread_rel: the larger of the three axes' spread
+   *  (their noise, the gains' and the T_R fits' errors) and the remaining frequency dependence
+   *  over that range, |D| / 6 (from the two tones; see "What is measured") */
   imest_comm_value_t sigma_ls_slip_h;
   float slip_test_hz; /**< the slip-frequency test's lower tone [Hz] (the upper one is twice it) */
   /** rotor time constant from the flux tails [s] (at the staircase's currents; after the rotating
@@ -438,7 +439,8 @@ typedef struct {
  * ------------------------------------------------------------------------- */
 
 #define IMEST_COMM_NSUM 9  /**< sums per block */
-/** blocks of one axis (5 plateaus x 9 + 8 square-wave + 3 slip-frequency) or of the probe */
+/** blocks of one axis (5 plateaus x 9 + 8 square-wave), the three axes' slip-frequency sums, or
+ *  the probe's */
 #define IMEST_COMM_NBLK 56
 
 /** One block of samples in one state, handed from the ISR to the background. */
@@ -454,7 +456,6 @@ typedef struct {
 typedef struct {
   float r_ohm, r_std, td_s, td_std, vth_v, vth_std, dr_ohm, dr_std;
   float tau_s, tau_std, lm_h, slsig_h, slsig_std, rhf_ohm, gain_dev, rms_v, i_top_a;
-  float slip_h, slip_std, slip_d_h; /* sigma*L_S at slip frequency, its standard error [H], D [H] */
   int ok, separable;
 } imest_comm_axis_fit_t;
 

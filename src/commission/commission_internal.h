@@ -10,7 +10,7 @@
 #include "common/imest_math.h" /* constants, imest__abs, imest__clarke, IMEST_BARRIER */
 
 /* Block kinds (tag & 0xF), plateau (tag >> 4 & 0xF), pattern (tag >> 8 & 0xF). */
-enum { CM_KIND_DC = 1u, CM_KIND_HF = 2u, CM_KIND_PROBE = 3u, CM_KIND_SLIP = 4u };
+enum { CM_KIND_DC = 1u, CM_KIND_HF = 2u, CM_KIND_PROBE = 3u };
 #define CM_TAG(kind, plateau, pattern)                                                                       \
   ((uint32_t)(kind) | ((uint32_t)(plateau) << 4) | ((uint32_t)(pattern) << 8))
 #define CM_TAG_KIND(t)    ((t)&0xFu)
@@ -38,11 +38,14 @@ enum { CM_L_IC = 0, CM_L_IS = 1, CM_L_VC = 2, CM_L_VS = 3, CM_L_TONE = 4 };
 /* The test's lower tone at w T_R = CM_SLIP_X: where 1 % of T_R moves sigma*L_S by 0.4 %
    (imest_commission.h, "What is measured"); each tone's amplitude a share of the DC current
    that keeps the sum of both 0.3 of it from zero (no phase current changes sign); the
-   settling before the blocks in T_R; the blocks, one period of f1 each. */
+   settling before the block in T_R; the block's whole periods of f1. */
 #define CM_SLIP_X       6.0f
 #define CM_SLIP_AMP     0.35f
 #define CM_SLIP_SETTLE  2.0f
-#define CM_SLIP_BLOCKS  3u
+#define CM_SLIP_PERIODS 3u
+/* Each axis's slip-frequency sums stay in blk[CM_SLIP_BLK + axis] for the standstill fit, past
+   the blocks an axis's staircase and square wave take (the probe's, before, may use them). */
+#define CM_SLIP_BLK (IMEST_COMM_NBLK - 3u)
 
 #define CM_PLATEAUS     5u /* levels 1, 2, 3, 2, 1 thirds */
 #define CM_BLK_PLATEAU  9u /* blocks per plateau: 3 cycles of the 3 patterns */

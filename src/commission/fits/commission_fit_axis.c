@@ -31,9 +31,6 @@
  * over the period, i its mean current): sigma L_S = T / a, and -b/a the resistance at that
  * frequency (R_S, R_R' and the devices).
  *
- * Slip-frequency blocks (commission_slip.c): sigma*L_S at f1 and 2 f1 from the impedance, with
- * this axis's R and tau (fit_slip).
- *
  * Sensor gains: the three measured currents sum to (g_k - mean g) 1.5 i_k on this axis (the
  * true currents sum to zero); the slope against the axis leg's current gives g_k - mean g.
  * float64, fixed iteration counts. */
@@ -214,66 +211,6 @@ static void fit_square_wave(imest_comm_t *c, uint32_t nb, imest_comm_axis_fit_t 
   f->slsig_h = (float)((double)c->ts_s / r[0]);
   f->slsig_std = (float)(sqrt(s2 * dinv[0]) / r[0]);
   f->rhf_ohm = (float)(-r[1] / r[0]);
-}
-
-/* sigma*L_S at tone t of slip-frequency block sums s (commission_slip.c): Z = U / I, U moved
-   back by the zero-order hold's half period and scaled by its sinc, less the axis's DC
-   resistance r; then (Im Z - Re Z / (w tau)) / w (imest_commission.h, "What is measured").
-   NaN without a current. */
-static double slip_sigma_ls(const double s[IMEST_COMM_NSUM], uint32_t t, double w, double ts, double r,
-                            double tau)
-{
-  const double *st = s + t * (uint32_t)CM_L_TONE;
-  /* the phasor of x_k = Re(X e^{j theta_k}) is X = (2 / n) sum x_k e^{-j theta_k}, and the ISR
-     summed x cos and x sin */
-  const double ic = st[CM_L_IC], is = -st[CM_L_IS], vc = st[CM_L_VC], vs = -st[CM_L_VS];
-  const double h = 0.5 * w * ts, h2 = h * h; /* below 0.04 rad: the series */
-  const double ch = 1.0 - 0.5 * h2 * (1.0 - h2 / 12.0), sh = h * (1.0 - h2 / 6.0);
-  const double sinc = 1.0 - h2 / 6.0 * (1.0 - h2 / 20.0);
-  /* U e^{-j h} sinc */
-  const double ur = (vc * ch + vs * sh) * sinc, ui = (vs * ch - vc * sh) * sinc;
-  const double i2 = ic * ic + is * is;
-  if (!(i2 > 0.0) || !(w > 0.0) || !(tau > 0.0)) return (double)NAN;
-  const double zr = (ur * ic + ui * is) / i2 - r, zi = (ui * ic - ur * is) / i2;
-  return (zi - zr / (w * tau)) / w;
-}
-
-/* The slip-frequency test of one axis, once R and tau are fitted: per tone the value from the
-   blocks' sums and its standard error from their scatter; f->slip_h the middle of the range
-   over rotor frequencies 0..f1, sigma*L_S(f1) - D / 6 with D = sigma*L_S(2 f1) - sigma*L_S(f1);
-   f->slip_std its relative standard error. NaN if the test has no blocks. */
-static void fit_slip(const imest_comm_t *c, uint32_t nb, imest_comm_axis_fit_t *f)
-{
-  double tot[IMEST_COMM_NSUM] = {0}, v[2][CM_SLIP_BLOCKS] = {{0}};
-  uint32_t m = 0u;
-  const double w = (double)c->sl_w, ts = (double)c->ts_s, r = (double)f->r_ohm, tau = (double)f->tau_s;
-  for (uint32_t bi = 0; bi < nb; ++bi) {
-    const imest_comm_block_t *b = &c->blk[bi];
-    if (CM_TAG_KIND(b->tag) != CM_KIND_SLIP || m >= CM_SLIP_BLOCKS) continue;
-    double s[IMEST_COMM_NSUM];
-    for (int j = 0; j < IMEST_COMM_NSUM; ++j) {
-      s[j] = (double)b->s[j];
-      tot[j] += s[j];
-    }
-    for (uint32_t t = 0; t < 2u; ++t) v[t][m] = slip_sigma_ls(s, t, w * (double)(t + 1u), ts, r, tau);
-    m++;
-  }
-  f->slip_h = f->slip_std = f->slip_d_h = NAN;
-  if (m < 2u) return;
-  double val[2], var[2];
-  for (uint32_t t = 0; t < 2u; ++t) {
-    val[t] = slip_sigma_ls(tot, t, w * (double)(t + 1u), ts, r, tau);
-    double mean = 0.0, ss = 0.0;
-    for (uint32_t k = 0; k < m; ++k) mean += v[t][k] / (double)m;
-    for (uint32_t k = 0; k < m; ++k) ss += (v[t][k] - mean) * (v[t][k] - mean);
-    var[t] = ss / (double)(m - 1u) / (double)m; /* of the mean */
-  }
-  const double d = val[1] - val[0], sl = val[0] - d / 6.0;
-  if (!(sl > 0.0)) return;
-  f->slip_h = (float)sl;
-  f->slip_d_h = (float)d;
-  /* sl = 7/6 val0 - 1/6 val1 */
-  f->slip_std = (float)(sqrt(49.0 * var[0] + var[1]) / 6.0 / sl);
 }
 
 /* The DC blocks' sums become means (the fits evaluate them many times); the buffer is the
@@ -468,7 +405,6 @@ void imest__cm_fit_axis(imest_comm_t *c, uint32_t axis)
     c->bg_fail = IMEST_COMM_REASON_FIT;
     return;
   }
-  fit_slip(c, x.nb, f);
   f->ok = 1;
   if (f->slsig_h > 0.0f) c->bg_sl = f->slsig_h;
 }

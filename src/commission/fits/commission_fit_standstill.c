@@ -4,7 +4,8 @@
  * corrected for them (an axis current read high by dev/2 makes R and the inductances read low
  * by as much), then means and spreads. R_S: the fitted R less the half-difference of the slope
  * resistances (the common part min(r_sw, r_d) stays in R_S: no terminal measurement separates
- * it) and less the user's known series resistance.
+ * it) and less the user's known series resistance. sigma*L_S at slip frequency from each axis's
+ * two-tone sums (commission_slip.c) with that axis's R and T_R.
  * float32: the per-axis fits (float64) are done; what is left are means, spreads and sums of
  * squares of three values each, with no cancellation (float32's 6e-8 against the fits' 1e-4
  * standard errors), and every result is a float. */
@@ -32,12 +33,33 @@ static void set_value(imest_comm_value_t *out, float value, float std_rel, float
   out->spread_rel = spread;
 }
 
+/* sigma*L_S at tone t of slip-frequency block sums s (commission_slip.c): Z = U / I, U moved
+   back by the zero-order hold's half period and scaled by its sinc, less the axis's DC
+   resistance r; then (Im Z - Re Z / (w tau)) / w (imest_commission.h, "What is measured").
+   NaN without a current (0 / 0). float32: the sums are float32, and what follows are a ratio and a
+   difference of terms 3:1 (Im Z against Re Z / x at x = 6), 1e-7 against the blocks' 1e-3
+   scatter. */
+static float slip_sigma_ls(const float s[IMEST_COMM_NSUM], uint32_t t, float w, float ts, float r, float tau)
+{
+  const float *st = s + t * (uint32_t)CM_L_TONE;
+  /* the phasor of x_k = Re(X e^{j theta_k}) is X = (2 / n) sum x_k e^{-j theta_k}, and the ISR
+     summed x cos and x sin */
+  const float ic = st[CM_L_IC], is = -st[CM_L_IS], vc = st[CM_L_VC], vs = -st[CM_L_VS];
+  const float h = 0.5f * w * ts, h2 = h * h; /* below 0.04 rad: the series */
+  const float ch = 1.0f - 0.5f * h2, sh = h * (1.0f - h2 / 6.0f), sinc = 1.0f - h2 / 6.0f;
+  /* U e^{-j h} sinc */
+  const float ur = (vc * ch + vs * sh) * sinc, ui = (vs * ch - vc * sh) * sinc;
+  const float i2 = ic * ic + is * is;
+  const float zr = (ur * ic + ui * is) / i2 - r, zi = (ui * ic - ur * is) / i2;
+  return (zi - zr / (w * tau)) / w;
+}
+
 /* The three axes' values (gain corrected): means, spreads, and the sums of the per-axis
    variances. */
 typedef struct {
   float rm, rsp, slm, slsp, taum, tausp, lmm, lmsp, tdm, tdsp, vthm, vthsp, drm, drsp;
   float r_var, sl_var, td_var, vth_var, dr_var, tau_var, rms2;
-  float sfm, sfsp, sf_var, sf_d; /* slip-frequency sigma*L_S: mean, spread, variance, mean D */
+  float sfm, sfsp, sf_d; /* slip-frequency sigma*L_S: mean, spread, mean D */
 } axes_t;
 
 /* Sensor gains relative to their mean (three sensors only), and the correction factor each
@@ -68,7 +90,7 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
   const imest_comm_axis_fit_t *f = c->fit;
   float rk[3], slk[3], tauk[3], lmk[3], tdk[3], vthk[3], drk[3], sfk[3];
   a->r_var = a->sl_var = a->td_var = a->vth_var = a->dr_var = a->tau_var = a->rms2 = 0.0f;
-  a->sf_var = a->sf_d = 0.0f;
+  a->sf_d = 0.0f;
   for (int k = 0; k < 3; ++k) {
     rk[k] = f[k].r_ohm * corr[k];
     slk[k] = f[k].slsig_h * corr[k];
@@ -77,9 +99,14 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
     tdk[k] = f[k].td_s;
     vthk[k] = f[k].vth_v;
     drk[k] = f[k].dr_ohm * corr[k];
-    sfk[k] = f[k].slip_h * corr[k];
-    a->sf_var += (f[k].slip_std * sfk[k]) * (f[k].slip_std * sfk[k]);
-    a->sf_d += f[k].slip_d_h * corr[k] / 3.0f;
+    /* slip-frequency sigma*L_S at f1 and 2 f1 with this axis's R and T_R: the middle of its
+       range over 0..f1, sigma*L_S(f1) - D / 6, and D = sigma*L_S(2 f1) - sigma*L_S(f1) */
+    float v[2];
+    for (uint32_t t = 0; t < 2u; ++t)
+      v[t] = slip_sigma_ls(c->blk[CM_SLIP_BLK + (uint32_t)k].s, t, c->sl_w * (float)(t + 1u), c->ts_s,
+                           f[k].r_ohm, f[k].tau_s) * corr[k];
+    sfk[k] = v[0] - (v[1] - v[0]) / 6.0f;
+    a->sf_d += (v[1] - v[0]) / 3.0f;
     a->r_var += f[k].r_std * f[k].r_std;
     a->sl_var += (f[k].slsig_std * f[k].slsig_h) * (f[k].slsig_std * f[k].slsig_h);
     a->td_var += f[k].td_std * f[k].td_std;
@@ -110,18 +137,13 @@ static float report_values(imest_comm_t *c, const axes_t *a)
   r->slip_test_hz = c->sl_w * (float)IMEST_INV_2PI_LIT;
   /* the frequency dependence left over rotor frequencies 0..f1: |D| / 6 */
   const float dep = imest__abs(a->sf_d) / 6.0f / a->sfm;
-  set_value(&r->sigma_ls_slip_h, a->sfm, imest__sqrt(a->sf_var) / 3.0f / a->sfm, a->sfsp > dep ? a->sfsp : dep);
-  if (r->flags & IMEST_COMM_FLAG_ROTOR_HF) {
-    if (a->sfm > 0.0f) { /* (NaN fails) */
-      imest__cm_copy(&r->sigma_ls_h, &r->sigma_ls_slip_h, sizeof r->sigma_ls_h);
-      r->flags |= IMEST_COMM_FLAG_SIGMA_SLIP;
-    } else { /* no slip-frequency value: the square wave's, marked as not the one needed */
-      imest__cm_copy(&r->sigma_ls_h, &r->sigma_ls_hf_h, sizeof r->sigma_ls_h);
-      if (!(r->sigma_ls_h.spread_rel >= 0.5f)) r->sigma_ls_h.spread_rel = 0.5f;
-    }
-  } else {
-    imest__cm_copy(&r->sigma_ls_h, &r->sigma_ls_hf_h, sizeof r->sigma_ls_h);
-  }
+  set_value(&r->sigma_ls_slip_h, a->sfm, NAN, a->sfsp > dep ? a->sfsp : dep);
+  /* a deep-bar rotor's sigma*L_S is the slip-frequency one; without it (NaN fails), the square
+     wave's, marked as not the one needed */
+  const int hf = (r->flags & IMEST_COMM_FLAG_ROTOR_HF) != 0u, slip = hf && a->sfm > 0.0f;
+  imest__cm_copy(&r->sigma_ls_h, slip ? &r->sigma_ls_slip_h : &r->sigma_ls_hf_h, sizeof r->sigma_ls_h);
+  if (slip) r->flags |= IMEST_COMM_FLAG_SIGMA_SLIP;
+  if (hf && !slip && !(r->sigma_ls_h.spread_rel >= 0.5f)) r->sigma_ls_h.spread_rel = 0.5f;
   set_value(&r->tr_s, a->taum, imest__sqrt(a->tau_var) / 3.0f / a->taum, a->tausp);
   set_value(&r->dead_time_s, a->tdm, imest__sqrt(a->td_var) / 3.0f / imest__abs(a->tdm), a->tdsp);
   set_value(&r->v_threshold_v, a->vthm, imest__sqrt(a->vth_var) / 3.0f / imest__abs(a->vthm), a->vthsp);
