@@ -89,8 +89,9 @@
  *      the rated-flux one, 4 to 6. (A voltage-fed V/f run oscillates at no load on a
  *      low-inertia motor.)
  *   The routine ends with zero voltage; its ISR call then returns 0 and the background call
- *   completes the result. Measured totals: 8.4 s at standstill for a 4 kW motor (T_R 128 ms),
- *   30 s for 37 kW (T_R 553 ms), plus 12.5 to 18 s of rotation (19 s for the 4 kW motor with
+ *   completes the result. Measured totals: 10.4 s at standstill for a 4 kW motor (T_R 128 ms;
+ *   the slip-frequency test 2.0 s of it, at most 5.3 A of the 11.6 A limit), 38.7 s for 37 kW
+ *   (T_R 553 ms; the test 8.5 s, 45.6 A of 96 A), plus 12.5 to 18 s of rotation (19 s for the 4 kW motor with
  *   saturation, 24 s for 11 kW; README, Commissioning).
  *
  * What is measured, and how (per axis, then combined; the spread between the three axes is
@@ -179,8 +180,13 @@
  * A double-cage rotor's sigma*L_S at the square wave's fs/8 is its outer cage's leakage, not
  * the leakage at slip frequency the estimator needs (sigma -44 % on the 4 kW real motor): the
  * square wave's resistance shows such a rotor (IMEST_COMM_FLAG_ROTOR_HF: 6 to 37 x R_R' on the
- * simulator's double cages, at most 2.2 x on its single cages, saturating or not), and
- * imest_comm_apply then leaves sigma to the data sheet.
+ * simulator's double cages, at most 2.2 x on its single cages, saturating or not), and sigma
+ * then comes from the slip-frequency test (IMEST_COMM_FLAG_SIGMA_SLIP). Without saturation
+ * (`imest-commission --real-motor --saturation 0 --iron-loss 0`) sigma is -0.02 % (4 kW),
+ * +0.06 % (11 kW), -0.01 % (37 kW) off the truth at slip frequency, stated to 1.1 / 0.6 / 0.6 %
+ * (was -44 %, or the data sheet's 20 %). With saturation (the real motor) the standstill T_R is
+ * not the one at the test's DC current and the tones disagree: sigma -35 % on the 4 kW real
+ * motor, with a spread of 77 % that says so (the estimator then refuses: constants_uncertain).
  *
  * Limits: the current never exceeds i_max_a in any phase (the routine stops with
  * IMEST_COMM_REASON_OVERCURRENT if it does: the firmware's own protection stays in charge); the
@@ -591,7 +597,7 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r);
 /**
  * Fill an estimator config from a result: pole_pairs, ls_h, sigma, rs_nominal_ohm, tr_nominal_s
  * and inverter (with i_band_a and uncertainty) - each only if the result holds it (sigma not with
- * IMEST_COMM_FLAG_ROTOR_HF: the config's stays, with its stated sigma_uncertainty, and
+ * IMEST_COMM_FLAG_ROTOR_HF unless IMEST_COMM_FLAG_SIGMA_SLIP: the config's stays, with its stated sigma_uncertainty, and
  * imest_config_check() names it if unset) - and, with ls_h and sigma, ls_uncertainty and
  * sigma_uncertainty by the rule above; the magnetising curve (ls_curve_points, ls_curve_i_a,
  * ls_curve_h) when the result has 2 or more points and the build follows L_S with the flux
