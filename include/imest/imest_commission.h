@@ -377,8 +377,8 @@ typedef struct {
   int wiring_map[3];
 
   /* standstill */
-  imest_comm_value_t rs_ohm;     /**< stator resistance (incl. min(r_sw, r_d), minus r_series_ohm) */
-  float rs_axis_ohm[3];          /**< R_S per axis (gain corrected) */
+  imest_comm_value_t rs_ohm; /**< stator resistance (incl. min(r_sw, r_d), minus r_series_ohm) */
+  float rs_axis_ohm[3];      /**< R_S per axis (gain corrected) */
   /** transient inductance sigma*L_S [H] the result's sigma is made of: the square wave's
    *  (sigma_ls_hf_h), or with IMEST_COMM_FLAG_SIGMA_SLIP the slip-frequency test's */
   imest_comm_value_t sigma_ls_h;
@@ -444,7 +444,7 @@ typedef struct {
  * Instance (caller-owned; every field is private)
  * ------------------------------------------------------------------------- */
 
-#define IMEST_COMM_NSUM 9  /**< sums per block */
+#define IMEST_COMM_NSUM 9 /**< sums per block */
 /** blocks of one axis (5 plateaus x 9 + 8 square-wave), the three axes' slip-frequency sums, or
  *  the probe's */
 #define IMEST_COMM_NBLK 56

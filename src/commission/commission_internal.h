@@ -45,7 +45,7 @@ enum { CM_L_IC = 0, CM_L_IS = 1, CM_L_VC = 2, CM_L_VS = 3, CM_L_TONE = 4 };
 #define CM_SLIP_PERIODS 3u
 /* Each axis's slip-frequency sums stay in blk[CM_SLIP_BLK + axis] for the standstill fit, past
    the blocks an axis's staircase and square wave take (the probe's, before, may use them). */
-#define CM_SLIP_BLK (IMEST_COMM_NBLK - 3u)
+#define CM_SLIP_BLK     (IMEST_COMM_NBLK - 3u)
 
 #define CM_PLATEAUS     5u /* levels 1, 2, 3, 2, 1 thirds */
 #define CM_BLK_PLATEAU  9u /* blocks per plateau: 3 cycles of the 3 patterns */

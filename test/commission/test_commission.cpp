@@ -254,8 +254,8 @@ TEST_P(CommissionDeepBar, SigmaAtSlipFrequencyWithinItsStatedUncertainty)
     const double llr = w > 0.0 ? zi / w : rp.llr_h;
     return ls - m * m / (m + llr);
   };
-  const double f_sl = out.sim.rated_freq_hz * (1.0 - out.sim.rated_speed_rpm * out.pole_pairs /
-                                                        (60.0 * out.sim.rated_freq_hz));
+  const double f_sl = out.sim.rated_freq_hz *
+                      (1.0 - out.sim.rated_speed_rpm * out.pole_pairs / (60.0 * out.sim.rated_freq_hz));
   ASSERT_GT(f_sl, 0.1);
   ASSERT_LT(f_sl, r.slip_test_hz); // the rated slip lies inside the range the value stands for
   EXPECT_NEAR(sigma_ls_at(0.0), out.sigma_ls_h, 1e-6 * out.sigma_ls_h); // the tool's truth: DC

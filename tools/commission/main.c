@@ -455,7 +455,8 @@ int main(int argc, char **argv)
   printf("  %-26s %s\n", "", note);
   snprintf(note, sizeof note, "spread %.2g %%", 100.0 * (double)r->sigma_ls_h.spread_rel);
   row("sigma*L_S [mH]", 1e3, (double)r->sigma_ls_h.value, out.sigma_ls_h, note);
-  snprintf(note, sizeof note, "square wave at fs/8; spread %.2g %%", 100.0 * (double)r->sigma_ls_hf_h.spread_rel);
+  snprintf(note, sizeof note, "square wave at fs/8; spread %.2g %%",
+           100.0 * (double)r->sigma_ls_hf_h.spread_rel);
   row("  at fs/8", 1e3, (double)r->sigma_ls_hf_h.value, out.sigma_ls_h, note);
   snprintf(note, sizeof note, "tones %.3g and %.3g Hz; spread %.2g %%", (double)r->slip_test_hz,
            2.0 * (double)r->slip_test_hz, 100.0 * (double)r->sigma_ls_slip_h.spread_rel);
@@ -469,8 +470,9 @@ int main(int argc, char **argv)
            "true values at the rated V/f flux at no load; L_S", 1e3 * out.ls_preset_h);
   row("sigma", 1.0, (double)r->sigma.value, out.sigma,
       (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP) ? "rotor_hf: sigma*L_S from the slip-frequency test"
-      : (r->flags & IMEST_COMM_FLAG_ROTOR_HF) ? "rotor_hf: sigma*L_S at fs/8 is the rotor's high-frequency one"
-                                              : NULL);
+      : (r->flags & IMEST_COMM_FLAG_ROTOR_HF)
+          ? "rotor_hf: sigma*L_S at fs/8 is the rotor's high-frequency one"
+          : NULL);
   row("T_R [ms]", 1e3, (double)r->tr_s.value, out.tr_s, "flux tails");
   row("R_R' [ohm]", 1.0, (double)r->rr_ohm.value, out.rr_ohm, "(1-sigma) L_S / T_R");
   {

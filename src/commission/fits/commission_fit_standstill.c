@@ -104,7 +104,8 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
     float v[2];
     for (uint32_t t = 0; t < 2u; ++t)
       v[t] = slip_sigma_ls(c->blk[CM_SLIP_BLK + (uint32_t)k].s, t, c->sl_w * (float)(t + 1u), c->ts_s,
-                           f[k].r_ohm, f[k].tau_s) * corr[k];
+                           f[k].r_ohm, f[k].tau_s) *
+             corr[k];
     sfk[k] = v[0] - (v[1] - v[0]) / 6.0f;
     a->sf_d += (v[1] - v[0]) / 3.0f;
     a->r_var += f[k].r_std * f[k].r_std;

@@ -14,7 +14,7 @@
  * current share, so their ratio, the impedance, does not see it. ISR, float32. */
 #include "commission_internal.h"
 
-_Static_assert(CM_PLATEAUS * CM_BLK_PLATEAU + CM_HF_BLOCKS <= CM_SLIP_BLK,
+_Static_assert(CM_PLATEAUS *CM_BLK_PLATEAU + CM_HF_BLOCKS <= CM_SLIP_BLK,
                "an axis's blocks leave the slip-frequency sums alone");
 _Static_assert(2 * CM_L_TONE <= IMEST_COMM_NSUM, "two tones' sums fit a block");
 
