@@ -41,7 +41,7 @@ static void set_value(imest_comm_value_t *out, float value, float std_rel, float
    scatter. */
 static float slip_sigma_ls(const float s[IMEST_COMM_NSUM], uint32_t t, float w, float ts, float r, float tau)
 {
-  const float *st = s + t * (uint32_t)CM_L_TONE;
+  const float *st = s + (size_t)t * (size_t)CM_L_TONE;
   /* the phasor of x_k = Re(X e^{j theta_k}) is X = (2 / n) sum x_k e^{-j theta_k}, and the ISR
      summed x cos and x sin */
   const float ic = st[CM_L_IC], is = -st[CM_L_IS], vc = st[CM_L_VC], vs = -st[CM_L_VS];

@@ -57,7 +57,7 @@ void imest__cm_stage_slip(imest_comm_t *c, float vdc, float i_n, float v_n)
   float ref = c->sl_bias;
   imest_comm_block_t *b = &c->blk[CM_SLIP_BLK + c->axis];
   for (uint32_t t = 0u; t < 2u; ++t) {
-    float *st = b->s + t * (uint32_t)CM_L_TONE;
+    float *st = b->s + (size_t)t * (size_t)CM_L_TONE;
     const float cs = c->sl_c[t], sn = c->sl_s[t];
     st[CM_L_IC] += di * cs;
     st[CM_L_IS] += di * sn;
