@@ -135,9 +135,10 @@ int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
   c->reason = IMEST_COMM_REASON_NONE;
   c->stage = IMEST_COMM_STAGE_OFFSETS;
   const float nanf_ = (float)NAN;
-  imest_comm_value_t *vals[] = {
-      &c->res.rs_ohm,      &c->res.sigma_ls_h,    &c->res.tr_s,   &c->res.rr_ohm, &c->res.ls_standstill_h,
-      &c->res.dead_time_s, &c->res.v_threshold_v, &c->res.dr_ohm, &c->res.ls_h,   &c->res.sigma};
+  imest_comm_value_t *vals[] = {&c->res.rs_ohm,        &c->res.sigma_ls_h,      &c->res.tr_s,
+                                &c->res.rr_ohm,        &c->res.ls_standstill_h, &c->res.dead_time_s,
+                                &c->res.v_threshold_v, &c->res.dr_ohm,          &c->res.ls_h,
+                                &c->res.sigma,         &c->res.sigma_ls_hf_h,   &c->res.sigma_ls_slip_h};
   for (size_t v = 0; v < sizeof vals / sizeof vals[0]; ++v) {
     vals[v]->value = nanf_;
     vals[v]->std_rel = nanf_;
@@ -150,6 +151,7 @@ int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
   c->res.rotating_r_ohm = nanf_;
   c->res.rotating_i_a = nanf_;
   c->res.rotating_f_hz = nanf_;
+  c->res.slip_test_hz = nanf_;
   c->res.ls_curve_points = 0u;
   for (int x = 0; x < 4; ++x) c->res.ls_curve_i_a[x] = c->res.ls_curve_h[x] = nanf_;
   c->res.dc_fit_rms_v = nanf_;
@@ -186,6 +188,7 @@ int imest_comm_status(const imest_comm_t *c, imest_comm_status_t *st)
   case IMEST_COMM_STAGE_TIME_CONSTANT: p = 0.04f; break;
   case IMEST_COMM_STAGE_STAIRCASE: p = 0.08f + per_axis * ((float)c->axis + in_axis); break;
   case IMEST_COMM_STAGE_PULSES:
+  case IMEST_COMM_STAGE_SLIP:
   case IMEST_COMM_STAGE_DEMAGNETISE: p = 0.08f + per_axis * ((float)c->axis + 0.9f); break;
   case IMEST_COMM_STAGE_ROTATE: {
     /* magnetise, ramp, the levels (settle, measure, next), down, stop */
@@ -236,6 +239,7 @@ const char *imest_comm_stage_name(int stage)
   case IMEST_COMM_STAGE_TIME_CONSTANT: return "time_constant";
   case IMEST_COMM_STAGE_STAIRCASE: return "staircase";
   case IMEST_COMM_STAGE_PULSES: return "pulses";
+  case IMEST_COMM_STAGE_SLIP: return "slip";
   case IMEST_COMM_STAGE_DEMAGNETISE: return "demagnetise";
   case IMEST_COMM_STAGE_ROTATE: return "rotate";
   case IMEST_COMM_STAGE_END: return "end";

@@ -32,6 +32,21 @@ enum { CM_S_V = 0, CM_S_MA = 1, CM_S_TD = 4, CM_S_VTH = 5, CM_S_DR = 6, CM_S_DEL
 /* Square-wave block sums: y = current step over a period, x1 = voltage, x2 = mean current. */
 enum { CM_H_X11 = 0, CM_H_X12, CM_H_X1, CM_H_X22, CM_H_X2, CM_H_YX1, CM_H_YX2, CM_H_Y, CM_H_YY };
 
+/* Slip-frequency block sums: per tone t (0: f1, 1: 2 f1) the current less the DC one and the
+   voltage less the DC one, each times cos and sin of the tone's phase (commission_slip.c). */
+enum { CM_L_IC = 0, CM_L_IS = 1, CM_L_VC = 2, CM_L_VS = 3, CM_L_TONE = 4 };
+/* The test's lower tone at w T_R = CM_SLIP_X: where 1 % of T_R moves sigma*L_S by 0.4 %
+   (imest_commission.h, "What is measured"); each tone's amplitude a share of the DC current
+   that keeps the sum of both 0.3 of it from zero (no phase current changes sign); the
+   settling before the block in T_R; the block's whole periods of f1. */
+#define CM_SLIP_X       6.0f
+#define CM_SLIP_AMP     0.35f
+#define CM_SLIP_SETTLE  2.0f
+#define CM_SLIP_PERIODS 3u
+/* Each axis's slip-frequency sums stay in blk[CM_SLIP_BLK + axis] for the standstill fit, past
+   the blocks an axis's staircase and square wave take (the probe's, before, may use them). */
+#define CM_SLIP_BLK     (IMEST_COMM_NBLK - 3u)
+
 #define CM_PLATEAUS     5u /* levels 1, 2, 3, 2, 1 thirds */
 #define CM_BLK_PLATEAU  9u /* blocks per plateau: 3 cycles of the 3 patterns */
 #define CM_HF_BLOCKS    8u
@@ -113,6 +128,7 @@ void imest__cm_block_flush(imest_comm_t *c);
 void imest__cm_probe_begin(imest_comm_t *c);
 void imest__cm_staircase_begin(imest_comm_t *c, uint32_t axis);
 void imest__cm_pulses_begin(imest_comm_t *c);
+void imest__cm_slip_begin(imest_comm_t *c);
 void imest__cm_rotate_begin(imest_comm_t *c);
 void imest__cm_finish(imest_comm_t *c);
 
@@ -123,6 +139,7 @@ void imest__cm_stage_wiring(imest_comm_t *c, const float m[3], float vdc);
 void imest__cm_stage_probe(imest_comm_t *c, const float m[3], float vdc, float i_n, float v_n);
 void imest__cm_stage_staircase(imest_comm_t *c, const float m[3], float vdc, float i_n, float v_n);
 void imest__cm_stage_pulses(imest_comm_t *c, float vdc, float i_n, float v_ended);
+void imest__cm_stage_slip(imest_comm_t *c, float vdc, float i_n, float v_n);
 void imest__cm_stage_demagnetise(imest_comm_t *c, float vdc, float i_n);
 void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc);
 

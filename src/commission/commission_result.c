@@ -45,12 +45,19 @@ static float at_most_max(float u)
   return u < IMEST_COMM_UNCERTAINTY_MAX ? u : IMEST_COMM_UNCERTAINTY_MAX;
 }
 
+/* 1 if the result's sigma is the one at slip frequency: a single cage's square wave, or a
+   deep-bar rotor's slip-frequency test (else the square wave saw its high-frequency leakage). */
+static int sigma_at_slip(const imest_comm_result_t *r)
+{
+  return !(r->flags & IMEST_COMM_FLAG_ROTOR_HF) || (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP) != 0u;
+}
+
 /* The rule imest_commission.h states for ls_uncertainty and sigma_uncertainty.
  * curve: the magnetising curve goes to the config, so the estimator takes L_S
  * (and sigma with it) at each window's flux, and their change over the curve
  * (ls_h's, sigma's spread_rel) is no longer an error of what it uses. A
- * high-frequency sigma (IMEST_COMM_FLAG_ROTOR_HF) is not filled: the config's
- * sigma and its stated uncertainty stay. */
+ * high-frequency sigma (IMEST_COMM_FLAG_ROTOR_HF without the slip-frequency
+ * test's) is not filled: the config's sigma and its stated uncertainty stay. */
 static void constants_uncertainty(const imest_comm_result_t *r, int curve, imest_config_t *cfg)
 {
   const int standstill = (r->flags & IMEST_COMM_FLAG_LS_STANDSTILL) != 0u;
@@ -58,7 +65,7 @@ static void constants_uncertainty(const imest_comm_result_t *r, int curve, imest
   const float u_ls = fmaxf(standstill ? IMEST_COMM_LS_FLOOR_STANDSTILL : IMEST_COMM_LS_FLOOR,
                            fmaxf(q_ls, standstill ? quality_rel(&r->ls_standstill_h) : 0.0f));
   cfg->ls_uncertainty = at_most_max(u_ls);
-  if (r->flags & IMEST_COMM_FLAG_ROTOR_HF) return;
+  if (!sigma_at_slip(r)) return;
   const float q_sg = curve ? std3_rel(&r->sigma) : quality_rel(&r->sigma);
   const float u_sg = fmaxf(standstill ? IMEST_COMM_SIGMA_FLOOR_STANDSTILL : IMEST_COMM_SIGMA_FLOOR,
                            fmaxf(q_sg, quality_rel(&r->sigma_ls_h) + u_ls));
@@ -80,7 +87,7 @@ int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)
       IMEST_WITH_FLUX && r->ls_curve_points >= 2u && r->ls_curve_points <= IMEST_LS_CURVE_POINTS;
   constants_uncertainty(r, curve, cfg);
   n += 2;
-  if (!(r->flags & IMEST_COMM_FLAG_ROTOR_HF)) { /* else its sigma is the high-frequency one */
+  if (sigma_at_slip(r)) { /* else its sigma is the high-frequency one */
     cfg->sigma = r->sigma.value;
     n++;
   }

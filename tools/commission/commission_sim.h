@@ -69,8 +69,8 @@ typedef struct {
   double inv_err_rms_v; /* rms of the latter over the same grid */
   /* run */
   double sim_time_s;
-  double stage_s[8];     /* time spent in each stage (imest_comm_stage_t) */
-  double stage_ipk_a[8]; /* largest true phase current in each stage */
+  double stage_s[IMEST_COMM_STAGE_END + 1];     /* time spent in each stage (imest_comm_stage_t) */
+  double stage_ipk_a[IMEST_COMM_STAGE_END + 1]; /* largest true phase current in each stage */
   imsim_config_t sim;
   imest_comm_config_t cc;
   imest_comm_result_t r;

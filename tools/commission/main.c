@@ -85,7 +85,8 @@ static void usage(FILE *f)
 }
 
 /* --apply-args: the config imest_comm_apply() fills from r, as imest-replay options (the
-   fields it leaves alone, e.g. sigma with IMEST_COMM_FLAG_ROTOR_HF, are not printed). */
+   fields it leaves alone, e.g. sigma with IMEST_COMM_FLAG_ROTOR_HF and no slip-frequency
+   value, are not printed). */
 static int print_apply_args(const imest_comm_result_t *r)
 {
   imest_config_t cfg;
@@ -97,7 +98,7 @@ static int print_apply_args(const imest_comm_result_t *r)
     return 1;
   }
   printf("--pole-pairs %u --ls %.9g", cfg.pole_pairs, (double)cfg.ls_h);
-  if (!(r->flags & IMEST_COMM_FLAG_ROTOR_HF))
+  if (!(r->flags & IMEST_COMM_FLAG_ROTOR_HF) || (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP))
     printf(" --sigma %.9g --sigma-uncertainty %.9g", (double)cfg.sigma, (double)cfg.sigma_uncertainty);
   printf(" --ls-uncertainty %.9g --rs %.9g", (double)cfg.ls_uncertainty, (double)cfg.rs_nominal_ohm);
   if (cfg.tr_nominal_s != tr0) printf(" --tr-nominal %.9g", (double)cfg.tr_nominal_s);
@@ -172,6 +173,9 @@ static void print_result(const imest_comm_result_t *r, const imest_comm_axis_fit
   print_value("rs_ohm", &r->rs_ohm);
   print_floats("rs_axis_ohm", r->rs_axis_ohm, 3u);
   print_value("sigma_ls_h", &r->sigma_ls_h);
+  print_value("sigma_ls_hf_h", &r->sigma_ls_hf_h);
+  print_value("sigma_ls_slip_h", &r->sigma_ls_slip_h);
+  printf("slip_test_hz %.9g\n", (double)r->slip_test_hz);
   print_value("tr_s", &r->tr_s);
   print_value("rr_ohm", &r->rr_ohm);
   print_value("ls_standstill_h", &r->ls_standstill_h);
@@ -451,6 +455,12 @@ int main(int argc, char **argv)
   printf("  %-26s %s\n", "", note);
   snprintf(note, sizeof note, "spread %.2g %%", 100.0 * (double)r->sigma_ls_h.spread_rel);
   row("sigma*L_S [mH]", 1e3, (double)r->sigma_ls_h.value, out.sigma_ls_h, note);
+  snprintf(note, sizeof note, "square wave at fs/8; spread %.2g %%",
+           100.0 * (double)r->sigma_ls_hf_h.spread_rel);
+  row("  at fs/8", 1e3, (double)r->sigma_ls_hf_h.value, out.sigma_ls_h, note);
+  snprintf(note, sizeof note, "tones %.3g and %.3g Hz; spread %.2g %%", (double)r->slip_test_hz,
+           2.0 * (double)r->slip_test_hz, 100.0 * (double)r->sigma_ls_slip_h.spread_rel);
+  row("  at slip frequency", 1e3, (double)r->sigma_ls_slip_h.value, out.sigma_ls_h, note);
   snprintf(note, sizeof note, "%s; standstill %.5g mH (%+.2f %%)",
            (r->flags & IMEST_COMM_FLAG_LS_STANDSTILL) ? "standstill" : "rotating",
            1e3 * (double)r->ls_standstill_h.value, pct((double)r->ls_standstill_h.value, out.ls_h));
@@ -459,8 +469,10 @@ int main(int argc, char **argv)
     printf("  %-26s %s %.5g mH (the preset's, at rated load's main flux)\n", "",
            "true values at the rated V/f flux at no load; L_S", 1e3 * out.ls_preset_h);
   row("sigma", 1.0, (double)r->sigma.value, out.sigma,
-      (r->flags & IMEST_COMM_FLAG_ROTOR_HF) ? "rotor_hf: sigma*L_S at fs/8 is the rotor's high-frequency one"
-                                            : NULL);
+      (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP) ? "rotor_hf: sigma*L_S from the slip-frequency test"
+      : (r->flags & IMEST_COMM_FLAG_ROTOR_HF)
+          ? "rotor_hf: sigma*L_S at fs/8 is the rotor's high-frequency one"
+          : NULL);
   row("T_R [ms]", 1e3, (double)r->tr_s.value, out.tr_s, "flux tails");
   row("R_R' [ohm]", 1.0, (double)r->rr_ohm.value, out.rr_ohm, "(1-sigma) L_S / T_R");
   {

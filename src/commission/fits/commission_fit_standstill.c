@@ -4,7 +4,8 @@
  * corrected for them (an axis current read high by dev/2 makes R and the inductances read low
  * by as much), then means and spreads. R_S: the fitted R less the half-difference of the slope
  * resistances (the common part min(r_sw, r_d) stays in R_S: no terminal measurement separates
- * it) and less the user's known series resistance.
+ * it) and less the user's known series resistance. sigma*L_S at slip frequency from each axis's
+ * two-tone sums (commission_slip.c) with that axis's R and T_R.
  * float32: the per-axis fits (float64) are done; what is left are means, spreads and sums of
  * squares of three values each, with no cancellation (float32's 6e-8 against the fits' 1e-4
  * standard errors), and every result is a float. */
@@ -32,11 +33,33 @@ static void set_value(imest_comm_value_t *out, float value, float std_rel, float
   out->spread_rel = spread;
 }
 
+/* sigma*L_S at tone t of slip-frequency block sums s (commission_slip.c): Z = U / I, U moved
+   back by the zero-order hold's half period and scaled by its sinc, less the axis's DC
+   resistance r; then (Im Z - Re Z / (w tau)) / w (imest_commission.h, "What is measured").
+   NaN without a current (0 / 0). float32: the sums are float32, and what follows are a ratio and a
+   difference of terms 3:1 (Im Z against Re Z / x at x = 6), 1e-7 against the blocks' 1e-3
+   scatter. */
+static float slip_sigma_ls(const float s[IMEST_COMM_NSUM], uint32_t t, float w, float ts, float r, float tau)
+{
+  const float *st = s + (size_t)t * (size_t)CM_L_TONE;
+  /* the phasor of x_k = Re(X e^{j theta_k}) is X = (2 / n) sum x_k e^{-j theta_k}, and the ISR
+     summed x cos and x sin */
+  const float ic = st[CM_L_IC], is = -st[CM_L_IS], vc = st[CM_L_VC], vs = -st[CM_L_VS];
+  const float h = 0.5f * w * ts, h2 = h * h; /* below 0.04 rad: the series */
+  const float ch = 1.0f - 0.5f * h2, sh = h * (1.0f - h2 / 6.0f), sinc = 1.0f - h2 / 6.0f;
+  /* U e^{-j h} sinc */
+  const float ur = (vc * ch + vs * sh) * sinc, ui = (vs * ch - vc * sh) * sinc;
+  const float i2 = ic * ic + is * is;
+  const float zr = (ur * ic + ui * is) / i2 - r, zi = (ui * ic - ur * is) / i2;
+  return (zi - zr / (w * tau)) / w;
+}
+
 /* The three axes' values (gain corrected): means, spreads, and the sums of the per-axis
    variances. */
 typedef struct {
   float rm, rsp, slm, slsp, taum, tausp, lmm, lmsp, tdm, tdsp, vthm, vthsp, drm, drsp;
   float r_var, sl_var, td_var, vth_var, dr_var, tau_var, rms2;
+  float sfm, sfsp, sf_d; /* slip-frequency sigma*L_S: mean, spread, mean D */
 } axes_t;
 
 /* Sensor gains relative to their mean (three sensors only), and the correction factor each
@@ -65,8 +88,9 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
 {
   imest_comm_result_t *r = &c->res;
   const imest_comm_axis_fit_t *f = c->fit;
-  float rk[3], slk[3], tauk[3], lmk[3], tdk[3], vthk[3], drk[3];
+  float rk[3], slk[3], tauk[3], lmk[3], tdk[3], vthk[3], drk[3], sfk[3];
   a->r_var = a->sl_var = a->td_var = a->vth_var = a->dr_var = a->tau_var = a->rms2 = 0.0f;
+  a->sf_d = 0.0f;
   for (int k = 0; k < 3; ++k) {
     rk[k] = f[k].r_ohm * corr[k];
     slk[k] = f[k].slsig_h * corr[k];
@@ -75,6 +99,15 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
     tdk[k] = f[k].td_s;
     vthk[k] = f[k].vth_v;
     drk[k] = f[k].dr_ohm * corr[k];
+    /* slip-frequency sigma*L_S at f1 and 2 f1 with this axis's R and T_R: the middle of its
+       range over 0..f1, sigma*L_S(f1) - D / 6, and D = sigma*L_S(2 f1) - sigma*L_S(f1) */
+    float v[2];
+    for (uint32_t t = 0; t < 2u; ++t)
+      v[t] = slip_sigma_ls(c->blk[CM_SLIP_BLK + (uint32_t)k].s, t, c->sl_w * (float)(t + 1u), c->ts_s,
+                           f[k].r_ohm, f[k].tau_s) *
+             corr[k];
+    sfk[k] = v[0] - (v[1] - v[0]) / 6.0f;
+    a->sf_d += (v[1] - v[0]) / 3.0f;
     a->r_var += f[k].r_std * f[k].r_std;
     a->sl_var += (f[k].slsig_std * f[k].slsig_h) * (f[k].slsig_std * f[k].slsig_h);
     a->td_var += f[k].td_std * f[k].td_std;
@@ -91,6 +124,7 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
   mean_spread(tdk, &a->tdm, &a->tdsp);
   mean_spread(vthk, &a->vthm, &a->vthsp);
   mean_spread(drk, &a->drm, &a->drsp);
+  mean_spread(sfk, &a->sfm, &a->sfsp);
 }
 
 /* The standstill values with their qualities; returns R_S. */
@@ -100,12 +134,23 @@ static float report_values(imest_comm_t *c, const axes_t *a)
   const float rs = a->rm - 0.5f * imest__abs(a->drm) - c->cfg.r_series_ohm;
   for (int k = 0; k < 3; ++k) r->rs_axis_ohm[k] -= 0.5f * imest__abs(a->drm);
   set_value(&r->rs_ohm, rs, imest__sqrt(a->r_var) / 3.0f / rs, a->rsp * a->rm / rs);
-  set_value(&r->sigma_ls_h, a->slm, imest__sqrt(a->sl_var) / 3.0f / a->slm, a->slsp);
+  set_value(&r->sigma_ls_hf_h, a->slm, imest__sqrt(a->sl_var) / 3.0f / a->slm, a->slsp);
+  r->slip_test_hz = c->sl_w * (float)IMEST_INV_2PI_LIT;
+  /* the frequency dependence left over rotor frequencies 0..f1: |D| / 6 */
+  const float dep = imest__abs(a->sf_d) / 6.0f / a->sfm;
+  set_value(&r->sigma_ls_slip_h, a->sfm, NAN, a->sfsp > dep ? a->sfsp : dep);
+  /* a deep-bar rotor's sigma*L_S is the slip-frequency one; without it (NaN fails), the square
+     wave's, marked as not the one needed */
+  const int hf = (r->flags & IMEST_COMM_FLAG_ROTOR_HF) != 0u, slip = hf && a->sfm > 0.0f;
+  imest__cm_copy(&r->sigma_ls_h, slip ? &r->sigma_ls_slip_h : &r->sigma_ls_hf_h, sizeof r->sigma_ls_h);
+  if (slip) r->flags |= IMEST_COMM_FLAG_SIGMA_SLIP;
+  if (hf && !slip && !(r->sigma_ls_h.spread_rel >= 0.5f)) r->sigma_ls_h.spread_rel = 0.5f;
   set_value(&r->tr_s, a->taum, imest__sqrt(a->tau_var) / 3.0f / a->taum, a->tausp);
   set_value(&r->dead_time_s, a->tdm, imest__sqrt(a->td_var) / 3.0f / imest__abs(a->tdm), a->tdsp);
   set_value(&r->v_threshold_v, a->vthm, imest__sqrt(a->vth_var) / 3.0f / imest__abs(a->vthm), a->vthsp);
   set_value(&r->dr_ohm, a->drm, imest__sqrt(a->dr_var) / 3.0f / imest__abs(a->drm), a->drsp);
-  const float ls_ss = a->slm + a->lmm;
+  /* the flux tails' L_S: their (1 - sigma) L_S plus the sigma*L_S of the same (slow) rotor */
+  const float ls_ss = r->sigma_ls_h.value + a->lmm;
   set_value(&r->ls_standstill_h, ls_ss, NAN, (a->lmsp * a->lmm) / ls_ss);
   set_value(&r->rr_ohm, a->lmm / a->taum, NAN, NAN);
   r->dc_fit_rms_v = imest__sqrt(a->rms2 / 3.0f);
@@ -142,7 +187,7 @@ static void prepare_rotation(imest_comm_t *c, const axes_t *a, float rs)
 {
   imest_comm_result_t *r = &c->res;
   const imest_inverter_t *inv = &r->inverter;
-  const float ls_ss = a->slm + a->lmm;
+  const float ls_ss = r->ls_standstill_h.value;
   c->rs_ff = rs + c->cfg.r_series_ohm;
   c->inv_td_f = a->tdm * c->fpwm;
   c->inv_v = a->vthm;
@@ -153,7 +198,7 @@ static void prepare_rotation(imest_comm_t *c, const axes_t *a, float rs)
   c->ls_ss = ls_ss;
   if (!c->cfg.allow_rotation) {
     set_value(&r->ls_h, ls_ss, NAN, NAN);
-    set_value(&r->sigma, a->slm / ls_ss, NAN, r->sigma_ls_h.spread_rel);
+    set_value(&r->sigma, r->sigma_ls_h.value / ls_ss, NAN, r->sigma_ls_h.spread_rel);
     r->flags |= IMEST_COMM_FLAG_LS_STANDSTILL;
     c->final_ready = 1;
   }
@@ -167,6 +212,11 @@ void imest__cm_fit_standstill(imest_comm_t *c)
   axes_t a;
   sensor_gains(c, corr);
   combine_axes(c, corr, &a);
+  /* the rotor's resistance at the square wave's frequency against R_R' from the flux tails: far
+     above it (deep bars, a double cage; single cages stay below 2.2 x, saturated or not), the
+     square wave's sigma*L_S is the rotor's high-frequency leakage, below the slip-frequency one */
+  if ((f[0].rhf_ohm + f[1].rhf_ohm + f[2].rhf_ohm) / 3.0f - a.rm > 3.0f * a.lmm / a.taum)
+    r->flags |= IMEST_COMM_FLAG_ROTOR_HF;
   const float rs = report_values(c, &a);
   inverter_model(c, &a);
   if (a.rsp > 0.03f || a.slsp > 0.03f) r->flags |= IMEST_COMM_FLAG_AXIS_SPREAD;
@@ -180,13 +230,6 @@ void imest__cm_fit_standstill(imest_comm_t *c)
   if (!ok) {
     c->bg_fail = IMEST_COMM_REASON_IMPLAUSIBLE;
     return;
-  }
-  /* the rotor's resistance at the square wave's frequency against R_R' from the flux tails: far
-     above it (deep bars, a double cage; single cages stay below 2.2 x, saturated or not), the
-     square wave's sigma*L_S is the rotor's high-frequency leakage, below the slip-frequency one */
-  if ((f[0].rhf_ohm + f[1].rhf_ohm + f[2].rhf_ohm) / 3.0f - a.rm > 3.0f * a.lmm / a.taum) {
-    r->flags |= IMEST_COMM_FLAG_ROTOR_HF;
-    if (!(r->sigma_ls_h.spread_rel >= 0.5f)) r->sigma_ls_h.spread_rel = 0.5f;
   }
   prepare_rotation(c, &a, rs);
 }

@@ -232,6 +232,7 @@ static inline void run_stage(imest_comm_t *c, const float i_abc_a[3], const floa
   case IMEST_COMM_STAGE_TIME_CONSTANT: imest__cm_stage_probe(c, m, vdc_v, i_n, c->v_app); break;
   case IMEST_COMM_STAGE_STAIRCASE: imest__cm_stage_staircase(c, m, vdc_v, i_n, c->v_app); break;
   case IMEST_COMM_STAGE_PULSES: imest__cm_stage_pulses(c, vdc_v, i_n, v_ended); break;
+  case IMEST_COMM_STAGE_SLIP: imest__cm_stage_slip(c, vdc_v, i_n, c->v_app); break;
   case IMEST_COMM_STAGE_DEMAGNETISE: imest__cm_stage_demagnetise(c, vdc_v, i_n); break;
   case IMEST_COMM_STAGE_ROTATE: imest__cm_stage_rotate(c, m, vdc_v); break;
   case IMEST_COMM_STAGE_END:

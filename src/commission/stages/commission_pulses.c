@@ -6,7 +6,8 @@
  * stays on one branch. Per period the background regresses the current step on the voltage
  * applied during it, the mean current and a constant (imest__cm_fit_axis): di = T/(sigma L_S)
  * (v - R i - c). The voltage is known exactly (it is what the routine commanded), the current
- * step's noise only enters at the ends of each half wave. ISR, float32. */
+ * step's noise only enters at the ends of each half wave. Then the slip-frequency test at the
+ * same bias (commission_slip.c). ISR, float32. */
 #include "commission_internal.h"
 
 void imest__cm_pulses_begin(imest_comm_t *c)
@@ -57,12 +58,10 @@ void imest__cm_stage_pulses(imest_comm_t *c, float vdc, float i_n, float v_ended
       if (++c->block < CM_HF_BLOCKS) {
         imest__cm_block_start(c, CM_TAG(CM_KIND_HF, 0u, 0u));
       } else {
-        imest__cm_post(c, CM_JOB_AXIS | (c->axis << 4), c->nblk);
-        c->stage = IMEST_COMM_STAGE_DEMAGNETISE;
-        c->step = 0u;
-        c->cnt = 0u;
-        c->cnt_demag = 0u;
-        c->i_ref = 0.0f;
+        /* the current loop's integrator holds the bias voltage the next stage starts from */
+        imest__cm_command(c, CM_PAT_CENTRED, c->integ[CM_PAT_CENTRED], vdc);
+        imest__cm_slip_begin(c);
+        return;
       }
     }
   }
