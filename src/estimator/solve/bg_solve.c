@@ -62,11 +62,10 @@ int imest__bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_
   if (!cfg_ok(cfg)) return out->status = IMEST_ERR_CONFIG;
 
   bg_tables_t t;
-  if (imest__bg_tables_build(in, cfg->tr_nominal_s, &t) != IMEST_OK) {
+  if (imest__bg_tables_build_weighted(in, cfg->tr_nominal_s, cfg->weight_c, &t) != IMEST_OK) {
     stats->roots.sturm_evals = stats->roots.bisect_steps = stats->roots.polish_evals = 0;
     return out->status = IMEST_REASON_NUMERIC;
   }
-  if (cfg->weight_c > 0.0) imest__bg_tables_weight(&t, cfg->weight_c);
   out->scale_s = t.s;
   out->scale_g = t.g;
   out->scale_c = t.c;
