@@ -46,9 +46,15 @@ double random_double(std::mt19937_64 &rng, int kind)
 TEST(BgFloat, Scale2IsTheMultiplication)
 {
   std::mt19937_64 rng(20261202);
-  const double special[] = {0.0, -0.0, 1.0, -1.0, std::numeric_limits<double>::infinity(),
-                            -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN(),
-                            std::numeric_limits<double>::denorm_min(), std::numeric_limits<double>::min(),
+  const double special[] = {0.0,
+                            -0.0,
+                            1.0,
+                            -1.0,
+                            std::numeric_limits<double>::infinity(),
+                            -std::numeric_limits<double>::infinity(),
+                            std::numeric_limits<double>::quiet_NaN(),
+                            std::numeric_limits<double>::denorm_min(),
+                            std::numeric_limits<double>::min(),
                             std::numeric_limits<double>::max()};
   long mismatches = 0;
   for (int i = 0; i < 400000; ++i) {
@@ -56,7 +62,8 @@ TEST(BgFloat, Scale2IsTheMultiplication)
     const int e = (i < 10 * 50) ? (i / 10) * 45 - 1100 : (int)(rng() % 2201) - 1100;
     const double want = x * imest__bg_pow2(e), got = imest__bg_scale2(x, e);
     if (std::isnan(want) ? !std::isnan(got) : bits(want) != bits(got)) {
-      if (++mismatches <= 5) ADD_FAILURE() << std::hexfloat << x << " * 2^" << e << ": " << got << ", want " << want;
+      if (++mismatches <= 5)
+        ADD_FAILURE() << std::hexfloat << x << " * 2^" << e << ": " << got << ", want " << want;
     }
   }
   EXPECT_EQ(mismatches, 0);
@@ -70,14 +77,26 @@ TEST(BgFloat, SqrtIsCorrectlyRounded)
   auto check = [&](double x) {
     const double want = std::sqrt(x), got = imest__bg_sqrt(x);
     if (std::isnan(want) ? !std::isnan(got) : bits(want) != bits(got)) {
-      if (++mismatches <= 5) ADD_FAILURE() << std::hexfloat << "sqrt(" << x << ") = " << got << ", want " << want;
+      if (++mismatches <= 5)
+        ADD_FAILURE() << std::hexfloat << "sqrt(" << x << ") = " << got << ", want " << want;
     }
   };
-  const double special[] = {0.0, -0.0, 1.0, 2.0, 4.0, 0.25, -1.0, -0.5e-310,
-                            std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
-                            std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::denorm_min(),
-                            std::numeric_limits<double>::min(), std::numeric_limits<double>::max(),
-                            std::nextafter(4.0, 0.0), std::nextafter(1.0, 2.0)};
+  const double special[] = {0.0,
+                            -0.0,
+                            1.0,
+                            2.0,
+                            4.0,
+                            0.25,
+                            -1.0,
+                            -0.5e-310,
+                            std::numeric_limits<double>::infinity(),
+                            -std::numeric_limits<double>::infinity(),
+                            std::numeric_limits<double>::quiet_NaN(),
+                            std::numeric_limits<double>::denorm_min(),
+                            std::numeric_limits<double>::min(),
+                            std::numeric_limits<double>::max(),
+                            std::nextafter(4.0, 0.0),
+                            std::nextafter(1.0, 2.0)};
   for (double x : special) check(x);
   for (int i = 0; i < 600000; ++i) check(random_double(rng, i));
   for (int i = 0; i < 200000; ++i) {
@@ -86,7 +105,8 @@ TEST(BgFloat, SqrtIsCorrectlyRounded)
     const long double mid = ((long double)y + 0x1p-53L) * ((long double)y + 0x1p-53L);
     const double base[2] = {y * y, (double)mid};
     for (double b : base)
-      for (int k = -2; k <= 2; ++k) check(std::ldexp(from_bits(bits(b) + (uint64_t)(int64_t)k), (int)(rng() % 200) - 100));
+      for (int k = -2; k <= 2; ++k)
+        check(std::ldexp(from_bits(bits(b) + (uint64_t)(int64_t)k), (int)(rng() % 200) - 100));
   }
   EXPECT_EQ(mismatches, 0);
 }

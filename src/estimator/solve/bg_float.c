@@ -86,7 +86,8 @@ double imest__bg_sqrt(double x)
     e -= 1;
   }
   const uint64_t mlo = m << 52; /* m 2^52 modulo 2^64 */
-  const float s0 = (float)imest__sqrt((imest_real_t)((float)(uint32_t)(m >> 22) * 9.31322574615478515625e-10f));
+  const float s0 =
+      (float)imest__sqrt((imest_real_t)((float)(uint32_t)(m >> 22) * 9.31322574615478515625e-10f));
   const uint32_t y0 = (uint32_t)(s0 * 8388608.0f); /* s0 2^23: an integer (24 bits) */
   const int64_t d = (int64_t)(m - ((uint64_t)y0 * y0 << 6));
   const float step1 = (float)(int32_t)(d / 4) * (16777216.0f / (float)y0); /* (m 2^52 - y0^2) / 2 y0 */

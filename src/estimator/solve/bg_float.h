@@ -28,7 +28,7 @@ double imest__bg_scale2(double x, int e);
  * instruction per operation the integer and float32 shortcuts below would
  * only slow down; 1 elsewhere, the host included, so that the tests run the
  * code of a single-precision FPU. */
-#if defined(__ARM_FP) && ((__ARM_FP) & 8)
+#if defined(__ARM_FP) && ((__ARM_FP)&8)
 #define BG_SOFT_DOUBLE 0
 #else
 #define BG_SOFT_DOUBLE 1

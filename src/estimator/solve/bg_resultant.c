@@ -10,7 +10,8 @@
 /* out[0..nout-1] (+)= conv(a[0..na-1], b[0..nb-1]) (nout <= na + nb - 1: the
  * terms of higher degree are not formed), negated if neg (an exact sign
  * flip, not a soft-double multiplication by -1) */
-static void conv_acc(const double *a, int na, const double *b, int nb, double *out, int nout, int clear, int neg)
+static void conv_acc(const double *a, int na, const double *b, int nb, double *out, int nout, int clear,
+                     int neg)
 {
   if (clear)
     for (int k = 0; k < nout; ++k) out[k] = 0.0;

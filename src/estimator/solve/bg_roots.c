@@ -234,11 +234,11 @@ BG_NOINLINE static void chain_build(chain_t *ch, const double *pd, int n)
   for (int i = 0; i < ch->deg[0]; ++i) c1[i] = (sreal_t)(i + 1) * c0[i + 1];
   chain_normalise(ch, 1, 1);
   ch->len = 2;
+  sreal_t r[NMAX + 1] = {0}; /* remainder scratch (P_len has room for db terms only), zeroed once */
   while (ch->deg[ch->len - 1] > 0 && ch->len <= n) {
     const sreal_t *a = CH(ch, ch->len - 2);
     const sreal_t *b = CH(ch, ch->len - 1);
     const int da = ch->deg[ch->len - 2], db = ch->deg[ch->len - 1];
-    sreal_t r[NMAX + 1]; /* remainder scratch (P_len has room for db terms only); r[0..da] is all that is read */
     for (int i = 0; i <= da; ++i) r[i] = a[i];
     for (int i = da; i >= db; --i) {
       const sreal_t q = r[i] / b[db];
@@ -597,13 +597,13 @@ int imest__bg_roots_positive_ex(const double *c, int deg, double *roots, int max
     const int ex = DOMAIN_EXP[dom], rev = DOMAIN_REV[dom], es = rev ? -ex : ex;
     const double step = imest__bg_pow2(es);
     double f = 1.0;
-    int kmax = 0;
+    double dmax = 0.0;
     for (int k = 0; k <= n; ++k) {
       d[k] = BG_SCALE2(rev ? p[n - k] : p[k], k * es, f); /* f = 2^(k es), |k es| <= 160: exact */
       f *= step;
-      if (mag(d[k]) > mag(d[kmax])) kmax = k;
+      if (mag(d[k]) > mag(dmax)) dmax = d[k];
     }
-    const int de = -imest__bg_round_log2(fabs(d[kmax]));
+    const int de = -imest__bg_round_log2(fabs(dmax));
     const double dn = imest__bg_pow2(de);
     for (int k = 0; k <= n; ++k) d[k] = BG_SCALE2(d[k], de, dn);
     const double ylo = DOMAIN_LO[dom];
