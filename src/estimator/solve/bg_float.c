@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "bg_float.h"
+#include "common/imest_math.h" /* imest__sqrt: VSQRT.F32, no library call */
 
 typedef union {
   double d;
@@ -19,6 +20,18 @@ double imest__bg_pow2(int e)
   bits64_t b;
   b.u = (uint64_t)(e + 1023) << 52;
   return b.d;
+}
+
+double imest__bg_scale2(double x, int e)
+{
+  bits64_t b;
+  b.d = x;
+  const int ex = (int)((b.u >> 52) & 0x7FFu), r = ex + e;
+  if (ex != 0 && ex != 0x7FF && r > 0 && r < 0x7FF && e >= -1022 && e <= 1023) {
+    b.u += (uint64_t)(int64_t)e << 52; /* the exponent field stays in range: the sign is kept */
+    return b.d;
+  }
+  return x * imest__bg_pow2(e); /* zero, subnormal, non-finite, or a result out of the normal range */
 }
 
 int imest__bg_finite(double x)
@@ -41,3 +54,59 @@ int imest__bg_round_log2(double x)
   /* log2 x = ex + log2(1.f): round up iff 1.f >= sqrt 2 (mantissa of sqrt 2) */
   return ex - off + (((b.u & 0xFFFFFFFFFFFFFull) >= 0x6A09E667F3BCDull) ? 1 : 0);
 }
+
+#if BG_SOFT_DOUBLE
+/* x = m 2^(e - 52), e even, m in [2^52, 2^54): sqrt(x) = y 2^(e/2 - 52) with
+ * y = round(sqrt(m 2^52)) in [2^52, 2^53]. s0 = sqrtf(m 2^-52) is within
+ * 2^-23.4 relative; one Newton step from y0 = s0 2^52, its correction
+ * formed in float32, leaves |y - sqrt(m 2^52)| < 2^8, so the residual
+ * m 2^52 - y^2 (< 2^62) is exact in int64 modulo 2^64; a second step leaves
+ * |y - sqrt| < 1.01, and at most two unit steps make y the floor (0 <= r <=
+ * 2y); y rounds up iff r > y (a tie cannot occur). */
+double imest__bg_sqrt(double x)
+{
+  bits64_t b;
+  b.d = x;
+  int ex = (int)((b.u >> 52) & 0x7FFu), off = 0;
+  if ((b.u >> 63) != 0u || ex == 0x7FF || ex == 0) {
+    if ((b.u << 1) == 0u || (ex == 0x7FF && (b.u >> 63) == 0u) || (ex == 0x7FF && (b.u << 12) != 0u))
+      return x; /* +-0, +inf, NaN */
+    if ((b.u >> 63) != 0u) {
+      b.u = 0x7FF8000000000000ull; /* x < 0: the default NaN */
+      return b.d;
+    }
+    b.d = x * 18014398509481984.0; /* subnormal: 2^54 x is normal */
+    ex = (int)((b.u >> 52) & 0x7FFu);
+    off = 54;
+  }
+  uint64_t m = (b.u & 0xFFFFFFFFFFFFFull) | 0x10000000000000ull;
+  int e = ex - 1023 - off;
+  if (((unsigned int)e & 1u) != 0u) {
+    m <<= 1;
+    e -= 1;
+  }
+  const uint64_t mlo = m << 52; /* m 2^52 modulo 2^64 */
+  const float s0 =
+      (float)imest__sqrt((imest_real_t)((float)(uint32_t)(m >> 22) * 9.31322574615478515625e-10f));
+  const uint32_t y0 = (uint32_t)(s0 * 8388608.0f); /* s0 2^23: an integer (24 bits) */
+  const int64_t d = (int64_t)(m - ((uint64_t)y0 * y0 << 6));
+  const float step1 = (float)(int32_t)(d / 4) * (16777216.0f / (float)y0); /* (m 2^52 - y0^2) / 2 y0 */
+  uint64_t y = ((uint64_t)y0 << 29) + (uint64_t)(int64_t)(int32_t)step1;
+  const int64_t r1 = (int64_t)(mlo - y * y);
+  const float step2 = (float)(int32_t)(r1 / 4294967296LL) * 512.0f / (float)(uint32_t)(y >> 22);
+  y += (uint64_t)(int64_t)(int32_t)step2;
+  int64_t r = (int64_t)(mlo - y * y);
+  for (int i = 0; i < 3; ++i) {
+    if (r < 0) {
+      r += (int64_t)(2u * y) - 1;
+      --y;
+    } else if (r > (int64_t)(2u * y)) {
+      r -= (int64_t)(2u * y) + 1;
+      ++y;
+    }
+  }
+  if (r > (int64_t)y) ++y; /* y = 2^53 carries into the exponent */
+  b.u = ((uint64_t)(int64_t)(e / 2 + 1022) << 52) + y;
+  return b.d;
+}
+#endif

@@ -14,12 +14,44 @@ extern "C" {
  * -O2, so the background code says it here). */
 #if defined(__GNUC__)
 #define BG_NOINLINE __attribute__((noinline))
+#define BG_CONST    __attribute__((const)) /* a result that is not used needs no call */
 #else
 #define BG_NOINLINE
+#define BG_CONST
 #endif
 
-double imest__bg_pow2(int e);   /* 2^e, e clamped to [-1022, 1023] */
+BG_CONST double imest__bg_pow2(int e); /* 2^e, e clamped to [-1022, 1023] */
+/* x * imest__bg_pow2(e), bit for bit, by an exponent addition where x and the
+ * result are normal (a soft-double multiplication costs ~45 instructions). */
+double imest__bg_scale2(double x, int e);
+/* BG_SOFT_DOUBLE: 0 where the FPU has double (Cortex-M7 fpv5-d16), whose one
+ * instruction per operation the integer and float32 shortcuts below would
+ * only slow down; 1 elsewhere, the host included, so that the tests run the
+ * code of a single-precision FPU. */
+#if defined(__ARM_FP) && ((__ARM_FP)&8)
+#define BG_SOFT_DOUBLE 0
+#else
+#define BG_SOFT_DOUBLE 1
+#endif
+
+/* x * p2, where p2 = imest__bg_pow2(e): by the exponent where double is soft
+ * (p2 is then not evaluated), by the multiplication where the FPU has double. */
+#if !BG_SOFT_DOUBLE
+#define BG_SCALE2(x, e, p2) ((x) * (p2))
+#else
+#define BG_SCALE2(x, e, p2) ((void)(p2), imest__bg_scale2((x), (e)))
+#endif
 int imest__bg_finite(double x); /* isfinite by the exponent bits */
+/* sqrt(x), correctly rounded like IEEE-754 sqrt (bit for bit; a NaN for x < 0):
+ * a float32 seed and two corrections in integers, ~100 instructions where
+ * libm's bit-by-bit soft-double sqrt takes ~800. Where the FPU has double,
+ * its one instruction. */
+#if !BG_SOFT_DOUBLE
+#define BG_SQRT(x) sqrt(x)
+#else
+double imest__bg_sqrt(double x);
+#define BG_SQRT(x) imest__bg_sqrt(x)
+#endif
 /* round(log2(x)) for finite x > 0, exact (mantissa compared with sqrt 2). */
 int imest__bg_round_log2(double x);
 

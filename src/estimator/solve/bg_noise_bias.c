@@ -23,11 +23,23 @@ static double bias_at(const bg_noise_t *nz, unsigned int i, unsigned int j)
   return (double)bias_f(nz, i, j);
 }
 
+/* *dst -= f b, without the soft-double multiplication where the whole bias is
+ * taken (whole: f = 1, the rule; x 1 is exact) */
+BG_NOINLINE static void take(double *dst, double f, int whole, double b)
+{
+  if (whole)
+    *dst -= b;
+  else
+    *dst -= f * b; /* as before, fused where the FPU fuses */
+}
+#define TAKE(dst, b) take(&(dst), f, whole, (b))
+
 /* In float64 although B and c0 are float32: B_yy - 2 c0' B_y + c0' B c0 (the
  * noise's share of the centred residual) cancels; formed in float32 it moved
  * PE_K1 of a poorly determined window by 10 % (tools/studies/compare). */
 static void apply(bg_sums_t *sm, const bg_noise_t *nz, double f, double m)
 {
+  const int whole = (f == 1.0);
   double c0[7];
   for (unsigned int i = 0; i < 7u; ++i) c0[i] = sm->c0[k_of_col[i]];
   double bwc[7]; /* B_WW c0 */
@@ -37,15 +49,17 @@ static void apply(bg_sums_t *sm, const bg_noise_t *nz, double f, double m)
   }
   double cbc = 0.0, cby = 0.0;
   for (unsigned int i = 0; i < 7u; ++i) {
-    for (unsigned int j = 0; j < 7u; ++j) sm->rw[k_of_col[i]][k_of_col[j]] -= f * bias_at(nz, i, j);
-    sm->rwy[k_of_col[i]] -= f * bias_at(nz, i, 7u);
-    sm->rwe[k_of_col[i]] -= f * (bias_at(nz, i, 7u) - bwc[i]);
+    for (unsigned int j = 0; j < 7u; ++j) TAKE(sm->rw[k_of_col[i]][k_of_col[j]], bias_at(nz, i, j));
+    TAKE(sm->rwy[k_of_col[i]], bias_at(nz, i, 7u));
+    TAKE(sm->rwe[k_of_col[i]], bias_at(nz, i, 7u) - bwc[i]);
     cbc += c0[i] * bwc[i];
     cby += c0[i] * bias_at(nz, i, 7u);
   }
-  sm->ry -= f * bias_at(nz, 7u, 7u);
-  sm->ree -= f * (bias_at(nz, 7u, 7u) - 2.0 * cby + cbc);
-  sm->e_slack = f * (bias_at(nz, 7u, 7u) - 2.0 * cby + cbc);
+  const double e_c0 = bias_at(nz, 7u, 7u) - 2.0 * cby + cbc;
+  TAKE(sm->ry, bias_at(nz, 7u, 7u));
+  TAKE(sm->ree, e_c0);
+  sm->e_slack = 0.0;
+  take(&sm->e_slack, f, whole, -e_c0); /* 0 - (-f e) = f e */
   /* column 3 is -m column 4, for the noise as for everything */
   for (unsigned int j = 0; j < 8u; ++j) sm->rw[2][j] = -m * sm->rw[3][j];
   for (unsigned int i = 0; i < 8u; ++i) sm->rw[i][2] = -m * sm->rw[i][3];

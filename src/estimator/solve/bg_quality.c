@@ -72,7 +72,7 @@ BG_NOINLINE static double kbound(pe_ctx_t *c, double x, int sign)
   if (!(v[0] > 0.0) || !imest__bg_finite(g)) {
     k = (double)sign * c->kprof;
   } else {
-    const double root = (g < 0.0) ? sqrt(-g) : 0.0;
+    const double root = (g < 0.0) ? BG_SQRT(-g) : 0.0;
     k = ((double)(-sign) * v[1] + root) / (2.0 * v[0]);
   }
   return imest__bg_finite(k) ? k : (double)sign * c->kprof;
@@ -250,8 +250,8 @@ unsigned int imest__bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, 
   double dk_q = BG_PE_UNBOUNDED, dx_q = BG_PE_UNBOUNDED;
   if (out->hessian_pd) {
     const double hh = 0.5 * er / det;
-    dk_q = sqrt(hh * h22);
-    dx_q = sqrt(hh * h11);
+    dk_q = BG_SQRT(hh * h22);
+    dx_q = BG_SQRT(hh * h11);
     out->pe_quad[0] = finite_or_unbounded(dk_q * t->g);
     out->pe_quad[1] = finite_or_unbounded(dx_q * t->s);
   } else {

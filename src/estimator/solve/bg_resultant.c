@@ -7,14 +7,18 @@
  * round-off (the paper's degree-18 r, one trailing zero). */
 #include "bg_resultant.h"
 
-/* out[0..na+nb-2] (+)= conv(a[0..na-1], b[0..nb-1]), sign = +1 or -1 */
-static void conv_acc(const double *a, int na, const double *b, int nb, double *out, int clear, double sign)
+/* out[0..nout-1] (+)= conv(a[0..na-1], b[0..nb-1]) (nout <= na + nb - 1: the
+ * terms of higher degree are not formed), negated if neg (an exact sign
+ * flip, not a soft-double multiplication by -1) */
+static void conv_acc(const double *a, int na, const double *b, int nb, double *out, int nout, int clear,
+                     int neg)
 {
   if (clear)
-    for (int k = 0; k < na + nb - 1; ++k) out[k] = 0.0;
+    for (int k = 0; k < nout; ++k) out[k] = 0.0;
   for (int i = 0; i < na; ++i) {
-    const double ai = sign * a[i];
-    for (int j = 0; j < nb; ++j) out[i + j] += ai * b[j];
+    const double ai = neg ? -a[i] : a[i];
+    const int nj = (nb < nout - i) ? nb : nout - i;
+    for (int j = 0; j < nj; ++j) out[i + j] += ai * b[j];
   }
 }
 
@@ -22,8 +26,8 @@ void imest__bg_resultant(const bg_tables_t *t, double r[22], int generic)
 {
   double u[15];  /* a0 bw2 - a1 bw1 */
   double sq[13]; /* a1 a1 */
-  conv_acc(t->a0, 8, t->bw2, 8, u, 1, 1.0);
-  conv_acc(t->a1, 7, t->bw1, 9, u, 0, -1.0);
+  conv_acc(t->a0, 8, t->bw2, 8, u, 15, 1, 0);
+  conv_acc(t->a1, 7, t->bw1, 9, u, 15, 0, 1);
   /* a1 a1, symmetric: diagonal plus twice each off-diagonal product */
   for (int k = 0; k < 13; ++k) sq[k] = 0.0;
   for (int i = 0; i < 7; ++i) {
@@ -32,14 +36,11 @@ void imest__bg_resultant(const bg_tables_t *t, double r[22], int generic)
     const double ai2 = 2.0 * t->a1[i];
     for (int j = i + 1; j < 7; ++j) sq[i + j] += ai2 * t->a1[j];
   }
-  conv_acc(t->a0, 8, u, 15, r, 1, 1.0);
-  conv_acc(sq, 13, t->bw0, 10, r, 0, 1.0);
-
-  if (!generic) {
-    /* W.3 = -m W.4 makes these vanish identically (for any cw); in floating
-     * point they are round-off that would create spurious roots near
-     * 1e9..1e16 (docs/METHOD.md §4). */
-    r[20] = 0.0;
-    r[21] = 0.0;
-  }
+  /* W.3 = -m W.4 makes r[20], r[21] vanish identically (for any cw); in
+   * floating point they are round-off that would create spurious roots near
+   * 1e9..1e16 (docs/METHOD.md §4): not formed unless generic. */
+  const int nr = generic ? 22 : 20;
+  conv_acc(t->a0, 8, u, 15, r, nr, 1, 0);
+  conv_acc(sq, 13, t->bw0, 10, r, nr, 0, 0);
+  for (int k = nr; k < 22; ++k) r[k] = 0.0;
 }

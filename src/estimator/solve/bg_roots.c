@@ -6,8 +6,8 @@
  * Design
  *  - Normalise: strip exact-zero leading and trailing coefficients (a root at 0
  *    is not positive), scale by a power of two so that max|c| is in
- *    [2^-1/2, 2^1/2). All power-of-two scalings are multiplications by exact
- *    powers of two (imest__bg_pow2), no ldexp/frexp.
+ *    [2^-1/2, 2^1/2). All power-of-two scalings are exact (BG_SCALE2: the
+ *    exponent field where double is soft), no ldexp/frexp.
  *  - Four domains, each searched on (lo, 1 + 2^-8] so that neighbouring
  *    domains overlap (a root at a domain boundary, where the sign of p is
  *    round-off, lies inside one of them): kappa in (0,1] on p(y); (1,16] on
@@ -54,7 +54,8 @@
  *    root or none (for p', whose roots the isolation does not separate).
  *  - Safety net in float64 (parity_rescue): if the odd-multiplicity roots
  *    found in a domain do not match the parity of the float64 sign change of p
- *    over the domain, p is sampled on a fixed grid (bg_bounds.h) and cells with a
+ *    over the domain (its end signs from the float32 P0 where a bound makes
+ *    them certain: sign_at), p is sampled on a fixed grid (bg_bounds.h) and cells with a
  *    sign change but no root are solved by the same newton_bracketed
  *    (stats.rescues). Every
  *    reported root is a float64 root (sign change or |p| at round-off level):
@@ -77,16 +78,19 @@
  */
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 
 #include "bg_roots.h"
 
 #ifdef BG_ROOTS_DOUBLE
 typedef double sreal_t;
 #define SR_TOL    (64.0 * DBL_EPSILON)
+#define SR_EPS    DBL_EPSILON
 #define SR_ABS(x) fabs(x)
 #else
 typedef float sreal_t;
 #define SR_TOL    (16.0f * FLT_EPSILON)
+#define SR_EPS    FLT_EPSILON
 #define SR_ABS(x) fabsf(x)
 #endif
 
@@ -116,13 +120,33 @@ typedef struct {
   short va, vb, depth;
 } ival_t;
 
+static uint64_t bits_of(double x)
+{
+  union {
+    double d;
+    uint64_t u;
+  } b;
+  b.d = x;
+  return b.u;
+}
+
+/* |x| as an integer: ordered like fabs(x) for every non-NaN x (a soft-double
+ * comparison costs ~25 instructions, this a few). */
+static uint64_t mag(double x)
+{
+  return bits_of(x) & 0x7FFFFFFFFFFFFFFFull;
+}
+
 static int sgn_s(sreal_t v)
 {
   return (v > 0) - (v < 0);
 }
-static int sgn_d(double v)
+/* (v > 0) - (v < 0), NaN 0, from the bits: two soft-double comparisons less */
+BG_NOINLINE static int sgn_d(double v)
 {
-  return (v > 0.0) - (v < 0.0);
+  const uint64_t a = mag(v);
+  if (a == 0u || a > 0x7FF0000000000000ull) return 0;
+  return (a == bits_of(v)) ? 1 : -1;
 }
 
 static sreal_t horner_s(const sreal_t *c, int n, sreal_t x)
@@ -210,11 +234,11 @@ BG_NOINLINE static void chain_build(chain_t *ch, const double *pd, int n)
   for (int i = 0; i < ch->deg[0]; ++i) c1[i] = (sreal_t)(i + 1) * c0[i + 1];
   chain_normalise(ch, 1, 1);
   ch->len = 2;
+  sreal_t r[NMAX + 1] = {0}; /* remainder scratch (P_len has room for db terms only), zeroed once */
   while (ch->deg[ch->len - 1] > 0 && ch->len <= n) {
     const sreal_t *a = CH(ch, ch->len - 2);
     const sreal_t *b = CH(ch, ch->len - 1);
     const int da = ch->deg[ch->len - 2], db = ch->deg[ch->len - 1];
-    sreal_t r[NMAX + 1] = {0}; /* remainder scratch (P_len has room for db terms only) */
     for (int i = 0; i <= da; ++i) r[i] = a[i];
     for (int i = da; i >= db; --i) {
       const sreal_t q = r[i] / b[db];
@@ -388,48 +412,74 @@ BG_NOINLINE static int refine(const chain_t *ch, const double *pd, int n, ival_t
   const int kind = polish(pd, n, (double)a, (double)b, lo, hi, root, st);
   if (kind == 0) return 0;
   const double est = 0.5 * ((double)a + (double)b);
-  const double dev = fabs(*root - est) / fabs(*root);
-  if (dev > st->max_chain_rel) st->max_chain_rel = dev;
+  const double dev = fabs(*root - est), ar = fabs(*root);
+  if (dev > st->max_chain_rel * ar) st->max_chain_rel = dev / ar; /* a division only when it grows */
   return kind;
+}
+
+/* The sign of the float64 Horner value of pd at x (x = a domain end, exact
+ * in chain precision), as +-1 or 0: from the chain's copy P0 = f pd (f > 0,
+ * all n + 1 coefficients, each rounded twice) where that is certain, else by
+ * the float64 evaluation. Certain: |P0(x)| in chain precision exceeds
+ * (4n + 8) u S, S = sum |P0_k| x^k, u the unit round-off, i.e. twice the
+ * rounding of P0's coefficients and of its Horner evaluation ((2n + 2) u S) plus
+ * the float64 evaluation's; SR_TINY covers underflow. Far from a root (the
+ * domain ends, as a rule) one chain-precision pass instead of a float64 one. */
+#define SR_TINY ((sreal_t)1.925929944387236e-34) /* 2^-112: 2^14 underflows of 2^-126 */
+BG_NOINLINE static int sign_at(const chain_t *ch, const double *pd, int n, double x)
+{
+#if BG_SOFT_DOUBLE
+  const sreal_t *c = CH(ch, 0), xs = (sreal_t)x;
+  sreal_t h = 0, a = 0;
+  for (int k = n; k >= 0; --k) {
+    h = h * xs + c[k];
+    a = a * xs + SR_ABS(c[k]);
+  }
+  if (SR_ABS(h) > (sreal_t)(4 * n + 8) * (SR_EPS * (sreal_t)0.5) * a + SR_TINY) return sgn_s(h);
+#else
+  (void)ch;
+#endif
+  return sgn_d(imest__bg_poly_eval(pd, n, x));
 }
 
 /* float64 safety net for a chain that lost accuracy: the number of odd-
  * multiplicity roots in (0, TOP] must have the parity of the sign change of p
  * between 0+ and TOP. If not, p is sampled in float64 at a fixed grid
  * (0, 2^-16 .. 2^-1, 0.75, TOP: BG_ROOTS_RESCUE_CELLS cells) and every grid cell with a sign
- * change and no root yet is solved by newton_bracketed. */
-BG_NOINLINE static int parity_rescue(const double *pd, int n, double ylo, double *out, int *odd, int nout,
-                                     bg_roots_stats_t *st)
+ * change and no root yet is solved by newton_bracketed. Only signs of p are
+ * used (newton_bracketed takes the sign of fa). */
+BG_NOINLINE static int parity_rescue(const chain_t *ch, const double *pd, int n, double ylo, double *out,
+                                     int *odd, int nout, bg_roots_stats_t *st)
 {
   const double top = (double)DOMAIN_TOP;
-  const double ftop = imest__bg_poly_eval(pd, n, top);
-  double flo = pd[0];
+  const int stop = sign_at(ch, pd, n, top);
+  int slo = sgn_d(pd[0]);
   if (ylo > 0.0) {
-    flo = imest__bg_poly_eval(pd, n, ylo);
+    slo = sign_at(ch, pd, n, ylo);
     ++st->polish_evals;
   }
   ++st->polish_evals;
   int nodd = 0;
   for (int i = 0; i < nout; ++i) nodd += odd[i];
-  if (sgn_d(ftop) == 0 || sgn_d(flo) == 0 || ((sgn_d(flo) != sgn_d(ftop)) == ((nodd & 1) == 1))) return nout;
+  if (stop == 0 || slo == 0 || ((slo != stop) == ((nodd & 1) == 1))) return nout;
   ++st->rescues;
   double glo = ylo;
   for (int k = 1; k <= (int)BG_ROOTS_RESCUE_CELLS; ++k) {
     const int p2 = (int)BG_ROOTS_RESCUE_POW2_CELLS;
     const double ghi = (k <= p2) ? imest__bg_pow2(k - p2 - 1) : (k == p2 + 1) ? 0.75 : top;
     if (ghi <= glo) continue;
-    const double fhi = imest__bg_poly_eval(pd, n, ghi);
+    const int shi = sgn_d(imest__bg_poly_eval(pd, n, ghi));
     ++st->polish_evals;
-    if (sgn_d(flo) * sgn_d(fhi) < 0) {
+    if (slo * shi < 0) {
       int inside = 0;
       for (int i = 0; i < nout; ++i) inside += (out[i] > glo && out[i] <= ghi);
       if (inside == 0 && nout < NMAX) {
-        out[nout] = newton_bracketed(pd, n, 0, glo, ghi, flo, st);
+        out[nout] = newton_bracketed(pd, n, 0, glo, ghi, (double)slo, st);
         odd[nout++] = 1;
       }
     }
     glo = ghi;
-    flo = fhi;
+    slo = shi;
   }
   return nout;
 }
@@ -486,7 +536,7 @@ static int domain_roots(chain_t *ch, const double *pd, int n, double ylo, double
       ++st->rejected;
     }
   }
-  return parity_rescue(pd, n, ylo, out, odd, nout, st);
+  return parity_rescue(ch, pd, n, ylo, out, odd, nout, st);
 }
 
 /* Insert x into the ascending roots[0..*nr-1] (at most max), dropping it if a
@@ -521,22 +571,22 @@ int imest__bg_roots_positive_ex(const double *c, int deg, double *roots, int max
   st->unresolved = st->rejected = st->merged = st->rescues = 0;
   st->max_chain_rel = 0.0;
   if (c == 0 || deg < 0 || deg > NMAX || (max > 0 && roots == 0)) return -1;
-  int hi = -1, lo = -1;
-  double mx = 0.0;
+  int hi = -1, lo = -1, kmx = 0;
   for (int k = 0; k <= deg; ++k) {
     if (!imest__bg_finite(c[k])) return -1;
-    if (c[k] != 0.0) {
+    if (mag(c[k]) != 0u) {
       if (lo < 0) lo = k;
       hi = k;
-      if (fabs(c[k]) > mx) mx = fabs(c[k]);
+      if (mag(c[k]) > mag(c[kmx])) kmx = k;
     }
   }
   if (hi < 0) return -1; /* all zero */
   const int n = hi - lo;
   if (n == 0) return 0;
   double p[NMAX + 1], d[NMAX + 1];
-  const double pn = imest__bg_pow2(-imest__bg_round_log2(mx));
-  for (int k = 0; k <= n; ++k) p[k] = c[lo + k] * pn;
+  const int pe = -imest__bg_round_log2(fabs(c[kmx]));
+  const double pn = imest__bg_pow2(pe);
+  for (int k = 0; k <= n; ++k) p[k] = BG_SCALE2(c[lo + k], pe, pn);
 
   chain_t ch;
   double xd[NMAX];
@@ -544,16 +594,18 @@ int imest__bg_roots_positive_ex(const double *c, int deg, double *roots, int max
   for (int dom = 0; dom < DOMAINS; ++dom) {
     /* domain polynomial: p(2^e y) or q(2^-e z) with q[k] = p[n-k] (the
      * reversed p), exactly scaled by powers of two, renormalised */
-    const int ex = DOMAIN_EXP[dom], rev = DOMAIN_REV[dom];
-    const double step = imest__bg_pow2(rev ? -ex : ex);
-    double f = 1.0, dmax = 0.0;
+    const int ex = DOMAIN_EXP[dom], rev = DOMAIN_REV[dom], es = rev ? -ex : ex;
+    const double step = imest__bg_pow2(es);
+    double f = 1.0;
+    double dmax = 0.0;
     for (int k = 0; k <= n; ++k) {
-      d[k] = (rev ? p[n - k] : p[k]) * f;
+      d[k] = BG_SCALE2(rev ? p[n - k] : p[k], k * es, f); /* f = 2^(k es), |k es| <= 160: exact */
       f *= step;
-      if (fabs(d[k]) > dmax) dmax = fabs(d[k]);
+      if (mag(d[k]) > mag(dmax)) dmax = d[k];
     }
-    const double dn = imest__bg_pow2(-imest__bg_round_log2(dmax));
-    for (int k = 0; k <= n; ++k) d[k] *= dn;
+    const int de = -imest__bg_round_log2(fabs(dmax));
+    const double dn = imest__bg_pow2(de);
+    for (int k = 0; k <= n; ++k) d[k] = BG_SCALE2(d[k], de, dn);
     const double ylo = DOMAIN_LO[dom];
     const int nd = domain_roots(&ch, d, n, ylo, xd, st);
     const double back = imest__bg_pow2(ex);

@@ -34,7 +34,7 @@ double imest__bg_solve_weight_c(const bg_sums_t *in)
   if (in == 0) return 0.0;
   const double r44 = in->rw[3][3], r66 = in->rw[5][5];
   if (!(imest__bg_finite(r44) && imest__bg_finite(r66) && r44 > 0.0 && r66 >= 0.0)) return 0.0;
-  const double c = sqrt(r66 / r44);
+  const double c = BG_SQRT(r66 / r44);
   return imest__bg_finite(c) ? c : 0.0;
 }
 
@@ -62,11 +62,10 @@ int imest__bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_
   if (!cfg_ok(cfg)) return out->status = IMEST_ERR_CONFIG;
 
   bg_tables_t t;
-  if (imest__bg_tables_build(in, cfg->tr_nominal_s, &t) != IMEST_OK) {
+  if (imest__bg_tables_build_weighted(in, cfg->tr_nominal_s, cfg->weight_c, &t) != IMEST_OK) {
     stats->roots.sturm_evals = stats->roots.bisect_steps = stats->roots.polish_evals = 0;
     return out->status = IMEST_REASON_NUMERIC;
   }
-  if (cfg->weight_c > 0.0) imest__bg_tables_weight(&t, cfg->weight_c);
   out->scale_s = t.s;
   out->scale_g = t.g;
   out->scale_c = t.c;
@@ -94,7 +93,7 @@ int imest__bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_
   /* E below zero is the cancellation floor of float32-accumulated sums */
   out->e = (c->e > 0.0) ? c->e : 0.0;
   out->e_w = (c->ew > 0.0) ? c->ew : 0.0;
-  out->e_i = sqrt(out->e / in->ry);
+  out->e_i = BG_SQRT(out->e / in->ry);
   /* The error indices take the residual as measured: the noise's share at
    * the selected K, not at the centring (far from the solution the latter
    * can be much smaller, and a negative compensated E then reads as an

@@ -22,11 +22,10 @@ static double *table_of(bg_tables_t *t, int order)
 /* bw[j] = (j-5) t[j-1] + cw (j+1) t[j+1], j = 0..len (t has len entries). */
 BG_NOINLINE static void weighted_b(const double *tab, int len, double cw, double *bw)
 {
-  for (int j = 0; j <= len; ++j) {
-    double v = (j >= 1) ? (double)(j - 5) * tab[j - 1] : 0.0;
-    if (cw != 0.0 && j + 1 < len) v += cw * (double)(j + 1) * tab[j + 1];
-    bw[j] = v;
-  }
+  bw[0] = 0.0;
+  for (int j = 1; j <= len; ++j) bw[j] = (double)(j - 5) * tab[j - 1];
+  if (cw != 0.0) /* one soft-double comparison, not one per entry */
+    for (int j = 0; j + 1 < len; ++j) bw[j] += cw * (double)(j + 1) * tab[j + 1];
 }
 
 void imest__bg_tables_weight(bg_tables_t *t, double weight_c)
@@ -37,14 +36,38 @@ void imest__bg_tables_weight(bg_tables_t *t, double weight_c)
   weighted_b(t->e0, 9, t->cw, t->bw0);
 }
 
-BG_NOINLINE static void p_coefficients(bg_tables_t *t)
+/* a1, a0 and, with the weight c_w (0: the paper's cost), bw* */
+BG_NOINLINE static void p_coefficients(bg_tables_t *t, double weight_c)
 {
-  for (int m = 0; m < 7; ++m) t->a1[m] = 2.0 * t->e2[m];
+  for (int m = 0; m < 7; ++m) t->a1[m] = BG_SCALE2(t->e2[m], 1, 2.0);
   for (int m = 0; m < 8; ++m) t->a0[m] = t->e1[m];
-  imest__bg_tables_weight(t, 0.0);
+  imest__bg_tables_weight(t, weight_c);
 }
 
-BG_NOINLINE void imest__bg_tables_scaled(const bg_sums_t *in, int sexp, int gexp, int cexp, bg_tables_t *t)
+/* a + b; 2 a (exact) without the soft-double addition where a and b are the
+ * same number, as in every symmetric R_W the window gives */
+static double pair_sum(double a, double b)
+{
+  union {
+    double d;
+    uint64_t u;
+  } x, y;
+  x.d = a;
+  y.d = b;
+  return (BG_SOFT_DOUBLE && x.u == y.u) ? BG_SCALE2(a, 1, 2.0) : a + b;
+}
+
+/* e2 *= g^2, e1 *= g (exact powers of two) */
+static void scale_g(bg_tables_t *t, int gexp)
+{
+  if (gexp == 0) return;
+  const double g1 = imest__bg_pow2(gexp), g2 = imest__bg_pow2(2 * gexp);
+  for (int m = 0; m < 7; ++m) t->e2[m] = BG_SCALE2(t->e2[m], 2 * gexp, g2);
+  for (int m = 0; m < 8; ++m) t->e1[m] = BG_SCALE2(t->e1[m], gexp, g1);
+}
+
+/* The tables of imest__bg_tables_scaled without a*, bw*. */
+BG_NOINLINE static void tables_fill(const bg_sums_t *in, int sexp, int gexp, int cexp, bg_tables_t *t)
 {
   t->sexp = sexp;
   t->gexp = gexp;
@@ -65,18 +88,20 @@ BG_NOINLINE void imest__bg_tables_scaled(const bg_sums_t *in, int sexp, int gexp
     for (int j = i; j < 8; ++j) {
       const int order = EXP_E[i] + EXP_E[j];
       const int pow_k2 = EXP_F[i] + EXP_F[j];
-      const double rij = (i == j) ? in->rw[i][i] : in->rw[i][j] + in->rw[j][i];
-      table_of(t, order)[pow_k2 + 4] += rij * fs[pow_k2 + 4];
+      const double rij = (i == j) ? in->rw[i][i] : pair_sum(in->rw[i][j], in->rw[j][i]);
+      table_of(t, order)[pow_k2 + 4] += BG_SCALE2(rij, sexp * pow_k2 - cexp, fs[pow_k2 + 4]);
     }
-    table_of(t, EXP_E[i])[EXP_F[i] + 4] += (-2.0 * in->rwy[i]) * fs[EXP_F[i] + 4];
+    const int f = EXP_F[i];
+    table_of(t, EXP_E[i])[f + 4] += BG_SCALE2(BG_SCALE2(-in->rwy[i], 1, 2.0), sexp * f - cexp, fs[f + 4]);
   }
-  t->e0[4] += in->ry * fs[4];
-  if (gexp != 0) {
-    const double g1 = imest__bg_pow2(gexp), g2 = imest__bg_pow2(2 * gexp);
-    for (int m = 0; m < 7; ++m) t->e2[m] *= g2;
-    for (int m = 0; m < 8; ++m) t->e1[m] *= g1;
-  }
-  p_coefficients(t);
+  t->e0[4] += BG_SCALE2(in->ry, -cexp, fs[4]);
+  scale_g(t, gexp);
+}
+
+BG_NOINLINE void imest__bg_tables_scaled(const bg_sums_t *in, int sexp, int gexp, int cexp, bg_tables_t *t)
+{
+  tables_fill(in, sexp, gexp, cexp, t);
+  p_coefficients(t, 0.0);
 }
 
 static int all_finite(const double *v, int n)
@@ -87,6 +112,11 @@ static int all_finite(const double *v, int n)
 }
 
 int imest__bg_tables_build(const bg_sums_t *in, double tr_nominal_s, bg_tables_t *t)
+{
+  return imest__bg_tables_build_weighted(in, tr_nominal_s, 0.0, t);
+}
+
+int imest__bg_tables_build_weighted(const bg_sums_t *in, double tr_nominal_s, double weight_c, bg_tables_t *t)
 {
   if (!all_finite(&in->rw[0][0], 64) || !all_finite(in->rwy, 8) || !imest__bg_finite(in->ry) ||
       !(in->ry > 0.0)) {
@@ -101,7 +131,7 @@ int imest__bg_tables_build(const bg_sums_t *in, double tr_nominal_s, bg_tables_t
 
   /* g from k^ = -sum(e1)/(2 sum(e2)) at kappa = 1 with g = 1; the g scaling
    * is then applied to e2 (g^2) and e1 (g) exactly, without a second pass. */
-  imest__bg_tables_scaled(in, sx, 0, cexp, t);
+  tables_fill(in, sx, 0, cexp, t);
   double se1 = 0.0, se2 = 0.0;
   for (int m = 0; m < 7; ++m) se2 += t->e2[m];
   for (int m = 0; m < 8; ++m) se1 += t->e1[m];
@@ -112,14 +142,10 @@ int imest__bg_tables_build(const bg_sums_t *in, double tr_nominal_s, bg_tables_t
     if (gexp > 200) gexp = 200;
     if (gexp < -200) gexp = -200;
   }
-  if (gexp != 0) {
-    t->gexp = gexp;
-    t->g = imest__bg_pow2(gexp);
-    const double g1 = t->g, g2 = imest__bg_pow2(2 * gexp);
-    for (int m = 0; m < 7; ++m) t->e2[m] *= g2;
-    for (int m = 0; m < 8; ++m) t->e1[m] *= g1;
-    p_coefficients(t);
-  }
+  t->gexp = gexp;
+  t->g = imest__bg_pow2(gexp);
+  scale_g(t, gexp);
+  p_coefficients(t, (weight_c > 0.0) ? weight_c : 0.0);
 
   if (!all_finite(t->e2, 7) || !all_finite(t->e1, 8) || !all_finite(t->e0, 9)) return IMEST_REASON_NUMERIC;
   return IMEST_OK;

@@ -41,6 +41,10 @@ void imest__bg_tables_weight(bg_tables_t *t, double weight_c); /* sets cw, refil
  * IMEST_OK, or IMEST_REASON_NUMERIC for non-finite sums, R_y <= 0 or non-finite
  * tables. */
 int imest__bg_tables_build(const bg_sums_t *in, double tr_nominal_s, bg_tables_t *t);
+/* The same with the weight c_w (cfg.weight_c; <= 0: the paper's cost): what
+ * imest__bg_tables_build and imest__bg_tables_weight give, with bw* formed once. */
+int imest__bg_tables_build_weighted(const bg_sums_t *in, double tr_nominal_s, double weight_c,
+                                    bg_tables_t *t);
 
 /* Values of e2(kappa), e1(kappa), e0(kappa) (polynomials in kappa) and their
  * first and second kappa-derivatives. */

@@ -134,8 +134,8 @@ static void result_from_solve(const bg_step_t *x, const imest_t *s, const bg_sol
     out->k2 = so->k2;
     const double e_noise = fmax(0.0, so->noise_e_k) * x->noise_share; /* bg_solve's, at this K */
     out->e = so->e + x->nz.scale * e_noise;
-    out->e_i = sqrt(out->e / ry_all);
-    out->e_i_noise = sqrt(e_noise / ry_all);
+    out->e_i = BG_SQRT(out->e / ry_all);
+    out->e_i_noise = BG_SQRT(e_noise / ry_all);
     out->hessian[0][0] = so->hessian[0][0];
     out->hessian[0][1] = so->hessian[0][1];
     out->hessian[1][0] = so->hessian[1][0];
