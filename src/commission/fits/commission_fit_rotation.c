@@ -145,7 +145,7 @@ static void rated_point(imest_comm_t *c, uint32_t ns, float psi, float *st)
    inflection the curve is convex, and the first curve level's flux comes out a little above
    its target (0.84 for 0.82 on the saturating 4 and 11 kW motors). A fixed point
    i = flux / L(i), contracting by |dL/di| i / L (0.3 on the 4 kW motor), CURVE_STEPS steps. */
-#define CURVE_STEPS 4
+#define CURVE_STEPS       4
 /* The prediction's largest rise above the lowest level's L_S: the unsaturated L_m is 1.2 to
    1.35 x the rated-flux one (15-25 % saturation); the cap holds only a secant that noise made
    steep on a nearly flat curve. */
