@@ -363,8 +363,11 @@ typedef struct {
    * no-load check compares with when there is no curve. */
   /** the curve's magnetising currents [A], alpha/beta amplitude (sqrt 3 x the phase rms, the unit
    *  of i_rms_a), strictly increasing, positive; piecewise linear between the points, clamped
-   *  outside them (the bound then takes as uncertain the whole difference between the clamped
-   *  value and the end segment's straight continuation) (default 0) */
+   *  outside them, with a bound from what saturation allows (docs/METHOD.md §18.5): below the
+   *  first point the first segment's straight continuation, above the last point the fall of
+   *  L_S to the last point's flux (L_S x_n / i). Cover the flux range the drive runs at:
+   *  commissioning's curve runs from rated flux down to 0.45 of it, field weakening to twice
+   *  base speed (default 0) */
   float ls_curve_i_a[IMEST_LS_CURVE_POINTS];
   /** L_S measured at no load at each of ls_curve_i_a [H], positive (default 0) */
   float ls_curve_h[IMEST_LS_CURVE_POINTS];

@@ -79,15 +79,19 @@
  *   5. With cc.allow_rotation only: a current-fed rotating field at no load, the identified
  *      inverter model as feed-forward: magnetise on the a axis (1 s + 3 T_R), ramp to
  *      speed_frac of rated frequency (ramp_s), then levels of magnetising current, each settled
- *      (1 s + 3 T_R) and measured (>= 1 s, whole electrical periods); ramp down. The first level
- *      is the rated V/f flux's current with the standstill L_S (within 80 % of the staircase's
- *      top); each measured level's L_S sets the next (the background computes it while the ISR
- *      holds the level): the search for the current i* at which the no-load stator flux
- *      L_S(i) i is psi = V_rated / w_rated (at most 4 levels, until a step changes the current
- *      by < 1 %), then 0.85 i* and 0.7 i* for the magnetising curve. On a linear motor the first
- *      level is i* (3 levels in all); on a saturating one, whose standstill L_S is about half
- *      the rated-flux one, 4 to 6. (A voltage-fed V/f run oscillates at no load on a
- *      low-inertia motor.)
+ *      (1 s + 3 T_R) and measured (>= 1 s, whole electrical periods); ramp down. Every level
+ *      stays within the staircase's top (a phase peak of level_frac * i_max_a, which the
+ *      standstill part has driven already); the first is the rated flux's current with the
+ *      standstill L_S (within 80 % of that top); each measured level's L_S sets the next (the
+ *      background computes it while the ISR holds the level): the search for the current i* at
+ *      which the no-load stator flux L_S(i) i is the rated flux psi, the stator flux at rated
+ *      voltage and frequency at no load, V_rated / (w_rated sqrt(1 + (R_S / (w_rated L_S))^2))
+ *      (the R_S drop taken off; at most 4 levels, until a step changes the current by < 1 %),
+ *      then 3 levels for the magnetising curve at 0.82, 0.63 and 0.45 of the rated point's flux
+ *      (field weakening to twice base speed: half the flux, less the load's drops). On a linear
+ *      motor the first level is i* (4 levels in all); on a saturating one, whose standstill L_S
+ *      is about half the rated-flux one, 5 to 7. (A voltage-fed V/f run oscillates at no load
+ *      on a low-inertia motor.)
  *   The routine ends with zero voltage; its ISR call then returns 0 and the background call
  *   completes the result. Measured totals: 10.4 s at standstill for a 4 kW motor (T_R 128 ms;
  *   the slip-frequency test 2.0 s of it, at most 5.3 A of the 11.6 A limit), 38.7 s for 37 kW
@@ -136,12 +140,16 @@
  *   - L_S (rotating): reactive part of the impedance at the field's frequency, from the commanded
  *     voltage (the inverter error compensated by its model) and the current, demodulated at the
  *     commanded angle; at no load the slip is ~1e-4, and is corrected for. Reported at the rated
- *     V/f flux: interpolated (linearly in the current) between the search's last two levels to
+ *     flux psi: interpolated (linearly in the current) between the search's last two levels to
  *     the current where L_S i = psi; the flux a drive runs at in its base speed range, where
  *     the estimator needs L_S (a saturating motor's L_m there is 15-25 % below unsaturated).
  *     If the current limit stops the search below psi, at that limit (the flux is then lower).
- *   - the magnetising curve (ls_curve_*): L_S at 0.7 i*, 0.85 i*, i* and at the first level if it
- *     ran above 1.05 i*, each measured as L_S; its spread is L_S's flux dependence.
+ *   - the magnetising curve (ls_curve_*): L_S at the three curve levels and at i*, each measured
+ *     as L_S; the levels' fluxes spread evenly from the rated point's down to 0.45 of it, the
+ *     flux range a drive runs at from base speed to field weakening at twice base speed (each
+ *     level's current: its flux over L_S predicted from the levels measured before it, high
+ *     where a saturating curve is concave, below about 0.85 of rated flux, so the lowest level's
+ *     flux is at or below its target); its spread is L_S's flux dependence.
  *   - n_p, encoder direction and counts: the ratio of the commanded electrical frequency to the
  *     measured mechanical speed is dir * n_p * cpr_assumed / cpr_true. With cc.rated_speed_rpm,
  *     n_p = floor(60 f_rated / n_rated) (the nameplate is the only independent evidence: a
@@ -404,7 +412,7 @@ typedef struct {
   float rotor_moved_rad;              /**< largest angle change during the standstill part [rad] */
 
   /* rotating */
-  /** stator inductance L_S [H]: rotating, at the rated V/f flux (else standstill). std_rel: the
+  /** stator inductance L_S [H]: rotating, at the rated flux (else standstill). std_rel: the
    *  interpolation's correction to the nearest level, at least 0.1 % (the rotating measurement's
    *  repeatability); spread_rel: (max - min) / L_S over the magnetising curve, L_S's flux
    *  dependence (below 0.5 % on a linear motor, 30-40 % on a saturating one) */
@@ -423,8 +431,10 @@ typedef struct {
   float rotating_i_a;  /**< magnetising current at rated flux (alpha/beta amplitude) [A] */
   float rotating_f_hz; /**< electrical frequency of the rotating run [Hz] */
   /** the magnetising curve (rotating; 0 points otherwise): L_S at no load against the
-   *  magnetising current, in increasing current: 0.7 and 0.85 of rotating_i_a, the rated point
-   *  (= ls_h) and, if the first level ran above 1.05 rotating_i_a, that level. 2 to 4 points */
+   *  magnetising current, in increasing current: the three curve levels, at about 0.45, 0.63
+   *  and 0.82 of the rated point's flux (the lowest at or below it), then the rated point (= ls_h, at
+   *  rotating_i_a). From base speed to field weakening at twice base speed (imest.h,
+   *  ls_curve_i_a, for the estimator's use of it outside the points). 2 to 4 points */
   unsigned int ls_curve_points;
   float ls_curve_i_a[4]; /**< magnetising current of each point (alpha/beta amplitude) [A] */
   float ls_curve_h[4];   /**< L_S at that current [H] (each point's uncertainty: ls_h.std_rel) */

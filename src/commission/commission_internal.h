@@ -75,12 +75,22 @@ enum {
 };
 
 /* Levels of the rotating run (commission_rotate.c, commission_fit_rotation.c): up to
-   CM_ROT_SEARCH levels searching the current that gives the rated flux, then the curve's two
-   lower levels. The blocks are free while the field turns (the standstill fits are done before it
-   starts): blk[level].s[] holds each level's figures (background), blk[CM_ROT_LEVELS].s[] the
-   search's state and the next level's current the background sets for the ISR (0: done). */
-#define CM_ROT_SEARCH 4u
-#define CM_ROT_LEVELS (CM_ROT_SEARCH + 2u)
+   CM_ROT_SEARCH levels searching the current that gives the rated flux, then the curve's
+   CM_ROT_CURVE lower levels, at fluxes spread evenly from rated down to CM_ROT_FLUX_MIN of it
+   (with the rated point, IMEST_LS_CURVE_POINTS points). The blocks are free while the field
+   turns (the standstill fits are done before it starts): blk[level].s[] holds each level's
+   figures (background), blk[CM_ROT_LEVELS].s[] the search's state and the next level's current
+   the background sets for the ISR (0: done). */
+#define CM_ROT_SEARCH     4u
+#define CM_ROT_CURVE      (IMEST_LS_CURVE_POINTS - 1u)
+#define CM_ROT_LEVELS     (CM_ROT_SEARCH + CM_ROT_CURVE)
+/* The curve's lowest flux, a fraction of the rated flux: field weakening to twice base speed.
+   At the voltage limit the flux falls as 1/f, to half at 2x, less the R_S and leakage drops of
+   the load's current, which at rated power take up to a tenth of the voltage (the envelope's
+   motors at 2x and rated power: 0.46 to 0.48 of the rated flux). */
+#define CM_ROT_FLUX_MIN   (0.5f * 0.9f)
+/* The first level's current, a fraction of the levels' limit (commission_rotate.c). */
+#define CM_ROT_FIRST_FRAC 0.8f
 enum { CM_LV_I = 0, CM_LV_LS, CM_LV_ZR };
 enum { CM_LB_NEXT = 0, CM_LB_NSEARCH, CM_LB_I, CM_LB_LS, CM_LB_STD };
 

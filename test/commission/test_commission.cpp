@@ -126,24 +126,42 @@ TEST_P(CommissionMotor, ThenTheEstimatorOnTheDutyCyclesGetsTrWithinOnePercent)
   if (id.tr_valid > 0) EXPECT_LT(std::fabs(id.tr_rel), 0.01);
 }
 
+// The curve's levels: their fluxes L_S i against the rated point's, evenly from 1 down to the
+// lowest (commissioning's CM_ROT_FLUX_MIN, 0.45: field weakening to twice base speed, where the
+// drive's flux is 0.46-0.48 of rated at rated power on the envelope's motors). Each level is set
+// from a predicted L_S: high where the curve is concave (below about 0.85 of rated flux), so the
+// lowest level's flux is at or below its target, by less than 3 % of the rated flux (measured
+// 0.3 ... 1.5 %); the highest, where a saturating curve is convex, within 3 % either way
+// (measured up to +1.8 %).
+constexpr double kFluxFw2 = 0.46; // field weakening to 2x base speed at rated power
+void expect_curve_spans_field_weakening(const imest_comm_result_t &r)
+{
+  ASSERT_EQ(r.ls_curve_points, 4u);
+  const double flux_rated = (double)r.ls_curve_h[3] * r.ls_curve_i_a[3];
+  const double target[3] = {0.45, 0.45 + 0.55 / 3.0, 0.45 + 1.1 / 3.0};
+  for (unsigned int j = 0; j < 3u; ++j) {
+    const double f = (double)r.ls_curve_h[j] * r.ls_curve_i_a[j] / flux_rated;
+    EXPECT_LE(f, target[j] + (j == 0u ? 0.005 : 0.03)) << "point " << j;
+    EXPECT_GT(f, target[j] - 0.03) << "point " << j;
+  }
+  EXPECT_LT((double)r.ls_curve_h[0] * r.ls_curve_i_a[0] / flux_rated, kFluxFw2);
+}
+
 // The magnetising curve of a linear motor is flat: L_S the same at every level (within the
-// rotating measurement's own error), the rated point found with the first level.
+// rotating measurement's own error), the rated point found with the first level: the rated
+// flux's current also on the paper's motor, whose R_S drop (R_S / (w L_S) 0.05) and small
+// current limit (the staircase's top, 1.1 x the rated flux's current) once held it at 0.84 of it.
 TEST_P(CommissionMotor, LinearMotorHasAFlatCurveAtRatedFlux)
 {
   const comm_sim_out_t out = run(opts(GetParam()));
   const imest_comm_result_t &r = out.r;
   ASSERT_TRUE(r.valid);
-  ASSERT_EQ(r.ls_curve_points, 3u); // 0.7, 0.85 and 1 x the rated current
-  EXPECT_FLOAT_EQ(r.ls_curve_h[2], r.ls_h.value);
-  EXPECT_FLOAT_EQ(r.ls_curve_i_a[2], r.rotating_i_a);
+  expect_curve_spans_field_weakening(r);
+  EXPECT_FLOAT_EQ(r.ls_curve_h[3], r.ls_h.value);
+  EXPECT_FLOAT_EQ(r.ls_curve_i_a[3], r.rotating_i_a);
   for (unsigned int j = 0; j < r.ls_curve_points; ++j)
     EXPECT_LT(std::fabs(rel(r.ls_curve_h[j], out.ls_h)), 0.01) << "point " << j;
-  EXPECT_NEAR(r.ls_curve_i_a[0] / r.ls_curve_i_a[2], 0.7, 0.01);
-  EXPECT_NEAR(r.ls_curve_i_a[1] / r.ls_curve_i_a[2], 0.85, 0.01);
-  // the rated flux's current, or the run's limit (80 % of the staircase's top, alpha/beta)
-  // where that is lower (the paper's motor)
-  const double i_lim = 0.8 * out.cc.level_frac * out.cc.i_max_a * std::sqrt(1.5);
-  EXPECT_LT(std::fabs(rel(r.rotating_i_a, std::fmin(out.i_rated_flux_a, i_lim))), 0.01);
+  EXPECT_LT(std::fabs(rel(r.rotating_i_a, out.i_rated_flux_a)), 0.01);
   EXPECT_LT(r.ls_h.spread_rel, 0.01f);              // no flux dependence to speak of
   EXPECT_LT(r.ls_h.std_rel, 0.01f);                 // also the curve's points'
   EXPECT_FALSE(r.flags & IMEST_COMM_FLAG_ROTOR_HF); // a single cage
@@ -152,9 +170,11 @@ TEST_P(CommissionMotor, LinearMotorHasAFlatCurveAtRatedFlux)
 // A saturating motor (the simulator's static magnetising curve, L_m at rated flux 25 % below
 // unsaturated; and the preset's real motor: saturation, iron loss, double cage): the standstill
 // L_S is about half the rated-flux one, which once set the rotating run 10-19 % too low. The
-// levels now find the rated flux: L_S within 2 % of L_S there, each point of the curve within
-// 2 % of the truth at its current, and the flux dependence reported. T_R (standstill) is as far
-// off as before; its reported spread says so.
+// levels now find the rated flux: L_S within 2 % of L_S there, the flux within 1 %, each point of
+// the curve within 2 % of the truth at its current, the curve down to field weakening's flux, and
+// the flux dependence reported. Also on the paper's 0.4 kW motor (exp1, saturation 0.25), small
+// and of high R_S, which its current limit once held at 0.84 of the rated flux's current (L_S
+// +9.6 %). T_R (standstill) is as far off as before; its reported spread says so.
 struct SatCase {
   const char *preset;
   int real_motor;
@@ -178,8 +198,8 @@ TEST_P(CommissionSaturating, LsAtRatedFluxAndTheCurveWithinTwoPercent)
   ASSERT_TRUE(r.valid);
   EXPECT_LT(std::fabs(rel(r.ls_h.value, out.ls_h)), 0.02);
   EXPECT_LT(std::fabs(rel(r.rotating_i_a, out.i_rated_flux_a)), 0.02);
-  ASSERT_GE(r.ls_curve_points, 3u);
-  ASSERT_LE(r.ls_curve_points, 4u);
+  EXPECT_LT(std::fabs(rel((double)r.ls_h.value * r.rotating_i_a, out.ls_h * out.i_rated_flux_a)), 0.01);
+  expect_curve_spans_field_weakening(r);
   for (unsigned int j = 0; j < r.ls_curve_points; ++j) {
     double ls_true = 0.0;
     ASSERT_EQ(comm_sim_true_at(&out.sim, r.ls_curve_i_a[j], &ls_true, nullptr, nullptr), 0);
@@ -189,7 +209,7 @@ TEST_P(CommissionSaturating, LsAtRatedFluxAndTheCurveWithinTwoPercent)
       EXPECT_LT(r.ls_curve_h[j], r.ls_curve_h[j - 1]); // saturating: L_S falls with the current
     }
   }
-  // the flux dependence is reported: L_S over the curve (0.7 rated current and up) changes by more
+  // the flux dependence is reported: L_S over the curve (0.45 rated flux and up) changes by more
   // than 10 %, and T_R's spread covers the standstill T_R's error at rated flux
   EXPECT_GT(r.ls_h.spread_rel, 0.1f);
   EXPECT_GE(r.sigma.spread_rel, r.ls_h.spread_rel);
@@ -216,7 +236,8 @@ TEST_P(CommissionSaturating, LsAtRatedFluxAndTheCurveWithinTwoPercent)
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, CommissionSaturating,
-                         ::testing::Values(SatCase{"4kw", 0}, SatCase{"11kw", 0}, SatCase{"4kw", 1}),
+                         ::testing::Values(SatCase{"4kw", 0}, SatCase{"11kw", 0}, SatCase{"4kw", 1},
+                                           SatCase{"exp1", 0}),
                          [](const ::testing::TestParamInfo<SatCase> &i) {
                            return std::string("m") + i.param.preset + (i.param.real_motor ? "_real" : "_sat");
                          });

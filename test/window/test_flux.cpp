@@ -119,7 +119,10 @@ TEST(FluxCurve, PiecewiseLinearWithItsStatedError)
   EXPECT_NEAR(err, 0.75f * 0.25f * 2.0f * 0.01f, 1e-6f);
 }
 
-TEST(FluxCurve, ClampedOutsideWithTheStraightContinuationAsItsError)
+// Outside the points the end value, with what saturation allows as its error: below the first
+// point the first segment's straight continuation (a concave curve stays under it), above the
+// last the fall to the last point's flux (L_S i no lower than there).
+TEST(FluxCurve, ClampedOutsideWithWhatSaturationAllowsAsItsError)
 {
   imest_config_t c = base_config();
   set_curve(c, {{3.0, 0.23}, {5.0, 0.21}, {7.0, 0.17}});
@@ -127,7 +130,10 @@ TEST(FluxCurve, ClampedOutsideWithTheStraightContinuationAsItsError)
   EXPECT_FLOAT_EQ(curve_ls(c, 1.0f, &err), 0.23f);
   EXPECT_NEAR(err, 0.01f * 2.0f, 1e-6f); // first segment's slope x 2 A
   EXPECT_FLOAT_EQ(curve_ls(c, 8.0f, &err), 0.17f);
-  EXPECT_NEAR(err, 0.02f * 1.0f, 1e-6f); // last segment's slope x 1 A
+  EXPECT_NEAR(err, 0.17f * (1.0f - 7.0f / 8.0f), 1e-6f); // y_n (1 - x_n / i): the flux held
+  EXPECT_GT(err, 0.02f * 1.0f) << "more than the last segment's slope x 1 A";
+  EXPECT_FLOAT_EQ(curve_ls(c, 14.0f, &err), 0.17f);
+  EXPECT_NEAR(err, 0.17f * 0.5f, 1e-6f) << "twice the last point's current: L_S down to half";
   EXPECT_FLOAT_EQ(curve_ls(c, 7.0f, &err), 0.17f) << "the last point itself";
   EXPECT_NEAR(err, 0.0f, 1e-9f);
 }

@@ -239,9 +239,16 @@ int comm_sim_run(const comm_sim_opts_t *o, comm_sim_out_t *out)
     free(simp);
     return -1;
   }
-  /* truth, at the rated V/f flux (no load) */
-  const double psi_rated = (double)out->cc.rated_voltage_v / (TWO_PI * (double)out->cc.rated_freq_hz);
-  out->i_rated_flux_a = comm_sim_current_at_flux(sc, psi_rated);
+  /* truth, at the rated flux: the stator flux at rated voltage and frequency at no load, the
+     R_S drop (in quadrature with the flux's voltage) taken off, at the motor's own L_S there */
+  const double wn = TWO_PI * (double)out->cc.rated_freq_hz, psi_vf = (double)out->cc.rated_voltage_v / wn;
+  out->i_rated_flux_a = comm_sim_current_at_flux(sc, psi_vf);
+  for (int it = 0; it < 3; ++it) {
+    double ls = sc->ls_h;
+    (void)comm_sim_true_at(sc, out->i_rated_flux_a, &ls, NULL, NULL);
+    const double x = sc->rs_ohm / (wn * ls);
+    out->i_rated_flux_a = comm_sim_current_at_flux(sc, psi_vf / sqrt(1.0 + x * x));
+  }
   out->ls_h = sc->ls_h;
   out->sigma = sc->sigma;
   out->tr_s = sc->tr_s;

@@ -50,10 +50,10 @@ typedef struct {
 } comm_sim_opts_t;
 
 typedef struct {
-  /* truth; L_S, sigma, sigma*L_S, T_R, L_m and R_R' at the rated V/f flux at no load (the
-     stator flux amplitude rated_voltage_v / (2 pi rated_freq_hz), the flux the routine's rotating
-     run aims at): with saturation they depend on the flux (comm_sim_true_at); for a linear motor
-     they are the preset's */
+  /* truth; L_S, sigma, sigma*L_S, T_R, L_m and R_R' at the rated flux at no load (the stator
+     flux amplitude at rated voltage and frequency, rated_voltage_v / (2 pi rated_freq_hz) less
+     the R_S drop, the flux the routine's rotating run aims at): with saturation they depend on
+     the flux (comm_sim_true_at); for a linear motor they are the preset's */
   double rs_ohm, ls_h, sigma, sigma_ls_h, tr_s, lm_h, rr_ohm;
   double i_rated_flux_a; /* magnetising current at that flux (alpha/beta amplitude) [A] */
   double ls_preset_h;    /* the preset's L_S (= ls_h for a linear motor) */

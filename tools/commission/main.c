@@ -467,7 +467,7 @@ int main(int argc, char **argv)
   row("L_S [mH]", 1e3, (double)r->ls_h.value, out.ls_h, note);
   if (fabs(out.ls_preset_h - out.ls_h) > 1e-9 * out.ls_h)
     printf("  %-26s %s %.5g mH (the preset's, at rated load's main flux)\n", "",
-           "true values at the rated V/f flux at no load; L_S", 1e3 * out.ls_preset_h);
+           "true values at the rated flux at no load; L_S", 1e3 * out.ls_preset_h);
   row("sigma", 1.0, (double)r->sigma.value, out.sigma,
       (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP) ? "rotor_hf: sigma*L_S from the slip-frequency test"
       : (r->flags & IMEST_COMM_FLAG_ROTOR_HF)

@@ -38,12 +38,20 @@ void imest__cm_rotate_begin(imest_comm_t *c)
   c->axis = 0u;
   c->we = 0.0f;
   c->we_test = IMEST_2PI_F * c->cfg.speed_frac * c->cfg.rated_freq_hz;
-  c->psi = c->cfg.rated_voltage_v / (IMEST_2PI_F * c->cfg.rated_freq_hz);
-  /* the first level: the rated magnetising current with the standstill L_S, within 80 % of the
-     top level (psi_im: that limit holds for every level) */
-  c->psi_im = 0.8f * c->level_a;
+  /* The rated flux: the stator flux at rated voltage and frequency at no load, where
+     V = (R_S + j w L_S) I and the flux is L_S I, so psi = V / (w sqrt(1 + (R_S / (w L_S))^2)):
+     the R_S drop, in quadrature with the flux's voltage, taken off (0.1 % on the 0.4 kW motor,
+     R_S / (w L_S) 0.05; with the standstill L_S, which a saturating motor makes low, the drop
+     is overstated by at most 0.05 % of psi). */
+  const float wn = IMEST_2PI_F * c->cfg.rated_freq_hz, x = c->res.rs_ohm.value / (wn * c->ls_ss);
+  c->psi = c->cfg.rated_voltage_v / (wn * imest__sqrt(1.0f + x * x));
+  /* The levels' limit: the staircase's top, the current the standstill part has driven through
+     every phase already (alpha/beta amplitude level_a: a phase peak of level_frac i_max_a). The
+     first level, the rated flux's current with the standstill L_S, starts below it
+     (CM_ROT_FIRST_FRAC): on a saturating motor that L_S is low and the current high. */
+  c->psi_im = c->level_a;
   float im = c->psi / c->ls_ss;
-  if (im > c->psi_im) im = c->psi_im;
+  if (im > CM_ROT_FIRST_FRAC * c->psi_im) im = CM_ROT_FIRST_FRAC * c->psi_im;
   c->i_ref = im;
   c->plateau = 0u; /* the level */
   c->ph_c = 1.0f;

@@ -37,6 +37,7 @@ static float seg_slope(const float *x, const float *y, uint32_t k)
   return (y[k + 1u] - y[k]) / (x[k + 1u] - x[k]);
 }
 
+/* the bounds outside the points: bg_flux.h */
 float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
 {
   const uint32_t n = s->ls_curve_points;
@@ -51,7 +52,7 @@ float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
     return y[0];
   }
   if (!(i_a < x[n - 1u])) {
-    *err_h = fabsf(slope) * (i_a - x[n - 1u]);
+    *err_h = y[n - 1u] * (1.0f - x[n - 1u] / i_a);
     return y[n - 1u];
   }
   const float t = (i_a - x[k]) / h;

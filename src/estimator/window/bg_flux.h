@@ -30,9 +30,18 @@ typedef struct {
  * slope changes by D along the segment, twice the parabola's (a saturation
  * curve bends more towards high flux than its points show: 4 kW, points at
  * 0.6 .. 1.05 x rated voltage, the chord 0.6 % above the curve at rated load,
- * this rule 0.4 %); outside the points, the whole difference between the
- * clamped value and the end segment's straight continuation. Without a curve:
- * ls_h, *err_h 0. */
+ * this rule 0.4 %). Outside the points, a bound from what saturation allows:
+ * the static L_S does not rise with the current, and the flux L_S i does not
+ * fall with it. Below the first point (x_0, y_0) L_S is then at least y_0,
+ * and, the curve concave there (a saturation curve is below about 0.85 of
+ * rated flux; commissioning's first point is at 0.45 of it, the flux of field
+ * weakening to twice base speed), at most the first segment's straight
+ * continuation: *err_h =
+ * |s_0| (x_0 - i_a), s_0 that segment's slope. Above the last point (x_n, y_n)
+ * L_S is at most y_n and at least y_n x_n / i_a (the flux no lower than at
+ * x_n): *err_h = y_n (1 - x_n / i_a), which a curve that bends down beyond its
+ * last point, as saturation does, can reach and the last segment's slope
+ * need not. Without a curve: ls_h, *err_h 0. */
 float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h);
 
 /* With a curve and where the steady-state picture holds (an estimate, the
