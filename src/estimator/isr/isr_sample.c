@@ -384,8 +384,6 @@ int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float
   isr_duty_k_t k;
   k.kp = wp * vdc_prev;
   k.kn = wn * vdc;
-  k.vdc = vdc;
-  k.vdc_prev = vdc_prev;
   const imest_real_t vbar = k.kp + k.kn;
   k.kt = m->td_f_half * vbar;
   const imest_real_t kr = m->ripple_per_v * vbar;
