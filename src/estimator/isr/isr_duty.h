@@ -14,8 +14,8 @@
 /* Per-sample constants shared by the three legs. */
 typedef struct {
   imest_real_t kp, kn; /* w_prev V_dc,prev and w_now V_dc: a leg's voltage is kp dp + kn d */
-  imest_real_t kt;    /* t_d f V_dc / 2 at the weighted bus voltage */
-  imest_real_t band2; /* b^2: the devices' own smoothing, or the smooth sign's band */
+  imest_real_t kt;     /* t_d f V_dc / 2 at the weighted bus voltage */
+  imest_real_t band2;  /* b^2: the devices' own smoothing, or the smooth sign's band */
 } isr_duty_k_t;
 
 /* The phase current's ripple at each leg's edges [A] (docs/METHOD.md §17.1):
