@@ -5,8 +5,11 @@ The simulator writes a CSV to a temporary file; imest-replay reads it exactly as
 an awk pass averages the simulator's truth columns over the replay's windows (window k = data
 rows k*N .. k*N+N-1, N samples per window). The CSV is deleted afterwards.
 """
+import argparse
 import os
+import re
 import subprocess
+import sys
 
 import motors
 import points
@@ -161,3 +164,26 @@ def run_point(p, sim, replay, work, duration_s, extra_replay=(), keep=False):
     if not keep and os.path.exists(csv_path):
         os.remove(csv_path)
     return err
+
+
+# the checkout's top: this file is tools/studies/envelope/simulate.py
+_TOP = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+
+
+def print_version(prog):
+    """NAME VERSION (include/imest/imest_version.h) and the licence, as the compiled tools."""
+    with open(os.path.join(_TOP, "include", "imest", "imest_version.h"), encoding="utf-8") as f:
+        v = re.search(r'^#define IMEST_VERSION_STRING "([^"]+)"', f.read(), re.M).group(1)
+    print("%s %s\nLicence: Apache License 2.0 <https://www.apache.org/licenses/LICENSE-2.0>" % (prog, v))
+
+
+class ArgParser(argparse.ArgumentParser):
+    """argparse with the messages of every imest tool: "NAME: unknown option '--x'" and
+    "Try 'NAME --help'." on stderr, exit 2."""
+
+    def error(self, message):
+        m = re.match(r"unrecognized arguments: (\S+)", message)
+        if m:
+            message = "unknown option '%s'" % m.group(1)
+        sys.stderr.write("%s: %s\nTry '%s --help'.\n" % (self.prog, message, self.prog))
+        sys.exit(2)
