@@ -95,8 +95,8 @@
  *   The routine ends with zero voltage; its ISR call then returns 0 and the background call
  *   completes the result. Measured totals: 10.4 s at standstill for a 4 kW motor (T_R 128 ms;
  *   the slip-frequency test 2.0 s of it, at most 5.3 A of the 11.6 A limit), 38.7 s for 37 kW
- *   (T_R 553 ms; the test 8.5 s, 45.6 A of 96 A), plus 12.5 to 18 s of rotation (19 s for the 4 kW motor with
- *   saturation, 24 s for 11 kW; README, Commissioning).
+ *   (T_R 553 ms; the test 8.5 s, 45.6 A of 96 A), plus 15 to 21.5 s of rotation (21.4 s for the 4 kW motor with
+ *   saturation, 26.9 s for 11 kW; README, Commissioning, tools/commission/readme-tables).
  *
  * What is measured, and how (per axis, then combined; the spread between the three axes is
  * reported as a quality figure for each quantity):
