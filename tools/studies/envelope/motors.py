@@ -11,7 +11,6 @@ the rotor flux at its rated value: the ideal IR-compensated V/f of a drive. A pl
 would weaken the field at low frequency (the stator resistance drop) and stall the small motors
 at 5 % of rated frequency under load.
 """
-import cmath
 import math
 
 # name, kW, sim preset, extra imest-sim flags, rated V_ll [V] at rated f [Hz], rated torque [N m],

@@ -9,7 +9,7 @@ about 7000 recordings; the design keeps what the goals need:
   part with load >= 25 % and frequency >= 15 % is the goal region, sampled on every point.
 * sweeps: one dimension at a time away from the goal sensors (ideal or 16-bit ADCs; 1024, 4096
   or 65536 counts; the duty-cycle input with an ideal inverter and with dead time and device
-  drops whose model is given), each on a sub-grid of every motor x 4 frequencies x 3 loads
+  drops whose model is given; measured voltages of a sine source), each on a sub-grid of every motor x 4 frequencies x 3 loads
   that reaches the envelope's corners (5 % frequency, 10 % load).
 
 The reduced form (CTest) is a handful of points from both.
@@ -40,6 +40,9 @@ SWEEPS = [
     ("encoder_65536", dict(encoder=65536)),
     ("duty_ideal", dict(input="duty")),
     ("duty_inverter", dict(input="duty_inv")),
+    # measured voltages of a smooth source (a line-fed motor, or a drive whose voltage channel is
+    # filtered): the sine supply, the estimator told so (--voltage-kind smooth)
+    ("sine_source", dict(input="sine")),
 ]
 
 # Dead time and device drops of the duty_inv variant (an IGBT inverter), given to the estimator.
