@@ -29,13 +29,8 @@ double imest__cm_exp(double x)
     p = 1.0 + p * r / n;
     n -= 1.0;
   }
-  /* 2^k by squaring (exact; |k| <= 1010, at most 10 rounds) */
-  double b = k < 0 ? 0.5 : 2.0;
-  for (uint32_t e = (uint32_t)(k < 0 ? -k : k); e != 0u; e >>= 1) {
-    if (e & 1u) p *= b;
-    b *= b;
-  }
-  return p;
+  /* times 2^k by the exponent (the estimator's, exact: |k| <= 1010 keeps p 2^k normal) */
+  return imest__bg_scale2(p, k);
 }
 
 void imest__cm_decay_init(cm_decay_t *d, double ts, double tau)
