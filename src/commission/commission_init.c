@@ -91,7 +91,8 @@ static int check_ok(const imest_comm_config_t *cc, const cm_check_t *k)
   /* the two bounds that involve another field */
   if (k->offset == offsetof(imest_comm_config_t, pwm_hz)) return !(x > 0.0f && x < cc->fs_hz);
   if (k->offset == offsetof(imest_comm_config_t, rated_speed_rpm))
-    return !(x > 0.0f && imest__in_range(cc->rated_freq_hz, 0.0f, 1, CM_NO_HI) && x >= 60.0f * cc->rated_freq_hz);
+    return !(x > 0.0f && imest__in_range(cc->rated_freq_hz, 0.0f, 1, CM_NO_HI) &&
+             x >= 60.0f * cc->rated_freq_hz);
   return 1;
 }
 
