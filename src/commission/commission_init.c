@@ -3,10 +3,12 @@
  * Runs outside the ISR (init) or reads only. float32: sample counts to the nearest sample,
  * below 2^24 for any configured time and rate but time_max_s (where a few samples do not
  * matter), and rates that are floats already. */
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 
 #include "commission_internal.h"
+#include "common/imest_range.h" /* imest__in_range, as the tracker's and temperatures' checks */
 
 /* Copies n chars (src NULL: zeroes): a struct assignment would call memcpy, which nothing else
    in the library links (0.3 KB on a Cortex-M4F); no <string.h> in the core. */
@@ -44,12 +46,56 @@ void imest_comm_config_default(imest_comm_config_t *cc)
   cc->ramp_s = 2.0f;
 }
 
-static int pos(float x)
+/* The config's fields and their ranges, checked in order by one loop (a table takes a fraction
+   of the flash of a comparison chain, as the estimator's config check says): finite and
+   lo <= x <= hi, with the flags' open ends, hi times fs_hz (checked first) where CK_HI_FS, only
+   with allow_rotation where CK_ROT; n_sensors (unsigned) as a float, exact for 2 and 3. */
+enum { CK_LO_OPEN = 1, CK_HI_OPEN = 2, CK_HI_FS = 4, CK_ROT = 8, CK_UINT = 16 };
+typedef struct {
+  unsigned short offset, flags;
+  float lo, hi;
+  const char *name;
+} cm_check_t;
+#define CM_NO_HI FLT_MAX /* finite is the only upper bound */
+#define CK(f, flags, lo, hi)                                                                                 \
+  {                                                                                                          \
+    (unsigned short)offsetof(imest_comm_config_t, f), flags, lo, hi, #f                                      \
+  }
+static const cm_check_t k_checks[] = {
+    CK(fs_hz, 0, 1000.0f, 1.0e5f),
+    CK(pwm_hz, CK_HI_FS, 0.0f, 64.0f), /* and 0 or at least fs_hz (below) */
+    CK(i_max_a, CK_LO_OPEN, 0.0f, 1.0e5f),
+    CK(level_frac, 0, 0.1f, 0.95f),
+    CK(v_max_v, 0, 0.0f, CM_NO_HI),
+    CK(time_max_s, CK_LO_OPEN, 0.0f, 3600.0f),
+    CK(tr_max_s, 0, 0.01f, 20.0f),
+    CK(n_sensors, CK_UINT, 2.0f, 3.0f),
+    CK(encoder_cpr, CK_HI_OPEN, 0.0f, 1.0e9f),
+    CK(r_series_ohm, 0, 0.0f, CM_NO_HI),
+    CK(rated_voltage_v, CK_ROT | CK_LO_OPEN, 0.0f, CM_NO_HI),
+    CK(rated_freq_hz, CK_ROT | CK_LO_OPEN | CK_HI_OPEN | CK_HI_FS, 0.0f, 0.1f),
+    CK(rated_speed_rpm, 0, 0.0f, CM_NO_HI), /* and below 60 rated_freq_hz if both known (below) */
+    CK(speed_frac, 0, 0.05f, 1.0f),
+    CK(ramp_s, 0, 0.1f, 60.0f),
+};
+#undef CK
+
+static int check_ok(const imest_comm_config_t *cc, const cm_check_t *k)
 {
-  return isfinite(x) && x > 0.0f;
+  const void *p = (const char *)cc + k->offset;
+  const float x = (k->flags & CK_UINT) ? (float)*(const unsigned int *)p : *(const float *)p;
+  const float hi = (k->flags & CK_HI_FS) ? k->hi * cc->fs_hz : k->hi;
+  if ((k->flags & CK_ROT) && !cc->allow_rotation) return 1;
+  if (!imest__in_range(x, k->lo, (k->flags & CK_LO_OPEN) != 0, hi)) return 0;
+  if ((k->flags & CK_HI_OPEN) && !(x < hi)) return 0;
+  /* the two bounds that involve another field */
+  if (k->offset == offsetof(imest_comm_config_t, pwm_hz)) return !(x > 0.0f && x < cc->fs_hz);
+  if (k->offset == offsetof(imest_comm_config_t, rated_speed_rpm))
+    return !(x > 0.0f && imest__in_range(cc->rated_freq_hz, 0.0f, 1, CM_NO_HI) &&
+             x >= 60.0f * cc->rated_freq_hz);
+  return 1;
 }
 
-// NOLINTNEXTLINE(readability-function-cognitive-complexity): a flat else-if list, one bound per field
 int imest_comm_config_check(const imest_comm_config_t *cc, const char **field)
 {
   const char *bad = NULL;
@@ -57,40 +103,8 @@ int imest_comm_config_check(const imest_comm_config_t *cc, const char **field)
     if (field) *field = "cc";
     return IMEST_ERR_NULL;
   }
-  const float fs = cc->fs_hz;
-  if (!pos(fs) || fs < 1000.0f || fs > 1.0e5f)
-    bad = "fs_hz";
-  else if (!(isfinite(cc->pwm_hz) && cc->pwm_hz >= 0.0f) ||
-           (cc->pwm_hz > 0.0f && (cc->pwm_hz < cc->fs_hz || cc->pwm_hz > 64.0f * cc->fs_hz)))
-    bad = "pwm_hz";
-  else if (!pos(cc->i_max_a) || cc->i_max_a > 1.0e5f)
-    bad = "i_max_a";
-  else if (!(isfinite(cc->level_frac) && cc->level_frac >= 0.1f && cc->level_frac <= 0.95f))
-    bad = "level_frac";
-  else if (!(isfinite(cc->v_max_v) && cc->v_max_v >= 0.0f))
-    bad = "v_max_v";
-  else if (!pos(cc->time_max_s) || cc->time_max_s > 3600.0f)
-    bad = "time_max_s";
-  else if (!(isfinite(cc->tr_max_s) && cc->tr_max_s >= 0.01f && cc->tr_max_s <= 20.0f))
-    bad = "tr_max_s";
-  else if (cc->n_sensors != 2u && cc->n_sensors != 3u)
-    bad = "n_sensors";
-  else if (!(isfinite(cc->encoder_cpr) && cc->encoder_cpr >= 0.0f && cc->encoder_cpr < 1.0e9f))
-    bad = "encoder_cpr";
-  else if (!(isfinite(cc->r_series_ohm) && cc->r_series_ohm >= 0.0f))
-    bad = "r_series_ohm";
-  else if (cc->allow_rotation && !pos(cc->rated_voltage_v))
-    bad = "rated_voltage_v";
-  else if (cc->allow_rotation && !(pos(cc->rated_freq_hz) && cc->rated_freq_hz < 0.1f * fs))
-    bad = "rated_freq_hz";
-  else if (!(isfinite(cc->rated_speed_rpm) && cc->rated_speed_rpm >= 0.0f) ||
-           (cc->rated_speed_rpm > 0.0f && pos(cc->rated_freq_hz) &&
-            cc->rated_speed_rpm >= 60.0f * cc->rated_freq_hz))
-    bad = "rated_speed_rpm";
-  else if (!(isfinite(cc->speed_frac) && cc->speed_frac >= 0.05f && cc->speed_frac <= 1.0f))
-    bad = "speed_frac";
-  else if (!(isfinite(cc->ramp_s) && cc->ramp_s >= 0.1f && cc->ramp_s <= 60.0f))
-    bad = "ramp_s";
+  for (size_t k = 0; bad == NULL && k < sizeof k_checks / sizeof k_checks[0]; ++k)
+    if (!check_ok(cc, &k_checks[k])) bad = k_checks[k].name;
   if (field) *field = bad;
   return bad ? IMEST_ERR_CONFIG : IMEST_OK;
 }

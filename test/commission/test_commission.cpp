@@ -6,6 +6,7 @@
 // protections on synthetic inputs.
 #include <gtest/gtest.h>
 
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -573,6 +574,98 @@ TEST(CommissionGuard, ConfigCheckNamesTheField)
   EXPECT_EQ(imest_comm_init(&c, &cc), IMEST_ERR_CONFIG);
   EXPECT_EQ(imest_comm_init(nullptr, &cc), IMEST_ERR_NULL);
   EXPECT_EQ(imest_comm_config_check(nullptr, nullptr), IMEST_ERR_NULL);
+}
+
+// Every bound of the config check at its edge, just inside and just outside, and the field it
+// names: the check is one table walked in order (commission_init.c), so a row's bound, open end,
+// fs_hz scaling or rotation condition written wrong shows here.
+TEST(CommissionGuard, ConfigCheckBoundsAtTheirEdges)
+{
+  struct edge {
+    float imest_comm_config_t::*f;
+    const char *name;
+    float value;
+    bool ok;
+  };
+  const float inf = INFINITY, nan = NAN, below_1e9 = std::nextafter(1.0e9f, 0.0f);
+  const edge edges[] = {
+      {&imest_comm_config_t::fs_hz, "fs_hz", 1000.0f, true},
+      {&imest_comm_config_t::fs_hz, "fs_hz", 999.9f, false},
+      {&imest_comm_config_t::fs_hz, "fs_hz", 1.0e5f, true},
+      {&imest_comm_config_t::fs_hz, "fs_hz", 1.0001e5f, false},
+      {&imest_comm_config_t::fs_hz, "fs_hz", nan, false},
+      {&imest_comm_config_t::pwm_hz, "pwm_hz", 0.0f, true},
+      {&imest_comm_config_t::pwm_hz, "pwm_hz", 8000.0f, true},
+      {&imest_comm_config_t::pwm_hz, "pwm_hz", 7999.0f, false},
+      {&imest_comm_config_t::pwm_hz, "pwm_hz", 64.0f * 8000.0f, true},
+      {&imest_comm_config_t::pwm_hz, "pwm_hz", 64.01f * 8000.0f, false},
+      {&imest_comm_config_t::pwm_hz, "pwm_hz", -1.0f, false},
+      {&imest_comm_config_t::i_max_a, "i_max_a", 0.0f, false},
+      {&imest_comm_config_t::i_max_a, "i_max_a", 1.0e5f, true},
+      {&imest_comm_config_t::i_max_a, "i_max_a", 1.0001e5f, false},
+      {&imest_comm_config_t::level_frac, "level_frac", 0.1f, true},
+      {&imest_comm_config_t::level_frac, "level_frac", 0.099f, false},
+      {&imest_comm_config_t::level_frac, "level_frac", 0.95f, true},
+      {&imest_comm_config_t::level_frac, "level_frac", 0.951f, false},
+      {&imest_comm_config_t::v_max_v, "v_max_v", 0.0f, true},
+      {&imest_comm_config_t::v_max_v, "v_max_v", -1.0e-6f, false},
+      {&imest_comm_config_t::v_max_v, "v_max_v", FLT_MAX, true},
+      {&imest_comm_config_t::v_max_v, "v_max_v", inf, false},
+      {&imest_comm_config_t::time_max_s, "time_max_s", 0.0f, false},
+      {&imest_comm_config_t::time_max_s, "time_max_s", 3600.0f, true},
+      {&imest_comm_config_t::time_max_s, "time_max_s", 3601.0f, false},
+      {&imest_comm_config_t::tr_max_s, "tr_max_s", 0.01f, true},
+      {&imest_comm_config_t::tr_max_s, "tr_max_s", 0.0099f, false},
+      {&imest_comm_config_t::tr_max_s, "tr_max_s", 20.0f, true},
+      {&imest_comm_config_t::tr_max_s, "tr_max_s", 20.01f, false},
+      {&imest_comm_config_t::encoder_cpr, "encoder_cpr", 0.0f, true},
+      {&imest_comm_config_t::encoder_cpr, "encoder_cpr", -1.0f, false},
+      {&imest_comm_config_t::encoder_cpr, "encoder_cpr", below_1e9, true},
+      {&imest_comm_config_t::encoder_cpr, "encoder_cpr", 1.0e9f, false},
+      {&imest_comm_config_t::r_series_ohm, "r_series_ohm", 0.0f, true},
+      {&imest_comm_config_t::r_series_ohm, "r_series_ohm", -1.0e-3f, false},
+      {&imest_comm_config_t::r_series_ohm, "r_series_ohm", nan, false},
+      {&imest_comm_config_t::rated_voltage_v, "rated_voltage_v", 0.0f, false},
+      {&imest_comm_config_t::rated_freq_hz, "rated_freq_hz", 0.0f, false},
+      {&imest_comm_config_t::rated_freq_hz, "rated_freq_hz", 799.9f, true}, /* below 0.1 fs_hz */
+      {&imest_comm_config_t::rated_freq_hz, "rated_freq_hz", 800.0f, false},
+      {&imest_comm_config_t::rated_speed_rpm, "rated_speed_rpm", 0.0f, true},
+      {&imest_comm_config_t::rated_speed_rpm, "rated_speed_rpm", -1.0f, false},
+      {&imest_comm_config_t::rated_speed_rpm, "rated_speed_rpm", 2999.0f, true}, /* below 60 f */
+      {&imest_comm_config_t::rated_speed_rpm, "rated_speed_rpm", 3000.0f, false},
+      {&imest_comm_config_t::speed_frac, "speed_frac", 0.05f, true},
+      {&imest_comm_config_t::speed_frac, "speed_frac", 0.049f, false},
+      {&imest_comm_config_t::speed_frac, "speed_frac", 1.0f, true},
+      {&imest_comm_config_t::speed_frac, "speed_frac", 1.001f, false},
+      {&imest_comm_config_t::ramp_s, "ramp_s", 0.1f, true},
+      {&imest_comm_config_t::ramp_s, "ramp_s", 0.099f, false},
+      {&imest_comm_config_t::ramp_s, "ramp_s", 60.0f, true},
+      {&imest_comm_config_t::ramp_s, "ramp_s", 60.1f, false},
+  };
+  imest_comm_config_t rot = base_config();
+  rot.allow_rotation = 1;
+  rot.rated_voltage_v = 400.0f;
+  rot.rated_freq_hz = 50.0f;
+  rot.rated_speed_rpm = 1441.0f;
+  const char *field = nullptr;
+  ASSERT_EQ(imest_comm_config_check(&rot, &field), IMEST_OK);
+  for (const edge &e : edges) {
+    imest_comm_config_t cc = rot;
+    cc.*e.f = e.value;
+    const int rc = imest_comm_config_check(&cc, &field);
+    EXPECT_EQ(rc, e.ok ? IMEST_OK : IMEST_ERR_CONFIG) << e.name << " = " << e.value;
+    if (!e.ok) EXPECT_STREQ(field, e.name) << e.value;
+  }
+  // the rotating part's fields only with rotation allowed; n_sensors 2 or 3
+  imest_comm_config_t cc = base_config();
+  cc.rated_voltage_v = 0.0f;
+  cc.rated_freq_hz = nan;
+  EXPECT_EQ(imest_comm_config_check(&cc, &field), IMEST_OK);
+  for (unsigned int n : {0u, 1u, 2u, 3u, 4u, 0xFFFFFFFFu}) {
+    cc = base_config();
+    cc.n_sensors = n;
+    EXPECT_EQ(imest_comm_config_check(&cc, &field), n == 2u || n == 3u ? IMEST_OK : IMEST_ERR_CONFIG) << n;
+  }
 }
 
 TEST(CommissionGuard, NonFiniteInputStopsWithZeroVoltage)

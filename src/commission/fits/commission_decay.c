@@ -21,7 +21,7 @@ double imest__cm_exp(double x)
   if (!(x > -700.0)) return x < 0.0 ? 0.0 : x; /* e^-700 = 1e-304; NaN stays NaN */
   if (x > 700.0) x = 700.0;                    /* 1e304: far beyond any value the fits take */
   const double kd = x * CM_LOG2E_LIT;
-  const int32_t k = (int32_t)(kd + (kd >= 0.0 ? 0.5 : -0.5));
+  const int k = (int)(kd + (kd >= 0.0 ? 0.5 : -0.5)); /* |k| <= 1010: an int even where it is 16 bits */
   const double r = (x - (double)k * CM_LN2_HI_LIT) - (double)k * CM_LN2_LO_LIT;
   /* e^r = 1 + r (1 + r/2 (1 + r/3 (...))) */
   double p = 1.0, n = (double)CM_EXP_TERMS;
@@ -29,13 +29,9 @@ double imest__cm_exp(double x)
     p = 1.0 + p * r / n;
     n -= 1.0;
   }
-  /* 2^k by squaring (exact; |k| <= 1010, at most 10 rounds) */
-  double b = k < 0 ? 0.5 : 2.0;
-  for (uint32_t e = (uint32_t)(k < 0 ? -k : k); e != 0u; e >>= 1) {
-    if (e & 1u) p *= b;
-    b *= b;
-  }
-  return p;
+  /* times 2^k, exact (|k| <= 1010 keeps p 2^k normal): as the estimator scales, by the exponent
+     where double is soft, by a multiplication where the FPU has double */
+  return BG_SCALE2(p, k, imest__bg_pow2(k));
 }
 
 void imest__cm_decay_init(cm_decay_t *d, double ts, double tau)

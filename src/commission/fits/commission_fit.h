@@ -4,6 +4,7 @@
 #define IMEST_COMMISSION_FIT_H
 
 #include "commission_internal.h"
+#include "estimator/solve/bg_float.h" /* BG_SQRT: the estimator's correctly rounded sqrt, no libm */
 
 /* e^x to a few ulp (commission_decay.c): no libm. */
 double imest__cm_exp(double x);

@@ -209,7 +209,7 @@ static void fit_square_wave(imest_comm_t *c, uint32_t nb, imest_comm_axis_fit_t 
   const double sse = s[CM_H_YY] - (r[0] * rhs[0] + r[1] * rhs[1] + r[2] * rhs[2]);
   const double s2 = sse > 0.0 ? sse / (n - 3.0) : 0.0;
   f->slsig_h = (float)((double)c->ts_s / r[0]);
-  f->slsig_std = (float)(sqrt(s2 * dinv[0]) / r[0]);
+  f->slsig_std = (float)(BG_SQRT(s2 * dinv[0]) / r[0]);
   f->rhf_ohm = (float)(-r[1] / r[0]);
 }
 
@@ -330,14 +330,14 @@ static void report_inverter(const axis_ctx_t *x, double s2, imest_comm_axis_fit_
   const double ktd = (double)x->c->fpwm * (double)x->c->vdc0;
   if (!x->lumped) {
     f->td_s = (float)x->beta[COL_TD];
-    f->td_std = (float)sqrt(s2 * x->dinv[COL_TD]);
+    f->td_std = (float)BG_SQRT(s2 * x->dinv[COL_TD]);
     f->vth_v = (float)x->beta[COL_VTH];
-    f->vth_std = (float)sqrt(s2 * x->dinv[COL_VTH]);
+    f->vth_std = (float)BG_SQRT(s2 * x->dinv[COL_VTH]);
     f->dr_ohm = (float)x->beta[COL_DR];
-    f->dr_std = (float)sqrt(s2 * x->dinv[COL_DR]);
+    f->dr_std = (float)BG_SQRT(s2 * x->dinv[COL_DR]);
   } else { /* all of it as dead time: it usually dominates, and scales with the bus */
     f->td_s = (float)(x->beta[1] / ktd);
-    f->td_std = (float)(sqrt(s2 * x->dinv[1]) / ktd);
+    f->td_std = (float)(BG_SQRT(s2 * x->dinv[1]) / ktd);
     f->vth_v = 0.0f;
     f->vth_std = NAN;
     f->dr_ohm = 0.0f;
@@ -361,16 +361,16 @@ static int report_axis(axis_ctx_t *x, double u, double sse, const double d_p[CM_
   const double tau = x->tau0 * imest__cm_exp(u);
   f->separable = !x->lumped;
   f->r_ohm = (float)x->beta[COL_R];
-  f->r_std = (float)sqrt(s2 * x->dinv[COL_R]);
+  f->r_std = (float)BG_SQRT(s2 * x->dinv[COL_R]);
   report_inverter(x, s2, f);
   f->tau_s = (float)tau;
-  f->tau_std = (float)(d2 > 0.0 ? tau * sqrt(2.0 * s2 / d2) : (double)NAN);
+  f->tau_std = (float)(d2 > 0.0 ? tau * BG_SQRT(2.0 * s2 / d2) : (double)NAN);
   f->i_top_a = (float)i_p[2];
   {
     double wsum = 0.0;
     for (uint32_t bi = 0; bi < x->nb; ++bi)
       if (dc_used(x, bi)) wsum += (double)c->blk[bi].n;
-    f->rms_v = (float)(wsum > 0.0 ? sqrt(sse / wsum) : (double)NAN);
+    f->rms_v = (float)(wsum > 0.0 ? BG_SQRT(sse / wsum) : (double)NAN);
   }
   f->lm_h = (float)tail_lm(x, tau, d_p, i_p);
   return 0;

@@ -41,7 +41,7 @@ int imest__cm_chol_solve(double a[CM_LSQ_MAX][CM_LSQ_MAX], double b[CM_LSQ_MAX],
   double sc[CM_LSQ_MAX];
   for (unsigned int i = 0; i < n; ++i) {
     if (!(a[i][i] > 0.0)) return -1;
-    sc[i] = 1.0 / sqrt(a[i][i]);
+    sc[i] = 1.0 / BG_SQRT(a[i][i]);
   }
   for (unsigned int i = 0; i < n; ++i) {
     for (unsigned int j = 0; j < n; ++j) a[i][j] *= sc[i] * sc[j];
@@ -52,7 +52,7 @@ int imest__cm_chol_solve(double a[CM_LSQ_MAX][CM_LSQ_MAX], double b[CM_LSQ_MAX],
     double d = a[j][j];
     for (unsigned int k = 0; k < j; ++k) d -= a[j][k] * a[j][k];
     if (!(d > 1e-13)) return -1;
-    d = sqrt(d);
+    d = BG_SQRT(d);
     a[j][j] = d;
     for (unsigned int i = j + 1u; i < n; ++i) {
       double s = a[i][j];
