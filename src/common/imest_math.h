@@ -149,4 +149,19 @@ static inline imest_real_t imest__wrap_pi(imest_real_t x)
   return x - (imest_real_t)k * IMEST_2PI_R;
 }
 
+/* Clear n values. Through a volatile pointer: a plain loop of zero stores is
+ * what compilers turn into a call of memset (GCC's loop-distribution at -O2,
+ * clang's loop-idiom pass, whatever the flags), and the ISR path calls no
+ * library function. The stores are the loop's own: one per value. */
+static inline void imest__zero_real(imest_real_t *p, uint32_t n)
+{
+  imest_real_t volatile *const v = p;
+  for (uint32_t k = 0u; k < n; ++k) v[k] = RL(0);
+}
+static inline void imest__zero_f32(float *p, uint32_t n)
+{
+  float volatile *const v = p;
+  for (uint32_t k = 0u; k < n; ++k) v[k] = 0.0f;
+}
+
 #endif /* IMEST_COMMON_MATH_H */

@@ -101,7 +101,7 @@ void imest__cm_block_start(imest_comm_t *c, uint32_t tag)
   c->cur.k0 = c->k + 1u;
   c->cur.n = 0u;
   c->cur.tag = tag;
-  for (int j = 0; j < IMEST_COMM_NSUM; ++j) c->cur.s[j] = 0.0f;
+  imest__zero_f32(c->cur.s, IMEST_COMM_NSUM);
 }
 
 void imest__cm_block_flush(imest_comm_t *c)

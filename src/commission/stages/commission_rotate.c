@@ -57,7 +57,7 @@ void imest__cm_rotate_begin(imest_comm_t *c)
   c->ph_c = 1.0f;
   c->ph_s = 0.0f;
   c->lim_cnt = 0u;
-  for (int j = 0; j < CM_R_COUNT; ++j) c->rot_sum[j] = 0.0f;
+  imest__zero_f32(c->rot_sum, CM_R_COUNT);
   c->blk[CM_ROT_LEVELS].s[CM_LB_NSEARCH] = 0.0f;
   c->blk[CM_ROT_LEVELS].s[CM_LB_I] = 0.0f;
   /* measure over whole electrical periods, at least 1 s */
@@ -104,7 +104,7 @@ static inline int next_level(imest_comm_t *c)
     c->i_ref = next;
     c->plateau++;
     c->step = CM_ROT_SETTLE;
-    for (int j = 0; j < CM_R_COUNT; ++j) c->rot_sum[j] = 0.0f;
+    imest__zero_f32(c->rot_sum, CM_R_COUNT);
   } else {
     c->step = CM_ROT_DOWN;
   }

@@ -75,7 +75,7 @@ void imest__cm_stage_slip(imest_comm_t *c, float vdc, float i_n, float v_n)
       c->step = 1u;
       c->cnt = 0u;
       b->n = 0u;
-      for (int j = 0; j < IMEST_COMM_NSUM; ++j) b->s[j] = 0.0f;
+      imest__zero_f32(b->s, IMEST_COMM_NSUM);
     }
     return;
   }

@@ -132,10 +132,8 @@ static int isr_close_window(imest_t *s)
   }
   /* overrun: the background still owns the other buffer */
   IMEST_STORE_RELAXED(&s->overruns, s->overruns + 1u);
-  for (unsigned int p = 0; p < IMEST_NACC; ++p) {
-    w->sum[p] = RL(0);
-    w->blk[p] = RL(0);
-  }
+  imest__zero_real(w->sum, IMEST_NACC);
+  imest__zero_real(w->blk, IMEST_NACC);
   isr_open_window(s, w, IMEST_FLAG_OVERRUN);
   return 0;
 }
