@@ -237,13 +237,15 @@ typedef struct {
    *  of the sign at a switching instant b = edge_band_a [A] beyond the ripple it computes (the
    *  output capacitance C_oss smooths over about C_oss V_dc / t_d; the simulator's ideal
    *  switches fit a tenth of the ripple's peak); i_band_a is then unused. 0: the smooth sign
-   *  above (default): with the model's numbers 20 % off the switching-instant model gave valid
-   *  T_R up to 7 % off on the dead-time table, where the smooth sign gives none */
+   *  above (default). Either model's uncertain harmonics enter the bounds through the window's fit
+   *  (docs/METHOD.md §18.1): with the numbers exact the switching-instant model gives more valid
+   *  windows on the dead-time table, with them 20 % high fewer, and with either none wrong */
   float edge_band_a;
   /** relative uncertainty of this model's error (e.g. 0.2 for 20 %); negative: the error is unknown
    *  (default), so R_S is never valid with the duty-cycle input. R_S's bound takes it as stated;
-   *  T_R's takes at least 0.2 (the error's shape near the zero crossings is not the model's even
-   *  when its numbers are exact; docs/METHOD.md §18.1) */
+   *  the harmonics' shares take at least 0.2 (the error's shape near the zero crossings is not the
+   *  model's even when its numbers are exact; docs/METHOD.md §18.1); 1 or more: the harmonics are
+   *  unbounded, neither T_R nor R_S is valid with the duty-cycle input */
   float uncertainty;
 } imest_inverter_t;
 

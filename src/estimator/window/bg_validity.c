@@ -100,28 +100,45 @@ static int wiring_mismatch(const imest_t *s, const op_point_t *op)
   return op->z_ohm > 3.0f * we * ls + rs_max;
 }
 
+/* The error's shape near the zero crossings (the ripple's, the devices'
+ * capacitances) is not known to better than this share of it even when every
+ * number of the model is exact: with the numbers exact and stated 3 %
+ * uncertain, T_R at 25 % load was valid and 1.0-1.9 % off (2.2 / 4 kW,
+ * 1-3 us); the harmonics' bounds take at least that. */
+#define SHAPE_FLOOR 0.2f
+
+/* The inverter model's error in the window as the harmonics' bounds need it
+ * (duty input with a known uncertainty; else all 0). */
+typedef struct {
+  float shape_v; /* the uncertainty whose harmonics T_R sees [V] (the fitted term) */
+  float sign_v;  /* the model's sign-type error, the part with harmonics [V]: the dead time's and the
+                    thresholds' (V_sw0 + V_d0)/2, and the switch-diode differences' half; not the
+                    slopes' mean (r_sw + r_d)/2 i, a resistance */
+  float u;       /* its relative uncertainty for the harmonics, at least SHAPE_FLOOR */
+} inv_share_t;
+
 /* The uncertainty of the voltage's fundamental per phase [V]: the inverter
  * model's error at this current times its relative uncertainty (duty input),
- * or u_uncertainty_v (measured voltages); negative: unknown. *shape_v: the
- * uncertainty whose harmonics T_R sees (duty input with a known uncertainty;
- * else 0). */
+ * or u_uncertainty_v (measured voltages); negative: unknown. *h: what the
+ * harmonics' bounds take. */
 static float voltage_uncertainty(const imest_t *s, const imest_window_t *w, const op_point_t *op,
-                                 float *shape_v)
+                                 inv_share_t *h)
 {
-  *shape_v = 0.0f;
+  h->shape_v = 0.0f;
+  h->sign_v = 0.0f;
+  h->u = 0.0f;
   if (!w->duty_input) return s->u_uncertainty_v;
   const imest_inverter_t *v = &s->inverter;
   if (v->uncertainty < 0.0f) return -1.0f;
   const float a = op->i_pk;
-  const float e = fabsf(v->dead_time_s * s->pwm_hz * (float)w->vdc_v + v->v_diode_v + v->r_diode_ohm * a +
+  const float dead = v->dead_time_s * s->pwm_hz * (float)w->vdc_v;
+  const float e = fabsf(dead + v->v_diode_v + v->r_diode_ohm * a +
                         0.5f * ((v->v_switch_v - v->v_diode_v) + (v->r_switch_ohm - v->r_diode_ohm) * a));
   const float dv = v->uncertainty * e;
-  /* the error's shape near the zero crossings (the ripple's, the devices'
-   * capacitances) is not known to better than 20 % of it even when every
-   * number of the model is exact: with the numbers exact and stated 3 %
-   * uncertain, T_R at 25 % load was valid and 1.0-1.9 % off (2.2 / 4 kW,
-   * 1-3 us); the harmonics' bound takes at least that */
-  *shape_v = fmaxf(dv, 0.2f * e);
+  h->shape_v = fmaxf(dv, SHAPE_FLOOR * e);
+  h->sign_v = fabsf(dead + 0.5f * (v->v_switch_v + v->v_diode_v)) +
+              0.5f * (fabsf(v->v_switch_v - v->v_diode_v) + fabsf(v->r_switch_ohm - v->r_diode_ohm) * a);
+  h->u = fmaxf(v->uncertainty, SHAPE_FLOOR);
   return dv;
 }
 
@@ -151,7 +168,8 @@ static float voltage_uncertainty(const imest_t *s, const imest_window_t *w, cons
  *   (2.2-37 kW, 0-3 us, 1 V drops, model exact or 20 % off) T_R moved by 0.2
  *   to 0.45 times what the in-phase term (4/pi) dV / I would move it taken in
  *   quadrature (largest at 25 % load, where dZ/dT_R is small). The bound
- *   takes 0.5 times it, in Im Z.
+ *   takes 0.5 times it, in Im Z, as a measured floor beside the derived
+ *   share (inverter_harmonics(), bounds()).
  * - the constants' stated uncertainty (ls_uncertainty, sigma_uncertainty):
  *   the fit matches the measured Z with the configured L_S and sigma, so an
  *   error of theirs moves T_R and R_S (imest__bg_constants_shift, first
@@ -472,8 +490,97 @@ static int rs_verdict(judge_t *j)
   return IMEST_REASON_NONE;
 }
 
+/* Harmonic pairs of the inverter's sign-type error the derived share sums
+ * (the 5th and 7th ... the 95th and 97th): the filter and the 1/k of a sign
+ * wave leave the rest below 1e-4 of the first pair's share wherever the
+ * 5th passes the filter (the share grows as 1/k^2 G^2, G^2 ~ (w_c / w)^6). */
+#define HARMONIC_PAIRS 16
+/* power-invariant alpha/beta: a balanced set of phase amplitude A has |.| = sqrt(3/2) A */
+#define AB_PER_PHASE_F 1.2247449f
+
+/* How far the inverter model's uncertain share can move K1 and K2 through
+ * its harmonics (docs/METHOD.md §18.1), derived per window from the fit
+ * itself rather than fitted to a table. A sign-type leg error of amplitude A
+ * has the harmonics k = -5, 7, -11, 13 ... (alpha/beta, signed by their
+ * sequence) of amplitude sqrt(3/2) (4/pi) A / |k|, at the rotor-frame
+ * frequency w_k = (k - 1) w_e + w_s. The cost E_w is, at a steady speed, the
+ * sum over the samples of |q|^2, q = dz/dt + K2 z - m (1 - j n w / K2) K2^2 i,
+ * z = di/dt - u/(sigma L_S) + K1 i + j n w i (docs/METHOD.md §2.3), every
+ * channel through the same low-pass G. A voltage error dU_k moves q by
+ * dq_k = G (j w_k + K2) dU_k / (sigma L_S), and through the gradient
+ * 2 N sum_k Re(dq_k conj(dq_k/dK)) the minimiser by -H^-1 of that, H the
+ * cost's Hessian (the result's). dq/dK1 = G (j w_k + K2) i_k and dq/dK2 = G
+ * (z_k - m (2 K2 - j n w) i_k), z_k = m K2 (K2 - j n w) i_k / (j w_k + K2)
+ * (the rotor flux's harmonic), i_k the current's harmonic: the data's error
+ * harmonic (the model's error e, up to (1 + u) of it) over the motor's
+ * impedance at k w_e and the slip w_k. Every term is taken at its largest
+ * (|cos| = 1, magnitudes summed); the digital filter's gain is below the
+ * analogue one at 2 f_s tan(pi f_c / f_s) (tan x >= x). Not counted: the
+ * fundamental (in phase with the current: R_S only, exactly) and the
+ * harmonics aliased beyond f_s / 2. *dk1, *dk2: the largest moves [1/s];
+ * infinite where H is not positive definite. */
+static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float slip_rate, float *dk1,
+                               float *dk2)
+{
+  const imest_t *s = j->s;
+  const imest_result_t *r = j->r;
+  *dk1 = 0.0f;
+  *dk2 = 0.0f;
+  if (!(h->sign_v > 0.0f)) return;
+  if (!(h->u < 1.0f)) {
+    *dk1 = INFINITY;
+    *dk2 = INFINITY;
+    return;
+  }
+  const float h11 = (float)r->hessian[0][0], h12 = (float)r->hessian[0][1], h22 = (float)r->hessian[1][1];
+  const float det = h11 * h22 - h12 * h12;
+  if (!(h11 > 0.0f && det > 0.0f) || !isfinite(det)) {
+    *dk1 = INFINITY;
+    *dk2 = INFINITY;
+    return;
+  }
+  const float we = j->op.we, k2 = 1.0f / j->tr, nw = we - slip_rate, m = s->m;
+  const float kb = s->bw.b0 / (1.0f - s->bw.b0); /* tan(pi f_c / f_s) of the first section */
+  const float wq = 2.0f * s->fs * kb;
+  const float lin = AB_PER_PHASE_F * FOUR_OVER_PI_F;
+  /* eps |E_1|^2 / (sigma L_S). The model within u of the truth puts the truth up to 1 / (1 - u) of
+   * the model's, and the model's error up to u / (1 - u) of it from the truth */
+  const float e1 = lin * h->sign_v / (1.0f - h->u);
+  const float ee = e1 * e1 * h->u * s->inv_s;
+  float g1 = 0.0f, g2 = 0.0f;
+  for (int p = 1; p <= HARMONIC_PAIRS; ++p) {
+    for (int sgn = -1; sgn <= 1; sgn += 2) {
+      const float k = (float)(6 * p + sgn) * (float)sgn; /* -5, 7, -11, 13 ... */
+      const float wk = (k - 1.0f) * we + slip_rate;
+      const float x = wk / wq, x3 = x * x * x;
+      const float w2 = ee / ((1.0f + x3 * x3) * k * k); /* G^2 eps |E_k|^2 / (sigma L_S) */
+      bg_impedance_t zk;
+      imest__bg_impedance(k * we, wk, s->ls_h, s->sigma, j->tr, j->rs, &zk);
+      const float zz = zk.zr * zk.zr + zk.zi * zk.zi;
+      if (!(zz > 0.0f)) continue;
+      /* y = 1 / Z_k: i_k = -E_k y */
+      const float yr = zk.zr / zz, yi = -zk.zi / zz;
+      /* dq/dK1 / (-E_k) = (K2 + j w_k) y; Re((K2 + j w_k) conj of it) = |K2 + j w_k|^2 Re y */
+      g1 += w2 * (k2 * k2 + wk * wk) * yr;
+      /* dq/dK2 / (-E_k) = m y F, F = K2 (K2 - j n w) / (K2 + j w_k) - (2 K2 - j n w) */
+      const float dd = k2 * k2 + wk * wk;
+      const float ar = k2 * k2, ai = -k2 * nw;                                  /* K2 (K2 - j n w) */
+      const float qr = (ar * k2 + ai * wk) / dd, qi = (ai * k2 - ar * wk) / dd; /* / (K2 + j w_k) */
+      const float fr = qr - 2.0f * k2, fi = qi + nw;
+      const float pr = m * (yr * fr - yi * fi), pi = m * (yr * fi + yi * fr); /* m y F */
+      /* Re((K2 + j w_k) conj(p)) */
+      g2 += w2 * (k2 * pr + wk * pi);
+    }
+  }
+  const float n2 = 2.0f * (float)j->w->nreg * (float)r->windows;
+  g1 *= n2;
+  g2 *= n2;
+  *dk1 = fabsf(h22 * g1 - h12 * g2) / det;
+  *dk2 = fabsf(h11 * g2 - h12 * g1) / det;
+}
+
 /* The systematic bounds: T_R's (the staircase, the timing, the inverter
- * model's harmonics) and R_S's: the voltage's uncertainty (the inverter
+ * model's harmonics: the measured floor and their move of the fit) and R_S's: the voltage's uncertainty (the inverter
  * model's, or none known), the timing's, the staircase's, the current
  * sensors' gain mismatch (|E| |Z| / R_S, measured: the paper motor, 1 %
  * between two sensors, R_S -3.5 %); both with the constants' share
@@ -493,10 +600,16 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
   j->x_rs = 0.0f;
   if (have && imest__bg_finite(r->rs_ohm) && j->rs > 0.0f) {
     const float rs = j->rs;
-    float harm_v;
-    const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &harm_v);
-    systematic_bounds(j->s, j->w, &j->op, j->st->slip_rate, j->tr, rs, dv_v, harm_v, &j->tr_b, &j->rs_b,
+    inv_share_t h;
+    float dk1, dk2;
+    const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &h);
+    systematic_bounds(j->s, j->w, &j->op, j->st->slip_rate, j->tr, rs, dv_v, h.shape_v, &j->tr_b, &j->rs_b,
                       &j->c_tr, &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
+    inverter_harmonics(j, &h, j->st->slip_rate, &dk1, &dk2);
+    const float h_tr = dk2 * j->tr,
+                h_rs = (j->s->sigma * j->s->ls_h * dk1 + (1.0f - j->s->sigma) * j->s->ls_h * dk2) / rs;
+    j->tr_b += h_tr;
+    j->rs_b += h_rs;
     /* the magnetising curve's share (bg_flux.c), where T_R's bound is finite;
      * nothing without a curve (the outputs stay as without it) */
     if (fx != NULL && j->s->ls_curve_points != 0u && isfinite(j->tr_b)) {
