@@ -77,9 +77,16 @@
  *      to settle, then three periods of f1 (5.1 T_R in all). Then zero current until the rotor
  *      flux has decayed.
  *   5. With cc.allow_rotation only: a current-fed rotating field at no load, the identified
- *      inverter model as feed-forward: magnetise on the a axis (1 s + 3 T_R), ramp to
- *      speed_frac of rated frequency (ramp_s), then levels of magnetising current, each settled
- *      (1 s + 3 T_R) and measured (>= 1 s, whole electrical periods); ramp down. Every level
+ *      inverter model as feed-forward, the leg of the largest |voltage| clamped to its rail
+ *      (discontinuous PWM: at no load the current crosses zero at the voltage's peak, so no leg
+ *      switches while its current is inside the ripple band, where the dead time's error is not
+ *      the model's and its fundamental lies along the voltage, in the reactive impedance):
+ *      magnetise on the a axis (1 s + 3 T_R), ramp to speed_frac of rated frequency (ramp_s),
+ *      then levels of magnetising current, the first settled 1 s + 3 T_R, each next 1 s and as
+ *      many of its own rotor time constant as leave less than 0.02 % of its flux step (T_R at
+ *      the level's flux, tau L_S / L_S standstill: below rated flux the iron is less saturated
+ *      and T_R up to twice the standstill tails'), and measured (>= 1 s, whole electrical
+ *      periods); ramp down. Every level
  *      stays within the staircase's top (a phase peak of level_frac * i_max_a, which the
  *      standstill part has driven already); the first is the rated flux's current with the
  *      standstill L_S (within 80 % of that top); each measured level's L_S sets the next (the
@@ -437,7 +444,9 @@ typedef struct {
    *  ls_curve_i_a, for the estimator's use of it outside the points). 2 to 4 points */
   unsigned int ls_curve_points;
   float ls_curve_i_a[4]; /**< magnetising current of each point (alpha/beta amplitude) [A] */
-  float ls_curve_h[4];   /**< L_S at that current [H] (each point's uncertainty: ls_h.std_rel) */
+  /** L_S at that current [H]; each point is measured as ls_h is, and carries its uncertainty
+   *  (ls_h.std_rel; imest_comm_apply's ls_uncertainty covers each point) */
+  float ls_curve_h[4];
 } imest_comm_result_t;
 
 /** Progress, readable from any context. */
