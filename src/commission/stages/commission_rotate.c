@@ -248,20 +248,25 @@ static inline void modulate(imest_comm_t *c, float ia, float ib, float ud, float
     if (v[x] > v[khi]) khi = x;
     if (v[x] < v[klo]) klo = x;
   }
+  /* the clamp on the curve's levels only (the rated point known): the search's levels keep
+     every leg switching, with the min-max zero sequence (k = 3: no leg clamped), whose
+     in-phase error the counts per revolution were measured with (the slip from Re Z) */
+  const int clamp = c->blk[CM_ROT_LEVELS].s[CM_LB_I] > 0.0f;
   const int up = imest__abs(ip[khi]) <= imest__abs(ip[klo]);
-  const uint32_t k = up ? khi : klo;
+  const uint32_t k = clamp ? (up ? khi : klo) : 3u;
   const float rail = up ? 0.5f * vdc : -0.5f * vdc;
   /* each leg's duty for its conduction shares from the uncompensated references */
-  const float inv = 1.0f / vdc, v0 = rail - v[k], vdt = c->inv_td_f * vdc;
+  const float inv = 1.0f / vdc, vdt = c->inv_td_f * vdc;
+  const float v0 = clamp ? rail - v[k] : -0.5f * (v[khi] + v[klo]);
   float u[3];
   for (uint32_t x = 0u; x < 3u; ++x)
     u[x] = v[x] + leg_error(c, ip[x], 0.5f + (v[x] + v0) * inv, x == k ? 0.0f : vdt);
-  const float w0 = rail - u[k];
+  const float w0 = clamp ? rail - u[k] : v0;
   for (uint32_t x = 0u; x < 3u; ++x) {
     const float d = 0.5f + (u[x] + w0) * inv;
     c->d_next[x] = d < 0.0f ? 0.0f : (d > 1.0f ? 1.0f : d);
   }
-  c->d_next[k] = up ? 1.0f : 0.0f; /* exactly: a duty a rounding off the rail has an edge */
+  if (clamp) c->d_next[k] = up ? 1.0f : 0.0f; /* exactly: a duty a rounding off the rail has an edge */
 }
 
 void imest__cm_stage_rotate(imest_comm_t *c, const float m[3], float vdc)
