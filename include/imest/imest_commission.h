@@ -77,10 +77,11 @@
  *      to settle, then three periods of f1 (5.1 T_R in all). Then zero current until the rotor
  *      flux has decayed.
  *   5. With cc.allow_rotation only: a current-fed rotating field at no load, the identified
- *      inverter model as feed-forward, the leg of the largest |voltage| clamped to its rail
- *      (discontinuous PWM: at no load the current crosses zero at the voltage's peak, so no leg
- *      switches while its current is inside the ripple band, where the dead time's error is not
- *      the model's and its fundamental lies along the voltage, in the reactive impedance):
+ *      inverter model as feed-forward (on the curve's levels one leg clamped to its rail, of
+ *      the highest- and the lowest-voltage leg the one whose current is nearer zero:
+ *      discontinuous PWM, so that no leg switches while its current is inside the ripple band,
+ *      where the dead time's error is not the model's and, at no load, its fundamental lies
+ *      along the voltage, in the reactive impedance):
  *      magnetise on the a axis (1 s + 3 T_R), ramp to speed_frac of rated frequency (ramp_s),
  *      then levels of magnetising current, the first settled 1 s + 3 T_R, each next 1 s and as
  *      many of its own rotor time constant as leave less than 0.02 % of its flux step (T_R at
@@ -606,7 +607,9 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r);
  *  over the magnetising curve (32-40 % on the saturating simulated motors), so without the curve
  *  in the config T_R is refused (constants_uncertain) rather than wrong; with the curve in the
  *  config (imest_comm_apply() copies it) the estimator takes L_S at each window's flux, and q()
- *  of ls_h and sigma is their 3 standard errors only. */
+ *  of ls_h and sigma is their 3 standard errors only. Each curve point is measured as ls_h is
+ *  and stated to ls_uncertainty x (rated flux / its flux) (imest.h, ls_curve_h: the same
+ *  voltage error at a lower voltage), 2.2 x at the lowest. */
 #define IMEST_COMM_LS_FLOOR               0.002f
 #define IMEST_COMM_SIGMA_FLOOR            0.005f
 #define IMEST_COMM_LS_FLOOR_STANDSTILL    0.01f

@@ -5,7 +5,7 @@
  * voltage-fed V/f at no load oscillates on a low-inertia motor, a current-fed one is damped by
  * the rotor circuit); feed-forward (R_S + j w L_S) I_m with the standstill values, PI for the
  * rest. The command is turned to the centre of the period it will be applied in (1.5 samples
- * ahead) and modulated with the leg of the largest |voltage| clamped to its rail (modulate());
+ * ahead) and modulated, on the curve's levels with one leg clamped to its rail (modulate());
  * the identified inverter model is added per leg, so the voltage applied is the one commanded.
  *
  * The run starts from a magnetised motor: the same current as DC on the a axis for 1 s + 3 T_R
@@ -213,8 +213,9 @@ static inline void measure(imest_comm_t *c, float ia, float ib, float id, float 
 }
 
 /* the voltage (field frame ud, uq) for the period after the next sample, at that period's
-   centre angle, into c->d_next: each leg's model error added, and one leg clamped to its rail
-   (discontinuous PWM; the others carry the zero sequence): of the leg with the highest voltage
+   centre angle, into c->d_next: each leg's model error added and, on the curve's levels, one leg
+   clamped to its rail (discontinuous PWM; the others carry the zero sequence): of the leg with
+   the highest voltage
    (clamped high) and the one with the lowest (low), the one whose current is nearer zero.
    Why: a leg that switches while its current is inside the ripple band makes a dead-time error
    the model's smooth sign does not follow (the current's sign at each edge, and the current
