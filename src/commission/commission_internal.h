@@ -94,7 +94,7 @@ enum {
 enum { CM_LV_I = 0, CM_LV_LS, CM_LV_ZR };
 /* The rotating measurement's repeatability, relative: the least uncertainty a level's L_S
    carries (commission_fit_rotation.c). */
-#define CM_ROT_LS_FLOOR   1e-3f
+#define CM_ROT_LS_FLOOR 1e-3f
 enum { CM_LB_NEXT = 0, CM_LB_NSEARCH, CM_LB_I, CM_LB_LS, CM_LB_STD, CM_LB_SETTLE };
 
 /* rot_sum[] */
