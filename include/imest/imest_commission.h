@@ -103,8 +103,9 @@
  *   The routine ends with zero voltage; its ISR call then returns 0 and the background call
  *   completes the result. Measured totals: 10.4 s at standstill for a 4 kW motor (T_R 128 ms;
  *   the slip-frequency test 2.0 s of it, at most 5.3 A of the 11.6 A limit), 38.7 s for 37 kW
- *   (T_R 553 ms; the test 8.5 s, 45.6 A of 96 A), plus 12.5 to 18 s of rotation (19 s for the 4 kW motor with
- *   saturation, 24 s for 11 kW; README, Commissioning).
+ *   (T_R 553 ms; the test 8.5 s, 45.6 A of 96 A), plus 17 to 30 s of rotation (28 s for the 4 kW motor with
+ *   saturation, 53 s for 11 kW and 60 s for 37 kW with their real motors' saturation; README,
+ *   Commissioning).
  *
  * What is measured, and how (per axis, then combined; the spread between the three axes is
  * reported as a quality figure for each quantity):
@@ -188,8 +189,13 @@
  *     11 kW, saturation 0.25 -19.0 % / +0.21 %   +23.3 % / -0.31 %     -30.0 %
  *     11 kW, real motor      -18.6 % / +0.43 %   -29.6 % / -43.0 %     -30.0 %
  *
- * and the curve's points within 0.4 % of the truth at their currents (0.5 % on the linear
- * motors; L_S there unchanged). What the levels do not fix, and the result says so: T_R comes from the
+ * and the curve's points within 0.35 % of the truth at their currents (0.15 % on the linear
+ * motors; L_S there unchanged): +0.33 % at the lowest flux on the 4 kW real motor, stated
+ * 0.69 % there (ls_uncertainty x rated flux / its flux), +0.07 / +0.15 / +0.14 % on the 4 / 11 /
+ * 37 kW motors with saturation alone. Before the clamp on the curve's levels and the per-level
+ * settle the lowest point read +0.67 / +1.45 / +1.75 % high (+1.38 % on the 4 kW real motor): the
+ * dead time's error (its current 3 x the ripple band on the 4 kW motor) and the rotor flux still
+ * settling (11 and 37 kW: T_R at that flux about twice the standstill one). What the levels do not fix, and the result says so: T_R comes from the
  * standstill flux tails, which on a saturating motor run at other currents (incremental, not
  * static, inductance): tr_s.spread_rel is at least the standstill L_S's departure from the
  * rated-flux one (41 % and 53 % on these motors), and T_R at rated flux may be off by as much.
