@@ -256,14 +256,15 @@ static inline void modulate(imest_comm_t *c, float ia, float ib, float ud, float
   const int up = imest__abs(ip[khi]) <= imest__abs(ip[klo]);
   const uint32_t k = clamp ? (up ? khi : klo) : 3u;
   const float rail = up ? 0.5f * vdc : -0.5f * vdc;
-  /* each leg's duty for its conduction shares from the uncompensated references; the clamped
-     leg's own error (ek) is made up by the others, through the zero sequence */
+  /* each leg's duty for its conduction shares from the uncompensated references */
   const float inv = 1.0f / vdc, vdt = c->inv_td_f * vdc;
   const float v0 = clamp ? rail - v[k] : -0.5f * (v[khi] + v[klo]);
-  const float ek = clamp ? leg_error(c, ip[k], up ? 1.0f : 0.0f, 0.0f) : 0.0f;
+  float u[3];
+  for (uint32_t x = 0u; x < 3u; ++x)
+    u[x] = v[x] + leg_error(c, ip[x], 0.5f + (v[x] + v0) * inv, x == k ? 0.0f : vdt);
+  const float w0 = clamp ? rail - u[k] : v0;
   for (uint32_t x = 0u; x < 3u; ++x) {
-    float d = 0.5f + (v[x] + v0) * inv;
-    d += (leg_error(c, ip[x], d, x == k ? 0.0f : vdt) - ek) * inv;
+    const float d = 0.5f + (u[x] + w0) * inv;
     c->d_next[x] = d < 0.0f ? 0.0f : (d > 1.0f ? 1.0f : d);
   }
   if (clamp) c->d_next[k] = up ? 1.0f : 0.0f; /* exactly: a duty a rounding off the rail has an edge */
