@@ -371,7 +371,10 @@ typedef struct {
    *  commissioning's curve runs from rated flux down to 0.45 of it, field weakening to twice
    *  base speed (default 0) */
   float ls_curve_i_a[IMEST_LS_CURVE_POINTS];
-  /** L_S measured at no load at each of ls_curve_i_a [H], positive (default 0) */
+  /** L_S measured at no load at each of ls_curve_i_a [H], positive (default 0). Each point is
+   *  taken as uncertain by ls_uncertainty x (the last point's flux / its flux), L_S i the flux:
+   *  measured as ls_h is, at no load and one frequency, a voltage error that is ls_uncertainty
+   *  of the last point's reactive voltage is that much larger a share at a lower flux */
   float ls_curve_h[IMEST_LS_CURVE_POINTS];
   /** points of the curve in use, 2 .. IMEST_LS_CURVE_POINTS (default 0: no curve, L_S is taken as
    *  flux-independent and every output is as without these fields); a core built with

@@ -77,9 +77,17 @@
  *      to settle, then three periods of f1 (5.1 T_R in all). Then zero current until the rotor
  *      flux has decayed.
  *   5. With cc.allow_rotation only: a current-fed rotating field at no load, the identified
- *      inverter model as feed-forward: magnetise on the a axis (1 s + 3 T_R), ramp to
- *      speed_frac of rated frequency (ramp_s), then levels of magnetising current, each settled
- *      (1 s + 3 T_R) and measured (>= 1 s, whole electrical periods); ramp down. Every level
+ *      inverter model as feed-forward (on the curve's levels one leg clamped to its rail, of
+ *      the highest- and the lowest-voltage leg the one whose current is nearer zero:
+ *      discontinuous PWM, so that no leg switches while its current is inside the ripple band,
+ *      where the dead time's error is not the model's and, at no load, its fundamental lies
+ *      along the voltage, in the reactive impedance):
+ *      magnetise on the a axis (1 s + 3 T_R), ramp to speed_frac of rated frequency (ramp_s),
+ *      then levels of magnetising current, the first settled 1 s + 3 T_R, each next 1 s and as
+ *      many of its own rotor time constant as leave less than 0.02 % of its flux step (T_R at
+ *      the level's flux, tau L_S / L_S standstill: below rated flux the iron is less saturated
+ *      and T_R up to twice the standstill tails'), and measured (>= 1 s, whole electrical
+ *      periods); ramp down. Every level
  *      stays within the staircase's top (a phase peak of level_frac * i_max_a, which the
  *      standstill part has driven already); the first is the rated flux's current with the
  *      standstill L_S (within 80 % of that top); each measured level's L_S sets the next (the
@@ -95,8 +103,9 @@
  *   The routine ends with zero voltage; its ISR call then returns 0 and the background call
  *   completes the result. Measured totals: 10.4 s at standstill for a 4 kW motor (T_R 128 ms;
  *   the slip-frequency test 2.0 s of it, at most 5.3 A of the 11.6 A limit), 38.7 s for 37 kW
- *   (T_R 553 ms; the test 8.5 s, 45.6 A of 96 A), plus 15 to 21.5 s of rotation (21.4 s for the 4 kW motor with
- *   saturation, 26.9 s for 11 kW; README, Commissioning, tools/commission/readme-tables).
+ *   (T_R 553 ms; the test 8.5 s, 45.6 A of 96 A), plus 17 to 30 s of rotation (28 s for the 4 kW motor with
+ *   saturation, 53 s for 11 kW and 60 s for 37 kW with their real motors' saturation; README,
+ *   Commissioning, tools/commission/readme-tables).
  *
  * What is measured, and how (per axis, then combined; the spread between the three axes is
  * reported as a quality figure for each quantity):
@@ -180,8 +189,13 @@
  *     11 kW, saturation 0.25 -19.0 % / +0.21 %   +23.3 % / -0.31 %     -30.0 %
  *     11 kW, real motor      -18.6 % / +0.43 %   -29.6 % / -43.0 %     -30.0 %
  *
- * and the curve's points within 0.4 % of the truth at their currents (0.5 % on the linear
- * motors; L_S there unchanged). What the levels do not fix, and the result says so: T_R comes from the
+ * and the curve's points within 0.35 % of the truth at their currents (0.15 % on the linear
+ * motors; L_S there unchanged): +0.33 % at the lowest flux on the 4 kW real motor, stated
+ * 0.69 % there (ls_uncertainty x rated flux / its flux), +0.07 / +0.15 / +0.14 % on the 4 / 11 /
+ * 37 kW motors with saturation alone. Before the clamp on the curve's levels and the per-level
+ * settle the lowest point read +0.67 / +1.45 / +1.75 % high (+1.38 % on the 4 kW real motor): the
+ * dead time's error (its current 3 x the ripple band on the 4 kW motor) and the rotor flux still
+ * settling (11 and 37 kW: T_R at that flux about twice the standstill one). What the levels do not fix, and the result says so: T_R comes from the
  * standstill flux tails, which on a saturating motor run at other currents (incremental, not
  * static, inductance): tr_s.spread_rel is at least the standstill L_S's departure from the
  * rated-flux one (41 % and 53 % on these motors), and T_R at rated flux may be off by as much.
@@ -437,7 +451,9 @@ typedef struct {
    *  ls_curve_i_a, for the estimator's use of it outside the points). 2 to 4 points */
   unsigned int ls_curve_points;
   float ls_curve_i_a[4]; /**< magnetising current of each point (alpha/beta amplitude) [A] */
-  float ls_curve_h[4];   /**< L_S at that current [H] (each point's uncertainty: ls_h.std_rel) */
+  /** L_S at that current [H]; each point is measured as ls_h is, and carries its uncertainty
+   *  (ls_h.std_rel; imest_comm_apply's ls_uncertainty covers each point) */
+  float ls_curve_h[4];
 } imest_comm_result_t;
 
 /** Progress, readable from any context. */
@@ -597,7 +613,9 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r);
  *  over the magnetising curve (32-40 % on the saturating simulated motors), so without the curve
  *  in the config T_R is refused (constants_uncertain) rather than wrong; with the curve in the
  *  config (imest_comm_apply() copies it) the estimator takes L_S at each window's flux, and q()
- *  of ls_h and sigma is their 3 standard errors only. */
+ *  of ls_h and sigma is their 3 standard errors only. Each curve point is measured as ls_h is
+ *  and stated to ls_uncertainty x (rated flux / its flux) (imest.h, ls_curve_h: the same
+ *  voltage error at a lower voltage), 2.2 x at the lowest. */
 #define IMEST_COMM_LS_FLOOR               0.002f
 #define IMEST_COMM_SIGMA_FLOOR            0.005f
 #define IMEST_COMM_LS_FLOOR_STANDSTILL    0.01f

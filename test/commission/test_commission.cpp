@@ -201,10 +201,22 @@ TEST_P(CommissionSaturating, LsAtRatedFluxAndTheCurveWithinTwoPercent)
   EXPECT_LT(std::fabs(rel(r.rotating_i_a, out.i_rated_flux_a)), 0.02);
   EXPECT_LT(std::fabs(rel((double)r.ls_h.value * r.rotating_i_a, out.ls_h * out.i_rated_flux_a)), 0.01);
   expect_curve_spans_field_weakening(r);
+  // each point within the uncertainty the estimator takes for it: imest_comm_apply's
+  // ls_uncertainty, a share of the rated point's reactive voltage, so rated / flux times it at a
+  // point of lower flux (bg_flux.c). The lowest flux's point once read 1.4 % high on the 4 kW
+  // real motor against 0.69 % (the dead time's error at a current 3 x the ripple band, and the
+  // rotor flux not settled: T_R there up to twice the standstill one)
+  imest_config_t applied;
+  imest_config_default(&applied);
+  ASSERT_GE(imest_comm_apply(&r, &applied), 1);
+  const double flux_rated = (double)r.ls_h.value * r.rotating_i_a;
   for (unsigned int j = 0; j < r.ls_curve_points; ++j) {
     double ls_true = 0.0;
     ASSERT_EQ(comm_sim_true_at(&out.sim, r.ls_curve_i_a[j], &ls_true, nullptr, nullptr), 0);
     EXPECT_LT(std::fabs(rel(r.ls_curve_h[j], ls_true)), 0.02) << "point " << j;
+    const double flux = (double)r.ls_curve_h[j] * r.ls_curve_i_a[j];
+    EXPECT_LE(std::fabs(rel(r.ls_curve_h[j], ls_true)), applied.ls_uncertainty * flux_rated / flux)
+        << "point " << j;
     if (j > 0) {
       EXPECT_GT(r.ls_curve_i_a[j], r.ls_curve_i_a[j - 1]);
       EXPECT_LT(r.ls_curve_h[j], r.ls_curve_h[j - 1]); // saturating: L_S falls with the current

@@ -31,6 +31,7 @@ imest_config_t base_config()
   c.ls_h = (float)kLs;
   c.sigma = (float)kSigma;
   c.fs_hz = 8000.0f;
+  c.ls_uncertainty = 0.0f; // the curve's own mechanics; its points' share: LowerFluxPointsCarryMore
   return c;
 }
 
@@ -280,6 +281,36 @@ TEST(FluxCorrection, ACurveNoMotorFitsIsRefusedNotUsed)
   EXPECT_EQ(x.r.tr_s, before.tr_s);
   EXPECT_TRUE(std::isinf(fx.tr_b));
   EXPECT_TRUE(std::isinf(fx.rs_b));
+}
+
+// The curve's points are measured as ls_h is, so each is uncertain by ls_uncertainty x (the
+// last point's flux / its flux): a window at the last point's flux or above gets nothing more
+// from it, one at about half of it the bound of an L_w about ls_uncertainty higher still.
+TEST(FluxCorrection, LowerFluxPointsCarryMore)
+{
+  imest_config_t c = base_config();
+  set_curve(c, {{3.0, 0.230}, {4.5, 0.215}, {6.0, 0.193}, {8.0, 0.160}});
+  imest_config_t cu = c;
+  cu.ls_uncertainty = 0.003f;
+  const double a = 1.0;
+  for (double i_amp : {12.0, 4.0 * std::sqrt(2.0)}) {
+    SCOPED_TRACE(i_amp);
+    float err;
+    const double i_d = i_amp / std::sqrt(1.0 + a * a), lw = curve_ls(c, (float)i_d, &err);
+    Window x = make_window(c, lw, 0.13, a, i_amp), xu = make_window(cu, lw, 0.13, a, i_amp);
+    bg_flux_t fx, fxu;
+    imest__bg_flux(&x.s, &x.st, &x.sm, x.nreg, &x.r, &fx);
+    imest__bg_flux(&xu.s, &xu.st, &xu.sm, xu.nreg, &xu.r, &fxu);
+    EXPECT_EQ(xu.r.tr_s, x.r.tr_s) << "the estimate is the same";
+    if (lw * i_d >= 8.0 * 0.160) {
+      EXPECT_FLOAT_EQ(fxu.tr_b, fx.tr_b) << "at or above the last point's flux";
+    } else {
+      // flux 0.91 Wb against 1.28: 0.4 x 0.3 % more L_S uncertainty, a tenth of a percent of
+      // T_R at a = 1 (about T_R's share of an L_S error there)
+      EXPECT_GT(fxu.tr_b, fx.tr_b + 2e-4f);
+      EXPECT_GT(fxu.rs_b, fx.rs_b);
+    }
+  }
 }
 
 } // namespace

@@ -132,7 +132,7 @@ static void rated_point(imest_comm_t *c, uint32_t ns, float psi, float *st)
   const float corr = imest__abs(ls - la) / ls;
   st[CM_LB_I] = is;
   st[CM_LB_LS] = ls;
-  st[CM_LB_STD] = corr > 1e-3f ? corr : 1e-3f;
+  st[CM_LB_STD] = corr > CM_ROT_LS_FLOOR ? corr : CM_ROT_LS_FLOOR;
 }
 
 /* The current of the curve's level j (0: the highest) from the levels 0..n-1 measured: its flux,
@@ -150,11 +150,17 @@ static void rated_point(imest_comm_t *c, uint32_t ns, float psi, float *st)
    1.35 x the rated-flux one (15-25 % saturation); the cap holds only a secant that noise made
    steep on a nearly flat curve. */
 #define CURVE_LS_RISE_MAX 2.0f
-static float curve_current(const imest_comm_t *c, uint32_t n, uint32_t j)
+/* the flux of the curve's level j (0: the highest) */
+static float curve_flux(const imest_comm_t *c, uint32_t j)
 {
   const float *st = c->blk[CM_ROT_LEVELS].s;
   const float frac = 1.0f - (float)(j + 1u) * ((1.0f - CM_ROT_FLUX_MIN) / (float)CM_ROT_CURVE);
-  const float flux = frac * st[CM_LB_I] * st[CM_LB_LS];
+  return frac * st[CM_LB_I] * st[CM_LB_LS];
+}
+
+static float curve_current(const imest_comm_t *c, uint32_t n, uint32_t j)
+{
+  const float flux = curve_flux(c, j);
   uint32_t a = 0u, b = 0u; /* the lowest current, the next */
   for (uint32_t k = 1u; k < n; ++k) {
     const float ik = c->blk[k].s[CM_LV_I];
@@ -179,37 +185,69 @@ static float curve_current(const imest_comm_t *c, uint32_t n, uint32_t j)
   return i;
 }
 
+/* How long the next level settles, into st[CM_LB_SETTLE] [samples]: 1 s (the speed) and
+   enough of its rotor time constant that what is left of the flux's step from level k is
+   below CM_ROT_SETTLE_RESID of its flux. Why per level: the rotor flux follows a change of the
+   magnetising current with T_R = L_R / R_R at the new flux, and below rated flux the iron is
+   less saturated, so L_R, and T_R, is up to 1.3 x the rated flux's and about 1.9 x the
+   standstill flux tails' tau (11 and 37 kW motors: 0.61 and 0.68 s against 0.32 and 0.35 s).
+   3 tau, the magnetising's settle, left 5 % of the step from 0.63 to 0.45 of rated flux (40 %
+   of the new flux) at the start of the lowest level's measurement: L_S +0.67 % and +1.0 %
+   high there. The tails measure tau = L_R/R_R at the staircase's L_S (ls_ss), so the level's
+   T_R is tau L_S / ls_ss with L_S = flux / current predicted for it: above the true one (1.5 x
+   on the 4 to 37 kW motors: ls_ss is the incremental L_S), so the residual stays below. */
+#define CM_ROT_SETTLE_RESID (0.2f * CM_ROT_LS_FLOOR)
+#define CM_ROT_SETTLE_TAUS  12u /* at most (a whole flux step to a fifth of 0.1 %: 9) */
+static void set_settle(imest_comm_t *c, uint32_t k, float i_next, float flux_next)
+{
+  const float flux_k = c->blk[k].s[CM_LV_I] * c->blk[k].s[CM_LV_LS];
+  const float t_r = c->tau * (flux_next / i_next) / c->ls_ss;
+  float left = imest__abs(flux_next - flux_k) / flux_next;
+  uint32_t n = 0u;
+  while (left > CM_ROT_SETTLE_RESID && n < CM_ROT_SETTLE_TAUS) {
+    left *= 0.36787944f; /* e^-1 */
+    n++;
+  }
+  c->blk[CM_ROT_LEVELS].s[CM_LB_SETTLE] = (1.0f + (float)n * t_r) * c->cfg.fs_hz;
+}
+
 /* The next level's current after level k (0: the run is complete): the search's fixed-point or
-   secant step, or the curve's lower levels once the rated point is known (levels ns on). */
+   secant step, or the curve's lower levels once the rated point is known (levels ns on); and
+   how long it settles. */
 static float next_level(imest_comm_t *c, uint32_t k)
 {
   const imest_comm_block_t *lv = c->blk;
   float *st = c->blk[CM_ROT_LEVELS].s;
   const uint32_t ns = (uint32_t)st[CM_LB_NSEARCH];
   const float psi = c->psi, i_lim = c->psi_im;
+  uint32_t j = 0u; /* the next curve level, if the next is one */
   if (st[CM_LB_I] > 0.0f && ns > 0u && k >= ns) {
-    const uint32_t j = k - ns + 1u; /* the next curve level */
-    return j < CM_ROT_CURVE ? curve_current(c, k + 1u, j) : 0.0f;
-  }
-  /* a search level */
-  const float ik = lv[k].s[CM_LV_I], lk = lv[k].s[CM_LV_LS];
-  float in = psi / lk;
-  if (k > 0u) {
-    const float ip = lv[k - 1u].s[CM_LV_I], lp = lv[k - 1u].s[CM_LV_LS];
-    if (imest__abs(ik - ip) > 1e-6f * ik) {
-      const float slope = (ik * lk - ip * lp) / (ik - ip);
-      if (slope > 0.0f) in = ik + (psi - ik * lk) / slope;
+    j = k - ns + 1u;
+    if (j >= CM_ROT_CURVE) return 0.0f;
+  } else {
+    /* a search level */
+    const float ik = lv[k].s[CM_LV_I], lk = lv[k].s[CM_LV_LS];
+    float in = psi / lk;
+    if (k > 0u) {
+      const float ip = lv[k - 1u].s[CM_LV_I], lp = lv[k - 1u].s[CM_LV_LS];
+      if (imest__abs(ik - ip) > 1e-6f * ik) {
+        const float slope = (ik * lk - ip * lp) / (ik - ip);
+        if (slope > 0.0f) in = ik + (psi - ik * lk) / slope;
+      }
     }
-  }
-  in = in < 0.5f * ik ? 0.5f * ik : (in > 1.5f * ik ? 1.5f * ik : in);
-  if (in > i_lim) in = i_lim;
-  st[CM_LB_NSEARCH] = (float)(k + 1u);
-  const int at_limit = ik >= 0.999f * i_lim && in >= 0.999f * i_lim;
-  if (imest__abs(in - ik) < 0.01f * ik || at_limit || k + 1u >= CM_ROT_SEARCH) {
+    in = in < 0.5f * ik ? 0.5f * ik : (in > 1.5f * ik ? 1.5f * ik : in);
+    if (in > i_lim) in = i_lim;
+    st[CM_LB_NSEARCH] = (float)(k + 1u);
+    const int at_limit = ik >= 0.999f * i_lim && in >= 0.999f * i_lim;
+    if (!(imest__abs(in - ik) < 0.01f * ik || at_limit || k + 1u >= CM_ROT_SEARCH)) {
+      set_settle(c, k, in, psi);
+      return in;
+    }
     rated_point(c, k + 1u, psi, st);
-    return curve_current(c, k + 1u, 0u);
   }
-  return in;
+  const float i = curve_current(c, k + 1u, j);
+  set_settle(c, k, i, curve_flux(c, j));
+  return i;
 }
 
 /* The result at the end of the run: L_S at rated flux, sigma, the magnetising curve (increasing

@@ -81,12 +81,33 @@ static int refit(const flux_z_t *z, float we, float ws, float ls, float sls, flo
   return 1;
 }
 
-/* L_S of the curve at the flux-producing current of the estimate with T_R tr:
- * i_d = |i| / sqrt(1 + a^2), a = ws tr. */
-static float ls_at(const imest_t *s, float i2, float ws, float tr, float *err)
+/* the flux-producing current of the estimate with T_R tr: i_d = |i| /
+ * sqrt(1 + a^2), a = ws tr */
+static float id_at(float i2, float ws, float tr)
 {
   const float a = ws * tr;
-  return imest__bg_flux_ls(s, sqrtf(i2 / (1.0f + a * a)), err);
+  return sqrtf(i2 / (1.0f + a * a));
+}
+
+/* L_S of the curve at the flux-producing current of the estimate with T_R tr. */
+static float ls_at(const imest_t *s, float i2, float ws, float tr, float *err)
+{
+  return imest__bg_flux_ls(s, id_at(i2, ws, tr), err);
+}
+
+/* The curve's points' own uncertainty beyond ls_uncertainty, relative, at the
+ * flux ls i_d: each point is measured as ls_h is (no-load reactive impedance,
+ * the same drive), so a voltage error that is ls_uncertainty of the last
+ * point's reactive voltage is rated / flux times that share at a point of
+ * lower flux (the voltage of a no-load test at one frequency is proportional
+ * to its flux; commissioning: the dead time's and the devices' residual,
+ * imest_commission.h). Its excess over ls_uncertainty, which the constants'
+ * shift takes already, at ls_shift_e's coverage. */
+static float low_flux_share(const imest_t *s, float ls, float i_d)
+{
+  const uint32_t n = s->ls_curve_points;
+  const float last = s->ls_curve_i_a[n - 1u] * s->ls_curve_h[n - 1u], flux = ls * i_d;
+  return flux > 0.0f && flux < last ? s->ls_shift_e * (last / flux - 1.0f) : 0.0f;
 }
 
 /* The secant step of FLUX_MAX_CONTRACTION: L_w from ls_h and the two curve
@@ -129,9 +150,11 @@ void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums
            refit(&z, we, ws, lw, sls, &tr, &rs);
   /* The curve's share of the bounds: L_w's uncertainty, i.e. its distance
    * from the curve at the result's own i_d (the step's remainder) plus the
-   * curve's uncertainty there, taken through the same closed form (the
+   * curve's uncertainty there (the interpolation's and, below the last
+   * point's flux, its points'), taken through the same closed form (the
    * estimate with L_w that much higher); and the picture's share of the move. */
-  const float dl = fabsf(ls_at(s, i2, ws, tr, &err) - lw) + err;
+  const float dl =
+      fabsf(ls_at(s, i2, ws, tr, &err) - lw) + err + lw * low_flux_share(s, lw, id_at(i2, ws, tr));
   ok = ok && refit(&z, we, ws, lw + dl, sls, &tr_e, &rs_e);
   if (!ok) {
     /* no motor with the curve's L_S gives this impedance, or the curve is too
