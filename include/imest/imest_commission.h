@@ -104,7 +104,7 @@
  *   completes the result. Measured totals: 10.4 s at standstill for a 4 kW motor (T_R 128 ms;
  *   the slip-frequency test 2.0 s of it, at most 5.3 A of the 11.6 A limit), 38.7 s for 37 kW
  *   (T_R 553 ms; the test 8.5 s, 45.6 A of 96 A), plus 17 to 30 s of rotation (28 s for the 4 kW motor with
- *   saturation, 53 s for 11 kW and 60 s for 37 kW with their real motors' saturation; README,
+ *   saturation, 55 s for 11 kW and 60 s for 37 kW with their real motors' saturation; README,
  *   Commissioning, tools/commission/readme-tables).
  *
  * What is measured, and how (per axis, then combined; the spread between the three axes is
