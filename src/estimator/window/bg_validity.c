@@ -539,14 +539,14 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
     *dk2 = INFINITY;
     return;
   }
-  const float we = j->op.we, k2 = 1.0f / j->tr, nw = we - slip_rate, m = s->m;
-  const float kb = s->bw.b0 / (1.0f - s->bw.b0); /* tan(pi f_c / f_s) of the first section */
-  const float wq = 2.0f * s->fs * kb;
+  const float we = j->op.we, k2 = 1.0f / j->tr, nw = we - slip_rate, m = (float)s->m;
+  const float b0 = (float)s->bw.b0, kb = b0 / (1.0f - b0); /* tan(pi f_c / f_s) of the first section */
+  const float wq = 2.0f * (float)s->fs * kb;
   const float lin = AB_PER_PHASE_F * FOUR_OVER_PI_F;
   /* eps |E_1|^2 / (sigma L_S). The model within u of the truth puts the truth up to 1 / (1 - u) of
    * the model's, and the model's error up to u / (1 - u) of it from the truth */
   const float e1 = lin * h->sign_v / (1.0f - h->u);
-  const float ee = e1 * e1 * h->u * s->inv_s;
+  const float ee = e1 * e1 * h->u * (float)s->inv_s;
   float g1 = 0.0f, g2 = 0.0f;
   for (int p = 1; p <= HARMONIC_PAIRS; ++p) {
     for (int sgn = -1; sgn <= 1; sgn += 2) {
