@@ -153,8 +153,9 @@ void imest__bg_flux(const imest_t *s, const bg_window_stats_t *st, const bg_sums
    * curve's uncertainty there (the interpolation's and, below the last
    * point's flux, its points'), taken through the same closed form (the
    * estimate with L_w that much higher); and the picture's share of the move. */
-  const float dl =
-      fabsf(ls_at(s, i2, ws, tr, &err) - lw) + err + lw * low_flux_share(s, lw, id_at(i2, ws, tr));
+  const float id = id_at(i2, ws, tr);
+  const float l_id = imest__bg_flux_ls(s, id, &err); /* err set before it is read */
+  const float dl = fabsf(l_id - lw) + err + lw * low_flux_share(s, lw, id);
   ok = ok && refit(&z, we, ws, lw + dl, sls, &tr_e, &rs_e);
   if (!ok) {
     /* no motor with the curve's L_S gives this impedance, or the curve is too

@@ -560,10 +560,10 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
       if (!(zz > 0.0f)) continue;
       /* y = 1 / Z_k: i_k = -E_k y */
       const float yr = zk.zr / zz, yi = -zk.zi / zz;
+      const float dd = k2 * k2 + wk * wk; /* |K2 + j w_k|^2 */
       /* dq/dK1 / (-E_k) = (K2 + j w_k) y; Re((K2 + j w_k) conj of it) = |K2 + j w_k|^2 Re y */
-      g1 += w2 * (k2 * k2 + wk * wk) * yr;
+      g1 += w2 * dd * yr;
       /* dq/dK2 / (-E_k) = m y F, F = K2 (K2 - j n w) / (K2 + j w_k) - (2 K2 - j n w) */
-      const float dd = k2 * k2 + wk * wk;
       const float ar = k2 * k2, ai = -k2 * nw;                                  /* K2 (K2 - j n w) */
       const float qr = (ar * k2 + ai * wk) / dd, qi = (ai * k2 - ar * wk) / dd; /* / (K2 + j w_k) */
       const float fr = qr - 2.0f * k2, fi = qi + nw;
