@@ -32,14 +32,19 @@ enum { CM_S_V = 0, CM_S_MA = 1, CM_S_TD = 4, CM_S_VTH = 5, CM_S_DR = 6, CM_S_DEL
 /* Square-wave block sums: y = current step over a period, x1 = voltage, x2 = mean current. */
 enum { CM_H_X11 = 0, CM_H_X12, CM_H_X1, CM_H_X22, CM_H_X2, CM_H_YX1, CM_H_YX2, CM_H_Y, CM_H_YY };
 
-/* Slip-frequency block sums: per tone t (0: f1, 1: 2 f1) the current less the DC one and the
-   voltage less the DC one, each times cos and sin of the tone's phase (commission_slip.c). */
+/* Slip-frequency block sums: per tone t (0: f1, 1: CM_SLIP_M f1) the current less the DC one
+   and the voltage less the DC one, each times cos and sin of the tone's phase
+   (commission_slip.c). */
 enum { CM_L_IC = 0, CM_L_IS = 1, CM_L_VC = 2, CM_L_VS = 3, CM_L_TONE = 4 };
-/* The test's lower tone at w T_R = CM_SLIP_X: where 1 % of T_R moves sigma*L_S by 0.4 %
-   (imest_commission.h, "What is measured"); each tone's amplitude a share of the DC current
-   that keeps the sum of both 0.3 of it from zero (no phase current changes sign); the
-   settling before the block in T_R; the block's whole periods of f1. */
+/* The test's lower tone at w T_R = CM_SLIP_X (imest_commission.h, "What is measured"); the
+   upper one an odd multiple of it, CM_SLIP_M f1, so that no second-order product of a
+   saturating magnetising curve (0, 2 f1, (M - 1) f1, (M + 1) f1, 2 M f1) falls on either tone;
+   each tone's amplitude a share of the DC current that keeps the sum of both 0.3 of it from
+   zero (no phase current changes sign); the settling before the block in T_R; the block's
+   whole periods of f1. */
 #define CM_SLIP_X       6.0f
+#define CM_SLIP_M       3u
+#define CM_SLIP_HARM(t) ((t) == 0u ? 1u : CM_SLIP_M) /* tone t's multiple of f1 */
 #define CM_SLIP_AMP     0.35f
 #define CM_SLIP_SETTLE  2.0f
 #define CM_SLIP_PERIODS 3u

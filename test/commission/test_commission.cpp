@@ -232,19 +232,27 @@ TEST_P(CommissionSaturating, LsAtRatedFluxAndTheCurveWithinTwoPercent)
     EXPECT_FALSE(r.flags & IMEST_COMM_FLAG_ROTOR_HF); // saturation alone is not a deep-bar rotor
   } else {
     // the double cage's sigma*L_S at fs/8 is its high-frequency one (about 44 % low): flagged,
-    // and sigma comes from the slip-frequency test, which on this saturating motor (its T_R
-    // from the tails at other currents, so the two tones disagree) is off by a third and says
-    // so: the stated uncertainty covers the error (the estimator then refuses, not errs)
+    // and sigma comes from the slip-frequency test, whose tones find their own magnetising
+    // branch (the incremental one at the test's flux; the standstill tails' T_R, from steps
+    // through the curve, once put it 35 % low): within 1 % of the truth at rated flux, and the
+    // uncertainty stated for sigma covers its error and is far below the data sheet's 0.2
     EXPECT_TRUE(r.flags & IMEST_COMM_FLAG_ROTOR_HF);
     EXPECT_TRUE(r.flags & IMEST_COMM_FLAG_SIGMA_SLIP);
     EXPECT_LT(rel(r.sigma_ls_hf_h.value, out.sigma_ls_h), -0.3);
+    EXPECT_LT(std::fabs(rel(r.sigma_ls_slip_h.value, out.sigma_ls_h)), 0.01);
     EXPECT_GE(r.sigma.spread_rel, std::fabs(rel(r.sigma.value, out.sigma)));
     imest_config_t cfg;
     imest_config_default(&cfg);
     EXPECT_EQ(imest_comm_apply(&r, &cfg), 7); // sigma too, the curve copied
     EXPECT_FLOAT_EQ(cfg.sigma, r.sigma.value);
     EXPECT_GT(cfg.sigma_uncertainty, std::fabs(rel(r.sigma.value, out.sigma)));
+    EXPECT_LT(cfg.sigma_uncertainty, 0.03f);
     EXPECT_FLOAT_EQ(cfg.ls_h, r.ls_h.value);
+    std::printf("%s real motor: sigma*L_S at slip frequency %+.3f %% (spread %.2f %%), sigma %+.3f %% "
+                "(stated %.2f %%)\n",
+                GetParam().preset, 100.0 * rel(r.sigma_ls_slip_h.value, out.sigma_ls_h),
+                100.0 * r.sigma_ls_slip_h.spread_rel, 100.0 * rel(r.sigma.value, out.sigma),
+                100.0 * cfg.sigma_uncertainty);
   }
 }
 
@@ -317,7 +325,7 @@ TEST_P(CommissionDeepBar, SigmaAtSlipFrequencyWithinItsStatedUncertainty)
               GetParam(), 100.0 * rel(v.value, sigma_ls_at(0.0)), 100.0 * rel(v.value, sigma_ls_at(f_sl)),
               f_sl, 100.0 * u, 100.0 * rel(r.sigma_ls_hf_h.value, out.sigma_ls_h),
               100.0 * rel(cfg.sigma, out.sigma), 100.0 * cfg.sigma_uncertainty, r.slip_test_hz,
-              2.0 * r.slip_test_hz);
+              3.0 * r.slip_test_hz);
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, CommissionDeepBar, ::testing::Values("4kw", "11kw"),

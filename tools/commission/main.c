@@ -459,7 +459,7 @@ int main(int argc, char **argv)
            100.0 * (double)r->sigma_ls_hf_h.spread_rel);
   row("  at fs/8", 1e3, (double)r->sigma_ls_hf_h.value, out.sigma_ls_h, note);
   snprintf(note, sizeof note, "tones %.3g and %.3g Hz; spread %.2g %%", (double)r->slip_test_hz,
-           2.0 * (double)r->slip_test_hz, 100.0 * (double)r->sigma_ls_slip_h.spread_rel);
+           3.0 * (double)r->slip_test_hz, 100.0 * (double)r->sigma_ls_slip_h.spread_rel);
   row("  at slip frequency", 1e3, (double)r->sigma_ls_slip_h.value, out.sigma_ls_h, note);
   snprintf(note, sizeof note, "%s; standstill %.5g mH (%+.2f %%)",
            (r->flags & IMEST_COMM_FLAG_LS_STANDSTILL) ? "standstill" : "rotating",

@@ -285,6 +285,17 @@ static int report(imest_comm_t *c, uint32_t last)
   r->ls_h.value = ls;
   r->ls_h.std_rel = sd;
   r->ls_h.spread_rel = dep;
+  /* the slip-frequency test's S is the leakage with the incremental L_M at its DC current; at
+     rated flux the static L_M is another: S = L_ls + L_m L_lr / (L_m + L_lr) moves by
+     (L_lr / L_R)^2 dL_m, and L_lr L_m / L_R <= S bounds that by (S / L_M)^2 |dL_M| (the split
+     of the leakage between stator and rotor is not observable: the bound takes all of it in
+     the rotor) */
+  {
+    const float lm_r = ls - sl, u = sl * imest__abs(c->sl_lm - lm_r) / (lm_r * lm_r);
+    if (lm_r > 0.0f && u > r->sigma_ls_slip_h.spread_rel) r->sigma_ls_slip_h.spread_rel = u;
+    if ((r->flags & IMEST_COMM_FLAG_SIGMA_SLIP) && lm_r > 0.0f && u > r->sigma_ls_h.spread_rel)
+      r->sigma_ls_h.spread_rel = u;
+  }
   r->sigma.value = sl / ls;
   {
     const float s1 = r->sigma_ls_h.std_rel, s2 = r->sigma_ls_h.spread_rel;

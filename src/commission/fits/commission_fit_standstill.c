@@ -5,7 +5,7 @@
  * by as much), then means and spreads. R_S: the fitted R less the half-difference of the slope
  * resistances (the common part min(r_sw, r_d) stays in R_S: no terminal measurement separates
  * it) and less the user's known series resistance. sigma*L_S at slip frequency from each axis's
- * two-tone sums (commission_slip.c) with that axis's R and T_R.
+ * two-tone sums (commission_slip.c) with that axis's R (their own magnetising branch: no T_R).
  * float32: the per-axis fits (float64) are done; what is left are means, spreads and sums of
  * squares of three values each, with no cancellation (float32's 6e-8 against the fits' 1e-4
  * standard errors), and every result is a float. */
@@ -33,13 +33,11 @@ static void set_value(imest_comm_value_t *out, float value, float std_rel, float
   out->spread_rel = spread;
 }
 
-/* sigma*L_S at tone t of slip-frequency block sums s (commission_slip.c): Z = U / I, U moved
-   back by the zero-order hold's half period and scaled by its sinc, less the axis's DC
-   resistance r; then (Im Z - Re Z / (w tau)) / w (imest_commission.h, "What is measured").
-   NaN without a current (0 / 0). float32: the sums are float32, and what follows are a ratio and a
-   difference of terms 3:1 (Im Z against Re Z / x at x = 6), 1e-7 against the blocks' 1e-3
-   scatter. */
-static float slip_sigma_ls(const float s[IMEST_COMM_NSUM], uint32_t t, float w, float ts, float r, float tau)
+/* Z - r at tone t of slip-frequency block sums s (commission_slip.c): Z = U / I, U moved back
+   by the zero-order hold's half period and scaled by its sinc, less the axis's DC resistance r.
+   NaN without a current (0 / 0). */
+static void slip_z(const float s[IMEST_COMM_NSUM], uint32_t t, float w, float ts, float r, float *zr,
+                   float *zi)
 {
   const float *st = s + (size_t)t * (size_t)CM_L_TONE;
   /* the phasor of x_k = Re(X e^{j theta_k}) is X = (2 / n) sum x_k e^{-j theta_k}, and the ISR
@@ -50,8 +48,42 @@ static float slip_sigma_ls(const float s[IMEST_COMM_NSUM], uint32_t t, float w, 
   /* U e^{-j h} sinc */
   const float ur = (vc * ch + vs * sh) * sinc, ui = (vs * ch - vc * sh) * sinc;
   const float i2 = ic * ic + is * is;
-  const float zr = (ur * ic + ui * is) / i2 - r, zi = (ui * ic - ur * is) / i2;
-  return (zi - zr / (w * tau)) / w;
+  *zr = (ur * ic + ui * is) / i2 - r;
+  *zi = (ui * ic - ur * is) / i2;
+}
+
+/* One axis's slip-frequency sigma*L_S from its two tones, w1 and w2 = CM_SLIP_M w1, with the
+   axis's DC resistance r (imest_commission.h, "What is measured"). In the inverse-Gamma circuit
+   Z_k - r - j w_k S = 1 / (1 / R'_k + 1 / (j w_k L_M)): the magnetising branch L_M (the
+   incremental one at the test's DC current, which no standstill T_R gives on a saturating
+   motor) is the same at both tones, the rotor's R'_k may differ (deep bars), so S is the root
+   of w_1 Im y_1(S) = w_2 Im y_2(S) = -1 / L_M, y_k = 1 / (Z_k - r - j w_k S). Newton's steps
+   from the root with R'_1 = R'_2 (closed form); the root has its error from the leakage's own
+   frequency dependence only. rp[k]: R'_k, *lm: L_M; returns S, NaN without the tones. float32: Im y_k is
+   a difference of terms up to 15:1 (the upper tone), 1e-6 against the blocks' 1e-3 scatter. */
+static float slip_sigma_ls(const float s[IMEST_COMM_NSUM], float w1, float ts, float r, float rp[2],
+                           float *lm)
+{
+  float a[2], b[2], w[2] = {w1, w1 * (float)CM_SLIP_M};
+  for (uint32_t t = 0u; t < 2u; ++t) slip_z(s, t, w[t], ts, r, &a[t], &b[t]);
+  /* Im Z_k - w_k S = Re Z_k / (w_k T): the same T at both tones */
+  const float p1 = b[0] / w[0], p2 = b[1] / w[1], q1 = a[0] / (w[0] * w[0]), q2 = a[1] / (w[1] * w[1]);
+  float S = p1 - q1 * (p1 - p2) / (q1 - q2);
+  for (int it = 0; it < 4; ++it) {
+    float g = 0.0f, dg = 0.0f;
+    for (uint32_t t = 0u; t < 2u; ++t) {
+      const float be = b[t] - w[t] * S, d = a[t] * a[t] + be * be, sg = t == 0u ? 1.0f : -1.0f;
+      g += sg * w[t] * be / d;
+      dg -= sg * w[t] * w[t] * (a[t] * a[t] - be * be) / (d * d);
+    }
+    S -= g / dg;
+  }
+  for (uint32_t t = 0u; t < 2u; ++t) {
+    const float be = b[t] - w[t] * S;
+    rp[t] = (a[t] * a[t] + be * be) / a[t];
+    if (t == 0u) *lm = (a[t] * a[t] + be * be) / (w[t] * be); /* -1 / (w_1 Im y_1) */
+  }
+  return S;
 }
 
 /* The three axes' values (gain corrected): means, spreads, and the sums of the per-axis
@@ -59,7 +91,7 @@ static float slip_sigma_ls(const float s[IMEST_COMM_NSUM], uint32_t t, float w, 
 typedef struct {
   float rm, rsp, slm, slsp, taum, tausp, lmm, lmsp, tdm, tdsp, vthm, vthsp, drm, drsp;
   float r_var, sl_var, td_var, vth_var, dr_var, tau_var, rms2;
-  float sfm, sfsp, sf_d; /* slip-frequency sigma*L_S: mean, spread, mean D */
+  float sfm, sfsp, sf_d, sf_lm; /* slip-frequency sigma*L_S: mean, spread, mean correction; L_M */
 } axes_t;
 
 /* Sensor gains relative to their mean (three sensors only), and the correction factor each
@@ -90,7 +122,7 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
   const imest_comm_axis_fit_t *f = c->fit;
   float rk[3], slk[3], tauk[3], lmk[3], tdk[3], vthk[3], drk[3], sfk[3];
   a->r_var = a->sl_var = a->td_var = a->vth_var = a->dr_var = a->tau_var = a->rms2 = 0.0f;
-  a->sf_d = 0.0f;
+  a->sf_d = a->sf_lm = 0.0f;
   for (int k = 0; k < 3; ++k) {
     rk[k] = f[k].r_ohm * corr[k];
     slk[k] = f[k].slsig_h * corr[k];
@@ -99,15 +131,23 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
     tdk[k] = f[k].td_s;
     vthk[k] = f[k].vth_v;
     drk[k] = f[k].dr_ohm * corr[k];
-    /* slip-frequency sigma*L_S at f1 and 2 f1 with this axis's R and T_R: the middle of its
-       range over 0..f1, sigma*L_S(f1) - D / 6, and D = sigma*L_S(2 f1) - sigma*L_S(f1) */
-    float v[2];
-    for (uint32_t t = 0; t < 2u; ++t)
-      v[t] = slip_sigma_ls(c->blk[CM_SLIP_BLK + (uint32_t)k].s, t, c->sl_w * (float)(t + 1u), c->ts_s,
-                           f[k].r_ohm, f[k].tau_s) *
-             corr[k];
-    sfk[k] = v[0] - (v[1] - v[0]) / 6.0f;
-    a->sf_d += (v[1] - v[0]) / 3.0f;
+    /* slip-frequency sigma*L_S with this axis's R; the leakage's frequency dependence from a
+       double cage's one pole: the leakage falls by tau x the resistance's rise, tau = the
+       square wave's leakage drop over its resistance rise (both the rotor's high-frequency
+       limits against the tones'), and the resistance rises as w^2: from 0 to f1 by
+       (R'_2 - R'_1) / (M^2 - 1). The root above is S(0) - (M^2 + 1) x that fall c (each tone's
+       S(w_k) = S(0) - c (w_k / w1)^2 weighted by the Im condition); it is corrected, and c
+       (M^2 + 1) stays as the frequency dependence */
+    float rp[2], lm;
+    const float sk =
+        slip_sigma_ls(c->blk[CM_SLIP_BLK + (uint32_t)k].s, c->sl_w, c->ts_s, f[k].r_ohm, rp, &lm);
+    a->sf_lm += lm * corr[k] / 3.0f;
+    const float dl = sk - f[k].slsig_h, dr = f[k].rhf_ohm - f[k].r_ohm - rp[0];
+    const float drise = (rp[1] - rp[0]) / (float)(CM_SLIP_M * CM_SLIP_M - 1u);
+    const float fall = dl > 0.0f && dr > 0.0f && drise > 0.0f ? dl / dr * drise : 0.0f;
+    const float kap = (float)(CM_SLIP_M * CM_SLIP_M + 1u);
+    sfk[k] = (sk + kap * fall) * corr[k];
+    a->sf_d += kap * fall * corr[k] / 3.0f;
     a->r_var += f[k].r_std * f[k].r_std;
     a->sl_var += (f[k].slsig_std * f[k].slsig_h) * (f[k].slsig_std * f[k].slsig_h);
     a->td_var += f[k].td_std * f[k].td_std;
@@ -136,9 +176,10 @@ static float report_values(imest_comm_t *c, const axes_t *a)
   set_value(&r->rs_ohm, rs, imest__sqrt(a->r_var) / 3.0f / rs, a->rsp * a->rm / rs);
   set_value(&r->sigma_ls_hf_h, a->slm, imest__sqrt(a->sl_var) / 3.0f / a->slm, a->slsp);
   r->slip_test_hz = c->sl_w * (float)IMEST_INV_2PI_LIT;
-  /* the frequency dependence left over rotor frequencies 0..f1: |D| / 6 */
-  const float dep = imest__abs(a->sf_d) / 6.0f / a->sfm;
+  /* the leakage's frequency dependence, the correction's size */
+  const float dep = a->sf_d / a->sfm;
   set_value(&r->sigma_ls_slip_h, a->sfm, NAN, a->sfsp > dep ? a->sfsp : dep);
+  c->sl_lm = a->sf_lm;
   /* a deep-bar rotor's sigma*L_S is the slip-frequency one; without it (NaN fails), the square
      wave's, marked as not the one needed */
   const int hf = (r->flags & IMEST_COMM_FLAG_ROTOR_HF) != 0u, slip = hf && a->sfm > 0.0f;
