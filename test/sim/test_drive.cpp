@@ -184,8 +184,8 @@ TEST(SimDrive, DropsFollowTheCurrentsSignWithinAPeriod)
     ASSERT_GT(used, 300) << moments;
     const double rms = std::sqrt(sum2 / (3.0 * used));
     EXPECT_LT(rms, 0.07) << moments;
-    std::printf("[ drops    ] moments=%d rows=%d rms |error - formula| near the crossings %.3f V\n", moments, used,
-                rms);
+    std::printf("[ drops    ] moments=%d rows=%d rms |error - formula| near the crossings %.3f V\n", moments,
+                used, rms);
   }
 }
 
