@@ -110,3 +110,53 @@ double imest__bg_sqrt(double x)
   return b.d;
 }
 #endif
+
+#if BG_SOFT_DOUBLE
+#include "bg_ff.h"
+
+/* s + e = a + b exactly (Knuth's two_sum: no condition on the magnitudes) */
+static bg_ff_t two_sum(float a, float b)
+{
+  bg_ff_t r;
+  r.hi = a + b;
+  const float bb = r.hi - a;
+  r.lo = (a - (r.hi - bb)) + (b - bb);
+  return r;
+}
+
+bg_ff_t imest__bg_ff_madd(bg_ff_t c, bg_ff_t a, bg_ff_t b)
+{
+  const float p = a.hi * b.hi;
+  const float pl = BG_FMAF(a.hi, b.lo, BG_FMAF(a.lo, b.hi, BG_FMAF(a.hi, b.hi, -p)));
+  bg_ff_t s = two_sum(c.hi, p);
+  s.lo += c.lo + pl;
+  return two_sum(s.hi, s.lo);
+}
+
+/* x = m 2^(e-52), m < 2^53: hi = the top 24 bits of m, exact; lo = the other
+ * 29, rounded once to float32 (error <= 2^4 of 2^(e-52) <= 2^-48 |x|). By
+ * the bits: a soft-double subtraction would cost ~90 instructions a value.
+ * For -32 <= e < 32 both scales, 2^(e-23) and 2^(e-52), are normal. */
+int imest__bg_ff_of(const double *v, int n, bg_ff_t *f)
+{
+  for (int i = 0; i < n; ++i) {
+    bits64_t b;
+    b.d = v[i];
+    const int ex = (int)((b.u >> 52) & 0x7FFu);
+    f[i].hi = f[i].lo = 0.0f;
+    if ((b.u << 1) == 0u) continue; /* +-0 */
+    if (ex < 1023 - 32 || ex > 1023 + 31) return 0;
+    const uint64_t m = (b.u & 0xFFFFFFFFFFFFFull) | 0x10000000000000ull;
+    union {
+      float f;
+      uint32_t u;
+    } sh, sl;
+    sh.u = (uint32_t)(ex - 1023 - 23 + 127) << 23;
+    sl.u = (uint32_t)(ex - 1023 - 52 + 127) << 23;
+    const float sg = ((b.u >> 63) != 0u) ? -1.0f : 1.0f;
+    f[i].hi = sg * ((float)(uint32_t)(m >> 29) * sh.f);
+    f[i].lo = sg * ((float)(uint32_t)(m & 0x1FFFFFFFu) * sl.f);
+  }
+  return 1;
+}
+#endif
