@@ -112,6 +112,62 @@ double imest__bg_sqrt(double x)
 #endif
 
 #if BG_SOFT_DOUBLE
+/* x = mx 2^(ex-52), y = my 2^(ey-52), mx, my in [2^52, 2^53); with mx < my
+ * doubled, x / y = (mx / my) 2^e with mx / my in [1, 2), so the result's
+ * mantissa is q = round(mx 2^52 / my) in [2^52, 2^53]. q is built in three
+ * chunks of 20, 22 and 10 bits, each estimated in float32 from the exact
+ * remainder rem = mx 2^n - Q my: |rem / my| <= 3 after each chunk (the
+ * float32 quotient is within 2^-22 relative, plus one for the truncation),
+ * so rem stays below 2^55 and is exact in int64 modulo 2^64, and the
+ * chunks fit int32. Then at most two unit steps make 0 <= rem < my (Q the
+ * floor), and Q rounds up iff 2 rem > my (no tie: mx 2^53 / my would be an
+ * odd integer, but my < 2^53 leaves a factor 2 in it). Zero, subnormal or
+ * non-finite operands and results outside the normal range: the library's
+ * division. */
+static int64_t div_chunk(int64_t rem, float rinv, float scale)
+{
+  return (int64_t)(int32_t)((float)(int32_t)(rem / 16777216) * rinv * scale); /* rem / 2^24 < 2^31 */
+}
+
+BG_CORE_PCS double imest__bg_div(double x, double y)
+{
+  bits64_t a, b;
+  a.d = x;
+  b.d = y;
+  const int ea = (int)((a.u >> 52) & 0x7FFu), eb = (int)((b.u >> 52) & 0x7FFu);
+  uint64_t mx = (a.u & 0xFFFFFFFFFFFFFull) | 0x10000000000000ull;
+  const uint64_t my = (b.u & 0xFFFFFFFFFFFFFull) | 0x10000000000000ull;
+  int e = ea - eb + 1023;
+  if (mx < my) {
+    mx <<= 1;
+    --e;
+  }
+  if (ea == 0 || ea == 0x7FF || eb == 0 || eb == 0x7FF || e < 1 || e > 2046) return x / y;
+  const float rinv = 1.0f / (float)(uint32_t)(my >> 21); /* 2^21 / my, within 2^-23 */
+  /* q1 = mx 2^20 / my: (mx / 2^22) (2^21 / my) 2^21 */
+  uint64_t q = (uint64_t)(uint32_t)((float)(uint32_t)(mx >> 22) * rinv * 2097152.0f);
+  int64_t rem = (int64_t)((mx << 20) - q * my);
+  /* next chunk: rem 2^22 / my = (rem / 2^24) (2^21 / my) 2^25 */
+  int64_t c = div_chunk(rem, rinv, 33554432.0f);
+  q = (q << 22) + (uint64_t)c;
+  rem = (int64_t)(((uint64_t)rem << 22) - (uint64_t)c * my);
+  c = div_chunk(rem, rinv, 8192.0f); /* rem 2^10 / my = (rem / 2^24) (2^21 / my) 2^13 */
+  q = (q << 10) + (uint64_t)c;
+  rem = (int64_t)(((uint64_t)rem << 10) - (uint64_t)c * my);
+  for (int i = 0; i < 3; ++i) {
+    if (rem < 0) {
+      rem += (int64_t)my;
+      --q;
+    } else if (rem >= (int64_t)my) {
+      rem -= (int64_t)my;
+      ++q;
+    }
+  }
+  if ((uint64_t)rem > my - (uint64_t)rem) ++q; /* q = 2^53 carries into the exponent */
+  b.u = ((a.u ^ b.u) & 0x8000000000000000ull) + ((uint64_t)(e - 1) << 52) + q;
+  return b.d;
+}
+
 #include "bg_ff.h"
 
 /* s + e = a + b exactly (Knuth's two_sum: no condition on the magnitudes) */

@@ -139,7 +139,7 @@ int imest__bg_tables_build_weighted(const bg_sums_t *in, double tr_nominal_s, do
   double se1 = 0.0, se2 = 0.0;
   for (int m = 0; m < 7; ++m) se2 += t->e2[m];
   for (int m = 0; m < 8; ++m) se1 += t->e1[m];
-  const double khat = -se1 / (2.0 * se2);
+  const double khat = BG_DIV(-se1, 2.0 * se2);
   int gexp = 0;
   if (imest__bg_finite(khat) && khat != 0.0) {
     gexp = imest__bg_round_log2(khat < 0.0 ? -khat : khat);
