@@ -3,7 +3,9 @@
 // bit: imest__bg_scale2 against the multiplication by imest__bg_pow2, and
 // imest__bg_sqrt against the correctly rounded sqrt, on random bit patterns
 // (every exponent, subnormals), numbers next to squares and to the rounding
-// midpoints (y + 1/2 ulp)^2, and the special values.
+// midpoints (y + 1/2 ulp)^2, and the special values; imest__bg_div against the
+// division, on random bit patterns, quotients next to the rounding midpoints
+// and to the ends of the normal range, and the special values.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -40,6 +42,26 @@ double random_double(std::mt19937_64 &rng, int kind)
   default: return from_bits(u & 0x800FFFFFFFFFFFFFull); // subnormal
   }
 }
+
+#if BG_SOFT_DOUBLE
+// zeros, subnormals, the ends of the range, non-finite, next to 1, 2 and 4
+const double kSpecial[] = {0.0,
+                           -0.0,
+                           1.0,
+                           2.0,
+                           4.0,
+                           0.25,
+                           -1.0,
+                           -0.5e-310,
+                           std::numeric_limits<double>::infinity(),
+                           -std::numeric_limits<double>::infinity(),
+                           std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::denorm_min(),
+                           std::numeric_limits<double>::min(),
+                           std::numeric_limits<double>::max(),
+                           std::nextafter(4.0, 0.0),
+                           std::nextafter(1.0, 2.0)};
+#endif
 
 } // namespace
 
@@ -81,23 +103,7 @@ TEST(BgFloat, SqrtIsCorrectlyRounded)
         ADD_FAILURE() << std::hexfloat << "sqrt(" << x << ") = " << got << ", want " << want;
     }
   };
-  const double special[] = {0.0,
-                            -0.0,
-                            1.0,
-                            2.0,
-                            4.0,
-                            0.25,
-                            -1.0,
-                            -0.5e-310,
-                            std::numeric_limits<double>::infinity(),
-                            -std::numeric_limits<double>::infinity(),
-                            std::numeric_limits<double>::quiet_NaN(),
-                            std::numeric_limits<double>::denorm_min(),
-                            std::numeric_limits<double>::min(),
-                            std::numeric_limits<double>::max(),
-                            std::nextafter(4.0, 0.0),
-                            std::nextafter(1.0, 2.0)};
-  for (double x : special) check(x);
+  for (double x : kSpecial) check(x);
   for (int i = 0; i < 600000; ++i) check(random_double(rng, i));
   for (int i = 0; i < 200000; ++i) {
     // next to squares and to rounding midpoints (y + 1/2 ulp)^2: the decisions that need every bit
@@ -107,6 +113,36 @@ TEST(BgFloat, SqrtIsCorrectlyRounded)
     for (double b : base)
       for (int k = -2; k <= 2; ++k)
         check(std::ldexp(from_bits(bits(b) + (uint64_t)(int64_t)k), (int)(rng() % 200) - 100));
+  }
+  EXPECT_EQ(mismatches, 0);
+}
+
+TEST(BgFloat, DivIsCorrectlyRounded)
+{
+  std::mt19937_64 rng(7002);
+  long mismatches = 0;
+  auto check = [&](double x, double y) {
+    const double want = x / y, got = imest__bg_div(x, y);
+    if (std::isnan(want) ? !std::isnan(got) : bits(want) != bits(got)) {
+      if (++mismatches <= 5)
+        ADD_FAILURE() << std::hexfloat << x << " / " << y << " = " << got << ", want " << want;
+    }
+  };
+  for (double x : kSpecial)
+    for (double y : kSpecial) check(x, y);
+  for (int i = 0; i < 600000; ++i) check(random_double(rng, i), random_double(rng, i / 3));
+  for (int i = 0; i < 200000; ++i) {
+    // x = (q + 1/2 ulp +- a few ulp) y: quotients next to the rounding midpoints, where the
+    // decision needs the exact remainder; and exponents at the ends of the normal range
+    const double y = 1.0 + (double)(rng() >> 12) * 0x1p-52;
+    const double q = 1.0 + (double)(rng() >> 12) * 0x1p-52;
+    const double x = (double)(((long double)q + 0x1p-53L) * (long double)y);
+    for (int k = -2; k <= 2; ++k) {
+      const double xk = from_bits(bits(x) + (uint64_t)(int64_t)k);
+      check(xk, y);
+      const int e = (int)(rng() % 2100) - 1050;
+      check(std::ldexp(xk, e / 2), std::ldexp(y, -(e - e / 2)));
+    }
   }
   EXPECT_EQ(mismatches, 0);
 }

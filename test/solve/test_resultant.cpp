@@ -145,3 +145,84 @@ TEST(Resultant, WeightedStructuredDegree19)
     }
   }
 }
+
+#if BG_SOFT_DOUBLE
+namespace {
+
+// out = conv(a, b) with sign, and its magnitude sum |a_i b_j|, in long double
+void conv_ld(const long double *a, int na, const long double *b, int nb, long double sign, long double *out,
+             long double *mag)
+{
+  for (int i = 0; i < na; ++i)
+    for (int j = 0; j < nb; ++j) {
+      out[i + j] += sign * a[i] * b[j];
+      mag[i + j] += std::fabs(a[i] * b[j]);
+    }
+}
+
+} // namespace
+
+// Where double is soft the resultant and the table values run in float-float
+// (bg_ff.h): within the stated bound (3n + 10) 2^-48 sum |terms| (n <= 15;
+// 2e-13) of a long double reference, on random weighted tables inside the
+// float-float range, and the table values within (8 + 3 * 8 + 4) 2^-48 (1.3e-13).
+TEST(Resultant, FloatFloatWithinItsBound)
+{
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> U(0, 1);
+  int in_range = 0;
+  double worst_r = 0, worst_v = 0;
+  for (int it = 0; it < 300; ++it) {
+    const bg_sums_t s = random_psd(rng, it % 2 == 0, (1 - 0.096) / 0.096);
+    bg_tables_t t;
+    imest__bg_tables_scaled(&s, 0, 0, 0, &t);
+    imest__bg_tables_weight(&t, (it % 3 == 0) ? 0.0 : std::pow(10.0, -2 + 4 * U(rng)));
+    if (!t.ff_ok) continue;
+    ++in_range;
+    double r[22];
+    imest__bg_resultant(&t, r, 1);
+    long double a0[8], a1[7], b2[8], b1[9], b0[10], u[15] = {0}, um[15] = {0}, sq[13] = {0}, sqm[13] = {0};
+    long double ref[22] = {0}, mag[22] = {0}, ignore[22] = {0};
+    for (int k = 0; k < 8; ++k) a0[k] = t.a0[k], b2[k] = t.bw2[k];
+    for (int k = 0; k < 7; ++k) a1[k] = t.a1[k];
+    for (int k = 0; k < 9; ++k) b1[k] = t.bw1[k];
+    for (int k = 0; k < 10; ++k) b0[k] = t.bw0[k];
+    conv_ld(a0, 8, b2, 8, 1, u, um);
+    conv_ld(a1, 7, b1, 9, -1, u, um);
+    conv_ld(a1, 7, a1, 7, 1, sq, sqm);
+    conv_ld(a0, 8, u, 15, 1, ref, ignore);
+    conv_ld(sq, 13, b0, 10, 1, ref, ignore);
+    long double a0m[8];
+    for (int k = 0; k < 8; ++k) a0m[k] = std::fabs(a0[k]);
+    long double b0m[10];
+    for (int k = 0; k < 10; ++k) b0m[k] = std::fabs(b0[k]);
+    conv_ld(a0m, 8, um, 15, 1, mag, ignore);
+    conv_ld(sqm, 13, b0m, 10, 1, mag, ignore);
+    for (int k = 0; k < 22; ++k) {
+      const double err = (double)std::fabs(r[k] - ref[k]);
+      EXPECT_LE(err, 2e-13 * (double)mag[k]) << it << " r[" << k << "]";
+      if (mag[k] > 0) worst_r = std::max(worst_r, err / (double)mag[k]);
+    }
+    for (int q = 0; q < 4; ++q) {
+      const double x = std::pow(2.0, -8 + 16 * U(rng));
+      double v[3];
+      imest__bg_tables_values(&t, x, v);
+      const double *tab[3] = {t.e2, t.e1, t.e0};
+      const int len[3] = {7, 8, 9};
+      for (int o = 0; o < 3; ++o) {
+        long double e = 0, m = 0;
+        for (int k = len[o] - 1; k >= 0; --k) {
+          e = e * x + tab[o][k];
+          m = m * x + std::fabs(tab[o][k]);
+        }
+        const double err = (double)std::fabs(v[o] - e);
+        EXPECT_LE(err, 1.3e-13 * (double)m) << it << " x " << x;
+        worst_v = std::max(worst_v, err / (double)m);
+      }
+    }
+  }
+  EXPECT_GE(in_range, 200); // the float-float path is what this tests
+  std::printf("[float-float] %d of 300 in range; worst |r - ref| / sum|terms| %.2g, values %.2g\n", in_range,
+              worst_r, worst_v);
+}
+#endif

@@ -110,3 +110,109 @@ double imest__bg_sqrt(double x)
   return b.d;
 }
 #endif
+
+#if BG_SOFT_DOUBLE
+/* x = mx 2^(ex-52), y = my 2^(ey-52), mx, my in [2^52, 2^53); with mx < my
+ * doubled, x / y = (mx / my) 2^e with mx / my in [1, 2), so the result's
+ * mantissa is q = round(mx 2^52 / my) in [2^52, 2^53]. q is built in three
+ * chunks of 20, 22 and 10 bits, each estimated in float32 from the exact
+ * remainder rem = mx 2^n - Q my: |rem / my| <= 3 after each chunk (the
+ * float32 quotient is within 2^-22 relative, plus one for the truncation),
+ * so rem stays below 2^55 and is exact in int64 modulo 2^64, and the
+ * chunks fit int32. Then at most two unit steps make 0 <= rem < my (Q the
+ * floor), and Q rounds up iff 2 rem > my (no tie: mx 2^53 / my would be an
+ * odd integer, but my < 2^53 leaves a factor 2 in it). Zero, subnormal or
+ * non-finite operands and results outside the normal range: the library's
+ * division. */
+static int64_t div_chunk(int64_t rem, float rinv, float scale)
+{
+  return (int64_t)(int32_t)((float)(int32_t)(rem / 16777216) * rinv * scale); /* rem / 2^24 < 2^31 */
+}
+
+BG_CORE_PCS double imest__bg_div(double x, double y)
+{
+  bits64_t a, b;
+  a.d = x;
+  b.d = y;
+  const int ea = (int)((a.u >> 52) & 0x7FFu), eb = (int)((b.u >> 52) & 0x7FFu);
+  uint64_t mx = (a.u & 0xFFFFFFFFFFFFFull) | 0x10000000000000ull;
+  const uint64_t my = (b.u & 0xFFFFFFFFFFFFFull) | 0x10000000000000ull;
+  int e = ea - eb + 1023;
+  if (mx < my) {
+    mx <<= 1;
+    --e;
+  }
+  if (ea == 0 || ea == 0x7FF || eb == 0 || eb == 0x7FF || e < 1 || e > 2046) return x / y;
+  const float rinv = 1.0f / (float)(uint32_t)(my >> 21); /* 2^21 / my, within 2^-23 */
+  /* q1 = mx 2^20 / my: (mx / 2^22) (2^21 / my) 2^21 */
+  uint64_t q = (uint64_t)(uint32_t)((float)(uint32_t)(mx >> 22) * rinv * 2097152.0f);
+  int64_t rem = (int64_t)((mx << 20) - q * my);
+  /* next chunk: rem 2^22 / my = (rem / 2^24) (2^21 / my) 2^25 */
+  int64_t c = div_chunk(rem, rinv, 33554432.0f);
+  q = (q << 22) + (uint64_t)c;
+  rem = (int64_t)(((uint64_t)rem << 22) - (uint64_t)c * my);
+  c = div_chunk(rem, rinv, 8192.0f); /* rem 2^10 / my = (rem / 2^24) (2^21 / my) 2^13 */
+  q = (q << 10) + (uint64_t)c;
+  rem = (int64_t)(((uint64_t)rem << 10) - (uint64_t)c * my);
+  for (int i = 0; i < 3; ++i) {
+    if (rem < 0) {
+      rem += (int64_t)my;
+      --q;
+    } else if (rem >= (int64_t)my) {
+      rem -= (int64_t)my;
+      ++q;
+    }
+  }
+  if ((uint64_t)rem > my - (uint64_t)rem) ++q; /* q = 2^53 carries into the exponent */
+  b.u = ((a.u ^ b.u) & 0x8000000000000000ull) + ((uint64_t)(e - 1) << 52) + q;
+  return b.d;
+}
+
+#include "bg_ff.h"
+
+/* s + e = a + b exactly (Knuth's two_sum: no condition on the magnitudes) */
+static bg_ff_t two_sum(float a, float b)
+{
+  bg_ff_t r;
+  r.hi = a + b;
+  const float bb = r.hi - a;
+  r.lo = (a - (r.hi - bb)) + (b - bb);
+  return r;
+}
+
+bg_ff_t imest__bg_ff_madd(bg_ff_t c, bg_ff_t a, bg_ff_t b)
+{
+  const float p = a.hi * b.hi;
+  const float pl = BG_FMAF(a.hi, b.lo, BG_FMAF(a.lo, b.hi, BG_FMAF(a.hi, b.hi, -p)));
+  bg_ff_t s = two_sum(c.hi, p);
+  s.lo += c.lo + pl;
+  return two_sum(s.hi, s.lo);
+}
+
+/* x = m 2^(e-52), m < 2^53: hi = the top 24 bits of m, exact; lo = the other
+ * 29, rounded once to float32 (error <= 2^4 of 2^(e-52) <= 2^-48 |x|). By
+ * the bits: a soft-double subtraction would cost ~90 instructions a value.
+ * For -32 <= e < 32 both scales, 2^(e-23) and 2^(e-52), are normal. */
+int imest__bg_ff_of(const double *v, int n, bg_ff_t *f)
+{
+  for (int i = 0; i < n; ++i) {
+    bits64_t b;
+    b.d = v[i];
+    const int ex = (int)((b.u >> 52) & 0x7FFu);
+    f[i].hi = f[i].lo = 0.0f;
+    if ((b.u << 1) == 0u) continue; /* +-0 */
+    if (ex < 1023 - 32 || ex > 1023 + 31) return 0;
+    const uint64_t m = (b.u & 0xFFFFFFFFFFFFFull) | 0x10000000000000ull;
+    union {
+      float f;
+      uint32_t u;
+    } sh, sl;
+    sh.u = (uint32_t)(ex - 1023 - 23 + 127) << 23;
+    sl.u = (uint32_t)(ex - 1023 - 52 + 127) << 23;
+    const float sg = ((b.u >> 63) != 0u) ? -1.0f : 1.0f;
+    f[i].hi = sg * ((float)(uint32_t)(m >> 29) * sh.f);
+    f[i].lo = sg * ((float)(uint32_t)(m & 0x1FFFFFFFu) * sl.f);
+  }
+  return 1;
+}
+#endif

@@ -52,6 +52,23 @@ int imest__bg_finite(double x); /* isfinite by the exponent bits */
 double imest__bg_sqrt(double x);
 #define BG_SQRT(x) imest__bg_sqrt(x)
 #endif
+/* x / y, correctly rounded like IEEE-754 division (bit for bit): three
+ * float32 quotient chunks and an exact remainder in integers, ~130
+ * instructions where libgcc's soft-double division takes ~560. Where the FPU
+ * has double, its one instruction. */
+#if !BG_SOFT_DOUBLE
+#define BG_DIV(x, y) ((x) / (y))
+#else
+/* On a hard-float ABI, the operands in core registers like libgcc's
+ * __aeabi_ddiv's: the callers then move nothing to the FPU and back. */
+#if defined(__arm__) && defined(__ARM_PCS_VFP) && defined(__GNUC__)
+#define BG_CORE_PCS __attribute__((pcs("aapcs")))
+#else
+#define BG_CORE_PCS
+#endif
+BG_CORE_PCS double imest__bg_div(double x, double y);
+#define BG_DIV(x, y) imest__bg_div((x), (y))
+#endif
 /* round(log2(x)) for finite x > 0, exact (mantissa compared with sqrt 2). */
 int imest__bg_round_log2(double x);
 

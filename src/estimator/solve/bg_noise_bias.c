@@ -106,7 +106,7 @@ double imest__bg_noise_e(const bg_noise_t *nz, const double k[8], double m)
 
 double imest__bg_noise_e_at(const bg_noise_t *nz, double k1, double k2, double m)
 {
-  const double tr = 1.0 / k2;
+  const double tr = BG_DIV(1.0, k2);
   const double k[8] = {k1, k2, k2 * k2, k1 * k2, tr, k1 * tr, k1 * tr * tr, tr * tr};
   return imest__bg_noise_e(nz, k, m);
 }

@@ -73,7 +73,7 @@ BG_NOINLINE static double kbound(pe_ctx_t *c, double x, int sign)
     k = (double)sign * c->kprof;
   } else {
     const double root = (g < 0.0) ? BG_SQRT(-g) : 0.0;
-    k = ((double)(-sign) * v[1] + root) / (2.0 * v[0]);
+    k = BG_DIV((double)(-sign) * v[1] + root, 2.0 * v[0]);
   }
   return imest__bg_finite(k) ? k : (double)sign * c->kprof;
 }
@@ -84,7 +84,7 @@ BG_NOINLINE static double illinois(pe_ctx_t *c, double xs, double x0, double f0,
   int retained = 0; /* +1: x0 kept last time, -1: x1 kept last time */
   double x = x1;
   for (int it = 0; it < BG_PE_MAX_ROOT; ++it) {
-    x = x1 - f1 * (x1 - x0) / (f1 - f0);
+    x = x1 - BG_DIV(f1 * (x1 - x0), f1 - f0);
     const double lo = (x0 < x1) ? x0 : x1, hi = (x0 < x1) ? x1 : x0;
     if (!(x > lo && x < hi)) x = 0.5 * (x0 + x1);
     const double fx = level_fn(c, x);
@@ -179,7 +179,7 @@ BG_NOINLINE static double pe_max(pe_ctx_t *c, int sign, double a, double b, doub
     const double p = (xb - xa) * (fb - fc), q = (xb - xc) * (fb - fa);
     const double den = 2.0 * (p - q);
     if (!(den != 0.0)) break;
-    u = xb - ((xb - xa) * p - (xb - xc) * q) / den;
+    u = xb - BG_DIV((xb - xa) * p - (xb - xc) * q, den);
     if (!(u > xa && u < xc)) break;
     if (fabs(u - xb) <= tol) break;
     const double fu = kbound(c, u, sign);
@@ -220,7 +220,7 @@ unsigned int imest__bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, 
   const double x = best->kappa, k = best->k;
   bg_tabval_t v;
   imest__bg_tables_eval(t, x, &v);
-  const double dd = x * x + t->cw, idd = 1.0 / dd, f = idd * idd;
+  const double dd = x * x + t->cw, idd = BG_DIV(1.0, dd), f = idd * idd;
   const double f1 = -4.0 * x * f * idd, f2 = (20.0 * x * x - 4.0 * t->cw) * f * f;
   const double p = (v.e2 * k + v.e1) * k + v.e0;
   const double pk = 2.0 * v.e2 * k + v.e1;
@@ -239,7 +239,7 @@ unsigned int imest__bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, 
 
   const double es = p * f; /* E_w~* */
   /* the residual as measured: the compensated one plus what the noise explains */
-  const double er = es + (cfg->e_noise / t->c) * (x * x * x * x) * f;
+  const double er = es + BG_DIV(cfg->e_noise, t->c) * (x * x * x * x) * f;
   if (!(er > 0.0)) {
     out->pe_k1 = out->pe_k2 = 0.0;
     out->pe_quad[0] = out->pe_quad[1] = 0.0;
@@ -249,7 +249,7 @@ unsigned int imest__bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, 
 
   double dk_q = BG_PE_UNBOUNDED, dx_q = BG_PE_UNBOUNDED;
   if (out->hessian_pd) {
-    const double hh = 0.5 * er / det;
+    const double hh = BG_DIV(0.5 * er, det);
     dk_q = BG_SQRT(hh * h22);
     dx_q = BG_SQRT(hh * h11);
     out->pe_quad[0] = finite_or_unbounded(dk_q * t->g);
@@ -270,8 +270,8 @@ unsigned int imest__bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, 
   if (!(d0 >= 1e-9 * x)) d0 = 1e-9 * x;
   if (d0 > x) d0 = 0.5 * x;
   /* band in kappa */
-  const double x_lo_edge = 1.0 / (cfg->tr_max_s * t->s);
-  const double x_hi_edge = 1.0 / (cfg->tr_min_s * t->s);
+  const double x_lo_edge = BG_DIV(1.0, cfg->tr_max_s * t->s);
+  const double x_hi_edge = BG_DIV(1.0, cfg->tr_min_s * t->s);
   double xlo, xhi;
   if (!crossing(&c, x, fs, d0, (x_lo_edge < x) ? x_lo_edge : x, -1, &xlo))
     out->pe_flags |= BG_PE_FLAG_K2_LO_EDGE;
@@ -283,7 +283,7 @@ unsigned int imest__bg_quality(const bg_tables_t *t, const bg_solve_cfg_t *cfg, 
   /* K1 extremes, started at the quadratic model's: dkappa = -(H12/H22) dk */
   double xe_hi = x, xe_lo = x, h = 0.125 * (xhi - xlo);
   if (out->hessian_pd && imest__bg_finite(dk_q) && imest__bg_finite(dx_q)) {
-    const double shift = (h12 / h22) * dk_q;
+    const double shift = BG_DIV(h12, h22) * dk_q;
     xe_hi = x - shift;
     xe_lo = x + shift;
     h = 0.25 * dx_q;

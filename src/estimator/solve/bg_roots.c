@@ -287,7 +287,7 @@ BG_NOINLINE static double newton_bracketed(const double *c, int n, int order, do
       a = x;
     else
       b = x;
-    const double step = f / df;
+    const double step = BG_DIV(f, df);
     if (fabs(step) <= 4.0 * DBL_EPSILON * fabs(x)) return x - step; /* converged to ulp level */
     double xn = x - step;
     const int newton = (xn > a && xn < b); /* false for NaN/Inf too */
@@ -609,7 +609,7 @@ int imest__bg_roots_positive_ex(const double *c, int deg, double *roots, int max
     const double ylo = DOMAIN_LO[dom];
     const int nd = domain_roots(&ch, d, n, ylo, xd, st);
     const double back = imest__bg_pow2(ex);
-    for (int i = 0; i < nd; ++i) merge_root(rev ? back / xd[i] : xd[i] * back, roots, &nr, max, st);
+    for (int i = 0; i < nd; ++i) merge_root(rev ? BG_DIV(back, xd[i]) : xd[i] * back, roots, &nr, max, st);
   }
   return nr;
 }

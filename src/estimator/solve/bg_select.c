@@ -32,7 +32,7 @@ static int centred_ok(const bg_sums_t *in)
 
 double imest__bg_e_centred(const bg_sums_t *in, double k1, double k2)
 {
-  const double ik = 1.0 / k2, ik2 = ik * ik;
+  const double ik = BG_DIV(1.0, k2), ik2 = ik * ik;
   const double K[8] = {k1, k2, k2 * k2, k1 * k2, ik, k1 * ik, k1 * ik2, ik2};
   double d[8];
   for (int i = 0; i < 8; ++i) d[i] = K[i] - in->c0[i];
@@ -61,18 +61,18 @@ int imest__bg_select(const bg_tables_t *t, const double *kappa, int n, const bg_
     imest__bg_tables_values(t, x, v);
     const double a1 = 2.0 * v[0], a0 = v[1];
     c->kappa = x;
-    c->k = -a0 / a1;
+    c->k = BG_DIV(-a0, a1);
     const double x2 = x * x, x4 = x2 * x2;
     const double p = (v[0] * c->k + v[1]) * c->k + v[2];
-    c->e = (p / x4) * t->c;
+    c->e = BG_DIV(p, x4) * t->c;
     double w = 1.0; /* kappa^4 / (kappa^2 + cw)^2 */
     if (t->cw != 0.0) {
       const double dd = x2 + t->cw;
-      w = x4 / (dd * dd);
+      w = BG_DIV(x4, dd * dd);
     }
     c->k1 = c->k * t->g;
     c->k2 = x * t->s;
-    c->tr_s = 1.0 / c->k2;
+    c->tr_s = BG_DIV(1.0, c->k2);
     c->rs_ohm = cfg->sigma * cfg->ls_h * c->k1 - (1.0 - cfg->sigma) * cfg->ls_h * c->k2;
     c->admissible = imest__bg_finite(c->k1) && imest__bg_finite(c->k2) && imest__bg_finite(c->tr_s) &&
                     imest__bg_finite(c->rs_ohm) && a1 > 0.0 && c->k1 > 0.0 && c->k2 > 0.0 &&

@@ -34,7 +34,7 @@ double imest__bg_solve_weight_c(const bg_sums_t *in)
   if (in == 0) return 0.0;
   const double r44 = in->rw[3][3], r66 = in->rw[5][5];
   if (!(imest__bg_finite(r44) && imest__bg_finite(r66) && r44 > 0.0 && r66 >= 0.0)) return 0.0;
-  const double c = BG_SQRT(r66 / r44);
+  const double c = BG_SQRT(BG_DIV(r66, r44));
   return imest__bg_finite(c) ? c : 0.0;
 }
 
@@ -93,7 +93,7 @@ int imest__bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_
   /* E below zero is the cancellation floor of float32-accumulated sums */
   out->e = (c->e > 0.0) ? c->e : 0.0;
   out->e_w = (c->ew > 0.0) ? c->ew : 0.0;
-  out->e_i = BG_SQRT(out->e / in->ry);
+  out->e_i = BG_SQRT(BG_DIV(out->e, in->ry));
   /* The error indices take the residual as measured: the noise's share at
    * the selected K, not at the centring (far from the solution the latter
    * can be much smaller, and a negative compensated E then reads as an

@@ -42,6 +42,10 @@ BG_NOINLINE static void p_coefficients(bg_tables_t *t, double weight_c)
   for (int m = 0; m < 7; ++m) t->a1[m] = BG_SCALE2(t->e2[m], 1, 2.0);
   for (int m = 0; m < 8; ++m) t->a0[m] = t->e1[m];
   imest__bg_tables_weight(t, weight_c);
+#if BG_SOFT_DOUBLE
+  t->ff_ok = imest__bg_ff_of(t->e2, 7, t->ff) && imest__bg_ff_of(t->e1, 8, t->ff + 7) &&
+             imest__bg_ff_of(t->e0, 9, t->ff + 15);
+#endif
 }
 
 /* a + b; 2 a (exact) without the soft-double addition where a and b are the
@@ -135,7 +139,7 @@ int imest__bg_tables_build_weighted(const bg_sums_t *in, double tr_nominal_s, do
   double se1 = 0.0, se2 = 0.0;
   for (int m = 0; m < 7; ++m) se2 += t->e2[m];
   for (int m = 0; m < 8; ++m) se1 += t->e1[m];
-  const double khat = -se1 / (2.0 * se2);
+  const double khat = BG_DIV(-se1, 2.0 * se2);
   int gexp = 0;
   if (imest__bg_finite(khat) && khat != 0.0) {
     gexp = imest__bg_round_log2(khat < 0.0 ? -khat : khat);
@@ -151,8 +155,41 @@ int imest__bg_tables_build_weighted(const bg_sums_t *in, double tr_nominal_s, do
   return IMEST_OK;
 }
 
+#if BG_SOFT_DOUBLE
+/* Entries within 2^+-32 and 2^-8 <= kappa < 2^8: every term e[m] kappa^m is
+ * zero or within 2^+-96, a value below 2^100 (no overflow), and a low part's
+ * underflow costs at most 2^-149, 2^-53 of the smallest nonzero term. kappa
+ * itself carries 2^-48 (imest__bg_ff_of), so a value is within ~(8 + 3 * 8 +
+ * 4) 2^-48 sum |e[m] kappa^m| of exact: a few 1e-13 relative to the terms,
+ * where the quality stage's indices need ~1e-6 (bg_quality.c) and the
+ * candidates' K1 and E the float32-accumulated sums' ~1e-5 (bg_select.c). */
+static int values_ff(const bg_tables_t *t, double kappa, double v[3])
+{
+  static const int first[4] = {0, 7, 15, 24};
+  union {
+    double d;
+    uint64_t u;
+  } b;
+  b.d = kappa;
+  const int ex = (int)(b.u >> 52) - 1023; /* the sign bit makes a negative kappa fail */
+  bg_ff_t x;
+  if (t->ff_ok && ex >= -8 && ex <= 7 && imest__bg_ff_of(&kappa, 1, &x)) {
+    for (int q = 0; q < 3; ++q) {
+      bg_ff_t p = t->ff[first[q + 1] - 1];
+      for (int m = first[q + 1] - 2; m >= first[q]; --m) p = imest__bg_ff_madd(t->ff[m], p, x);
+      v[q] = bg_ff_to_d(p);
+    }
+    return 1;
+  }
+  return 0; /* float64 */
+}
+#endif
+
 void imest__bg_tables_values(const bg_tables_t *t, double kappa, double v[3])
 {
+#if BG_SOFT_DOUBLE
+  if (values_ff(t, kappa, v)) return;
+#endif
   double p2 = t->e2[6], p1 = t->e1[7], p0 = t->e0[8];
   p1 = p1 * kappa + t->e1[6];
   p0 = p0 * kappa + t->e0[7];

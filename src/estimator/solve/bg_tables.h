@@ -6,6 +6,7 @@
 
 #include "bg_solve.h"
 #include "bg_float.h"
+#include "bg_ff.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -27,6 +28,13 @@ typedef struct {
   double e2[7], e1[8], e0[9];     /* E~ = kappa^-4 sum_m (e2[m] k^2 + e1[m] k + e0[m]) kappa^m */
   double a1[7], a0[8];            /* p1 = a1(kappa) k + a0(kappa) */
   double bw2[8], bw1[9], bw0[10]; /* p2w = bw2 k^2 + bw1 k + bw0 */
+#if BG_SOFT_DOUBLE
+  /* e2, e1, e0 in float-float (bg_ff.h) at ff[0], ff[7], ff[15], for the
+   * value evaluations and the resultant where double is soft; ff_ok = 0 if an
+   * entry is outside 2^+-32 (float64 then) */
+  bg_ff_t ff[24];
+  int ff_ok;
+#endif
 } bg_tables_t;
 
 /* Tables for given exponents (no data-driven choice): R~ = D R D / c with
@@ -54,7 +62,9 @@ typedef struct {
   double dd2, dd1, dd0; /* second derivatives */
 } bg_tabval_t;
 void imest__bg_tables_eval(const bg_tables_t *t, double kappa, bg_tabval_t *v);
-/* Values only: v[0] = e2, v[1] = e1, v[2] = e0 at kappa. */
+/* Values only: v[0] = e2, v[1] = e1, v[2] = e0 at kappa. Where double is soft,
+ * in float-float if ff_ok and 2^-8 <= kappa < 2^8 (the range docs/METHOD.md
+ * §10.4 bounds), else in float64. */
 void imest__bg_tables_values(const bg_tables_t *t, double kappa, double v[3]);
 
 #ifdef __cplusplus

@@ -43,8 +43,8 @@ static void result_header(const imest_t *s, const imest_window_t *w, imest_resul
   out->overruns = IMEST_LOAD_RELAXED(&s->overruns);
   out->flags = (unsigned int)(w->flags & 0xFFFFu); /* every IMEST_FLAG_ fits 16 bits (int may be 16) */
   /* every window before this one was complete (a flushed one ends a run) */
-  out->t_end_s = ((double)w->seq * (double)s->window_n + (double)w->samples - 1.0) / (double)s->fs;
-  out->span_s = (double)w->samples / (double)s->fs;
+  out->t_end_s = BG_DIV((double)w->seq * (double)s->window_n + (double)w->samples - 1.0, (double)s->fs);
+  out->span_s = BG_DIV((double)w->samples, (double)s->fs);
   out->windows = 1u;
   out->tr_bound_rel = (double)NAN;
   out->rs_bound_rel = (double)NAN;
@@ -97,9 +97,9 @@ static void combine_join(imest_t *s, const imest_window_t *w, double m, bg_step_
   imest__bg_combine_add(&s->combo, &x->sums, x->nz.e_c0, x->ry_raw, w->samples);
   imest__bg_combine_sums(&s->combo, m, &x->sums);
   x->e_c0 = s->combo.e_c0;
-  x->noise_share = (double)s->combo.samples / (double)(w->samples ? w->samples : 1u);
+  x->noise_share = BG_DIV((double)s->combo.samples, (double)(w->samples ? w->samples : 1u));
   x->sums.noise_f = x->nz.scale * x->noise_share;
-  out->span_s = (double)s->combo.samples / (double)s->fs;
+  out->span_s = BG_DIV((double)s->combo.samples, (double)s->fs);
   out->windows = (unsigned int)s->combo.n;
   out->flags |= IMEST_FLAG_COMBINED;
 }
@@ -134,16 +134,16 @@ static void result_from_solve(const bg_step_t *x, const imest_t *s, const bg_sol
     out->k2 = so->k2;
     const double e_noise = fmax(0.0, so->noise_e_k) * x->noise_share; /* bg_solve's, at this K */
     out->e = so->e + x->nz.scale * e_noise;
-    out->e_i = BG_SQRT(out->e / ry_all);
-    out->e_i_noise = BG_SQRT(e_noise / ry_all);
+    out->e_i = BG_SQRT(BG_DIV(out->e, ry_all));
+    out->e_i_noise = BG_SQRT(BG_DIV(e_noise, ry_all));
     out->hessian[0][0] = so->hessian[0][0];
     out->hessian[0][1] = so->hessian[0][1];
     out->hessian[1][0] = so->hessian[1][0];
     out->hessian[1][1] = so->hessian[1][1];
     out->pe_k1 = so->pe_k1;
     out->pe_k2 = so->pe_k2;
-    out->pe_k1_rel = so->pe_k1 / so->k1;
-    out->pe_k2_rel = so->pe_k2 / so->k2;
+    out->pe_k1_rel = BG_DIV(so->pe_k1, so->k1);
+    out->pe_k2_rel = BG_DIV(so->pe_k2, so->k2);
     if (so->hessian_pd) out->flags |= IMEST_FLAG_HESSIAN_PD;
   } else {
     out->tr_s = (double)NAN;
