@@ -144,14 +144,14 @@ static float level_slope(const imest_comm_t *c, uint32_t j, uint32_t k)
 
 /* The rated point's standard error, relative, from the levels 0..last measured: the two
    levels' own, CM_ROT_LS_FLOOR each (weights 1 - t and t: independent errors at most 1.58 x
-   with t down to -0.5; never below one level's, which errors common to both keep), plus a bound of what the straight line leaves of the curve there, counted as
-   a CM_COVERAGE-th of it (imest_comm_apply's coverage makes it whole again). The correction
-   L* - L_a is no error: the curve is measured there. Interpolated, the line's remainder is
-   |t (1 - t)| |i_b - i_a| times the slope's change to the neighbouring segments (the larger
-   side; the bound bg_flux.c puts on the estimator's own interpolation); with no neighbour, the
-   line's slope itself. Not interpolated (one level, or a flux not rising between the two), the
-   point is a's L_S at i*: |i* - i_a| times the slope to a's nearest neighbour, with none
-   L_S / i (the flux L_S i rises with the current while L_S does not: |dL_S/di| <= L_S / i). */
+   with t down to -0.5; never below one level's, which errors common to both keep), plus a
+   bound of what the line leaves of the curve there, counted as a CM_COVERAGE-th of it
+   (imest_comm_apply's coverage makes it whole again). The correction L* - L_a is no error: the
+   curve is measured there. The bound: the line's slope (the two levels'; not interpolated, one
+   level or a flux not rising between the two: none) against the slopes to the nearest levels
+   either side, the larger change (as bg_flux.c bounds its own interpolation), times
+   |t (1 - t)| |i_b - i_a| (not interpolated: |i* - i_a|); with no neighbour L_S / i (the flux
+   L_S i rises with the current while L_S does not: |dL_S/di| <= L_S / i). */
 static float rated_std(const imest_comm_t *c, uint32_t last, uint32_t ns)
 {
   const float *st = c->blk[CM_ROT_LEVELS].s;
@@ -160,29 +160,19 @@ static float rated_std(const imest_comm_t *c, uint32_t last, uint32_t ns)
   const uint32_t a = ns - 1u, b = interp ? ns - 2u : a;
   const float ia = c->blk[a].s[CM_LV_I], ib = c->blk[b].s[CM_LV_I];
   const uint32_t lo = ia < ib ? a : b, hi = ia < ib ? b : a;
+  const float s_ab = interp ? level_slope(c, a, b) : 0.0f;
   uint32_t kd = CM_ROT_LEVELS, ku = CM_ROT_LEVELS; /* the nearest levels below and above */
   for (uint32_t k = 0u; k <= last && k < CM_ROT_LEVELS; ++k) {
     const float ik = c->blk[k].s[CM_LV_I];
     if (ik < c->blk[lo].s[CM_LV_I] && (kd == CM_ROT_LEVELS || ik > c->blk[kd].s[CM_LV_I])) kd = k;
     if (ik > c->blk[hi].s[CM_LV_I] && (ku == CM_ROT_LEVELS || ik < c->blk[ku].s[CM_LV_I])) ku = k;
   }
-  float rem;
-  if (interp) {
-    const float s_ab = level_slope(c, a, b);
-    float ds = kd == CM_ROT_LEVELS && ku == CM_ROT_LEVELS ? imest__abs(s_ab) : 0.0f;
-    if (kd < CM_ROT_LEVELS) ds = imest__abs(level_slope(c, kd, lo) - s_ab);
-    if (ku < CM_ROT_LEVELS && imest__abs(level_slope(c, hi, ku) - s_ab) > ds)
-      ds = imest__abs(level_slope(c, hi, ku) - s_ab);
-    rem = imest__abs(t * (1.0f - t) * (ib - ia)) * ds;
-  } else {
-    uint32_t kn = kd; /* a's nearest neighbour */
-    if (ku < CM_ROT_LEVELS &&
-        (kd == CM_ROT_LEVELS || c->blk[ku].s[CM_LV_I] - ia < ia - c->blk[kd].s[CM_LV_I]))
-      kn = ku;
-    const float slope = kn < CM_ROT_LEVELS ? level_slope(c, kn, a) : ls / (is < ia ? is : ia);
-    rem = imest__abs((is - ia) * slope);
-  }
+  float ds = -1.0f; /* the larger slope change to a neighbour; none yet */
+  if (kd < CM_ROT_LEVELS) ds = imest__abs(level_slope(c, kd, lo) - s_ab);
+  if (ku < CM_ROT_LEVELS) ds = fmaxf(ds, imest__abs(level_slope(c, hi, ku) - s_ab));
+  if (ds < 0.0f) ds = ls / (is < ia ? is : ia);
   const float w2 = interp ? (1.0f - t) * (1.0f - t) + t * t : 1.0f;
+  const float rem = (interp ? imest__abs(t * (1.0f - t) * (ib - ia)) : imest__abs(is - ia)) * ds;
   return CM_ROT_LS_FLOOR * (w2 > 1.0f ? imest__sqrt(w2) : 1.0f) + rem / (CM_COVERAGE * ls);
 }
 
