@@ -100,7 +100,9 @@ enum { CM_LV_I = 0, CM_LV_LS, CM_LV_ZR };
 /* The rotating measurement's repeatability, relative: the least uncertainty a level's L_S
    carries (commission_fit_rotation.c). */
 #define CM_ROT_LS_FLOOR 1e-3f
-enum { CM_LB_NEXT = 0, CM_LB_NSEARCH, CM_LB_I, CM_LB_LS, CM_LB_STD, CM_LB_SETTLE };
+/* The coverage factor imest_comm_apply() puts on a value's std_rel (imest_commission.h). */
+#define CM_COVERAGE     3.0f
+enum { CM_LB_NEXT = 0, CM_LB_NSEARCH, CM_LB_I, CM_LB_LS, CM_LB_T, CM_LB_SETTLE };
 
 /* rot_sum[] */
 enum { CM_R_ID = 0, CM_R_IQ, CM_R_ND, CM_R_NQ, CM_R_UD, CM_R_UQ, CM_R_I2, CM_R_N, CM_R_WE, CM_R_COUNT };

@@ -28,7 +28,7 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r)
 /* 3 standard errors (NaN: not known, 0). */
 static float std3_rel(const imest_comm_value_t *v)
 {
-  return isfinite(v->std_rel) ? 3.0f * v->std_rel : 0.0f;
+  return isfinite(v->std_rel) ? CM_COVERAGE * v->std_rel : 0.0f;
 }
 
 /* A value's relative uncertainty from its quality: the larger of 3 standard

@@ -109,14 +109,14 @@ static float slip_corrected(float lx, float x, float sl)
    there, interpolated (linearly in the current) between the last two levels (the search's
    nearest to psi); with one level, the fixed-point step i = psi / L_S from it (it was within
    1 %). Within the current limit: there the flux stays below psi. Into st[CM_LB_I], st[CM_LB_LS]
-   and st[CM_LB_STD], the rated point's uncertainty: the interpolation's correction to the last
-   level, at least the measurement's 0.1 %. */
+   and st[CM_LB_T], where i* is on the line: t = (i* - i_a) / (i_b - i_a), a the last level, b
+   the one before (NaN: not interpolated, L_S is a's); its uncertainty: rated_std. */
 static void rated_point(imest_comm_t *c, uint32_t ns, float psi, float *st)
 {
   const float *a = c->blk[ns - 1u].s, *b = c->blk[ns >= 2u ? ns - 2u : 0u].s;
   const float ia = a[CM_LV_I], la = a[CM_LV_LS], ib = b[CM_LV_I], lb = b[CM_LV_LS];
   const float pa = ia * la, pb = ib * lb;
-  float is = psi / la, ls = la;
+  float is = psi / la, ls = la, t = NAN;
   /* two levels whose flux increases with the current: L_S linear in the current between them,
      no further than half their distance beyond them */
   if (imest__abs(ib - ia) > 1e-6f * ia && (pb - pa) / (ib - ia) > 0.0f) {
@@ -125,14 +125,55 @@ static void rated_point(imest_comm_t *c, uint32_t ns, float psi, float *st)
     is = ia + (psi - pa) * (ib - ia) / (pb - pa);
     is = is < lo ? lo : (is > hi ? hi : is);
     if (is > c->psi_im) is = c->psi_im;
-    ls = la + (is - ia) * (lb - la) / (ib - ia);
+    t = (is - ia) / (ib - ia);
+    ls = la + t * (lb - la);
   } else if (is > c->psi_im) {
     is = c->psi_im;
   }
-  const float corr = imest__abs(ls - la) / ls;
   st[CM_LB_I] = is;
   st[CM_LB_LS] = ls;
-  st[CM_LB_STD] = corr > CM_ROT_LS_FLOOR ? corr : CM_ROT_LS_FLOOR;
+  st[CM_LB_T] = t;
+}
+
+/* The slope of L_S between levels j and k [H/A]. */
+static float level_slope(const imest_comm_t *c, uint32_t j, uint32_t k)
+{
+  const float *a = c->blk[j].s, *b = c->blk[k].s;
+  return (b[CM_LV_LS] - a[CM_LV_LS]) / (b[CM_LV_I] - a[CM_LV_I]);
+}
+
+/* The rated point's standard error, relative, from the levels 0..last measured: the two
+   levels' own, CM_ROT_LS_FLOOR each (weights 1 - t and t: independent errors at most 1.58 x
+   with t down to -0.5; never below one level's, which errors common to both keep), plus a
+   bound of what the line leaves of the curve there, counted as a CM_COVERAGE-th of it
+   (imest_comm_apply's coverage makes it whole again). The correction L* - L_a is no error: the
+   curve is measured there. The bound: the line's slope (the two levels'; not interpolated, one
+   level or a flux not rising between the two: none) against the slopes to the nearest levels
+   either side, the larger change (as bg_flux.c bounds its own interpolation), times
+   |t (1 - t)| |i_b - i_a| (not interpolated: |i* - i_a|); with no neighbour L_S / i (the flux
+   L_S i rises with the current while L_S does not: |dL_S/di| <= L_S / i). */
+static float rated_std(const imest_comm_t *c, uint32_t last, uint32_t ns)
+{
+  const float *st = c->blk[CM_ROT_LEVELS].s;
+  const float is = st[CM_LB_I], ls = st[CM_LB_LS], t = st[CM_LB_T];
+  const int interp = isfinite(t);
+  const uint32_t a = ns - 1u, b = interp ? ns - 2u : a;
+  const float ia = c->blk[a].s[CM_LV_I], ib = c->blk[b].s[CM_LV_I];
+  const uint32_t lo = ia < ib ? a : b, hi = ia < ib ? b : a;
+  const float s_ab = interp ? level_slope(c, a, b) : 0.0f;
+  uint32_t kd = CM_ROT_LEVELS, ku = CM_ROT_LEVELS; /* the nearest levels below and above */
+  for (uint32_t k = 0u; k <= last && k < CM_ROT_LEVELS; ++k) {
+    const float ik = c->blk[k].s[CM_LV_I];
+    if (ik < c->blk[lo].s[CM_LV_I] && (kd == CM_ROT_LEVELS || ik > c->blk[kd].s[CM_LV_I])) kd = k;
+    if (ik > c->blk[hi].s[CM_LV_I] && (ku == CM_ROT_LEVELS || ik < c->blk[ku].s[CM_LV_I])) ku = k;
+  }
+  float ds = -1.0f; /* the larger slope change to a neighbour; none yet */
+  if (kd < CM_ROT_LEVELS) ds = imest__abs(level_slope(c, kd, lo) - s_ab);
+  if (ku < CM_ROT_LEVELS) ds = fmaxf(ds, imest__abs(level_slope(c, hi, ku) - s_ab));
+  if (ds < 0.0f) ds = ls / (is < ia ? is : ia);
+  const float w2 = interp ? (1.0f - t) * (1.0f - t) + t * t : 1.0f;
+  const float rem = (interp ? imest__abs(t * (1.0f - t) * (ib - ia)) : imest__abs(is - ia)) * ds;
+  return CM_ROT_LS_FLOOR * (w2 > 1.0f ? imest__sqrt(w2) : 1.0f) + rem / (CM_COVERAGE * ls);
 }
 
 /* The current of the curve's level j (0: the highest) from the levels 0..n-1 measured: its flux,
@@ -259,7 +300,7 @@ static int report(imest_comm_t *c, uint32_t last)
   const imest_comm_block_t *lv = c->blk;
   const float *st = c->blk[CM_ROT_LEVELS].s;
   const uint32_t ns = (uint32_t)st[CM_LB_NSEARCH];
-  const float ls = st[CM_LB_LS], is = st[CM_LB_I], sl = r->sigma_ls_h.value, sd = st[CM_LB_STD];
+  const float ls = st[CM_LB_LS], is = st[CM_LB_I], sl = r->sigma_ls_h.value, sd = rated_std(c, last, ns);
   /* the curve's levels in increasing current, each above the one before and below the rated
      point (the estimator takes increasing currents only) */
   unsigned int n = 0u;
