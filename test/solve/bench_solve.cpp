@@ -4,34 +4,15 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 
-#include <nlohmann/json.hpp>
-
-#include "bg_quality.h"
-#include "bg_resultant.h"
-#include "bg_roots.h"
-#include "bg_select.h"
-#include "bg_tables.h"
+#include "solve_util.hpp"
 
 // NOLINTNEXTLINE(bugprone-exception-escape): a benchmark; a JSON or file error ends it in terminate()
 int main(int argc, char **argv)
 {
   const long reps = (argc > 1) ? std::atol(argv[1]) : 20000;
-  std::ifstream f(IMEST_TESTVECTOR);
-  const auto j = nlohmann::json::parse(f);
-  bg_sums_t s{};
-  for (int i = 0; i < 8; ++i) {
-    for (int k = 0; k < 8; ++k) s.rw[i][k] = j["R_W"][i][k].get<double>();
-    s.rwy[i] = j["R_Wy"][i].get<double>();
-  }
-  s.ry = j["R_y"].get<double>();
-  bg_solve_cfg_t cfg{};
-  cfg.sigma = 0.096;
-  cfg.ls_h = 0.2908;
-  cfg.tr_nominal_s = 0.1;
-  cfg.tr_min_s = 1e-3;
-  cfg.tr_max_s = 10;
+  const bg_sums_t s = solvetest::tv_sums();
+  const bg_solve_cfg_t cfg = solvetest::default_cfg();
   bg_solve_out_t o{};
   bg_solve_stats_t st{};
   volatile double sink = 0;

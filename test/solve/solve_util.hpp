@@ -1,16 +1,16 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 // Helpers shared by the background-solve tests: the testvector, a float64
-// reference of the regressor (docs/METHOD.md §2) for realistic random sums, and an
-// independent long-double evaluation of E_p^2.
+// reference of the regressor (docs/METHOD.md §2) for realistic random sums, an
+// independent long-double evaluation of E_p^2, and Eigen's companion-matrix roots.
+// The testvector's JSON and Eigen's polynomial solver are compiled once, in
+// solve_ref.cpp (testvector.hpp): instantiated in every test file they were most
+// of the solve tests' build time.
 #pragma once
 
 #include <cmath>
-#include <fstream>
+#include <complex>
 #include <random>
-#include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "bg_quality.h"
 #include "bg_resultant.h"
@@ -18,9 +18,6 @@
 #include "bg_select.h"
 #include "bg_tables.h"
 
-#ifndef IMEST_TESTVECTOR
-#define IMEST_TESTVECTOR "test/data/testvector.json"
-#endif
 namespace solvetest {
 
 // The Sturm chain of the library this binary links: true float32 (the
@@ -28,26 +25,12 @@ namespace solvetest {
 // only file compiled once per chain (test/solve/CMakeLists.txt).
 bool chain_f32();
 
-inline const nlohmann::json &testvector()
-{
-  static const nlohmann::json j = [] {
-    std::ifstream f(IMEST_TESTVECTOR);
-    return nlohmann::json::parse(f);
-  }();
-  return j;
-}
+// The testvector's sums R_W, R_Wy, R_y (test/data/testvector.json).
+bg_sums_t tv_sums();
 
-inline bg_sums_t tv_sums()
-{
-  const auto &j = testvector();
-  bg_sums_t s{};
-  for (int i = 0; i < 8; ++i) {
-    for (int k = 0; k < 8; ++k) s.rw[i][k] = j["R_W"][i][k].get<double>();
-    s.rwy[i] = j["R_Wy"][i].get<double>();
-  }
-  s.ry = j["R_y"].get<double>();
-  return s;
-}
+// Every root of c[0] + c[1] x + ... + c[n-1] x^(n-1) (c[n-1] != 0), from Eigen's
+// PolynomialSolver (balanced companion matrix, QR eigenvalues).
+std::vector<std::complex<double>> companion_roots(const double *c, int n);
 
 inline bg_solve_cfg_t default_cfg(double sigma = 0.096, double ls = 0.2908)
 {

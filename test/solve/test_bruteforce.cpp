@@ -14,7 +14,6 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <unsupported/Eigen/Polynomials>
 
 #include "solve_util.hpp"
 
@@ -93,12 +92,8 @@ int companion_roots_in_band(const bg_sums_t &s, const bg_solve_cfg_t &cfg)
   imest__bg_resultant(&t, r, 0);
   int hi = BG_RES_DEG;
   while (hi > 0 && r[hi] == 0) --hi;
-  Eigen::VectorXd c(hi + 1);
-  for (int k = 0; k <= hi; ++k) c[k] = r[k];
-  Eigen::PolynomialSolver<double, Eigen::Dynamic> ps(c);
   int n = 0;
-  for (int i = 0; i < ps.roots().size(); ++i) {
-    const auto z = ps.roots()[i];
+  for (const auto &z : companion_roots(r, hi + 1)) {
     const double k2 = z.real() * t.s;
     if (std::fabs(z.imag()) <= 1e-7 * std::abs(z) && k2 >= 1 / cfg.tr_max_s && k2 <= 1 / cfg.tr_min_s) {
       ++n;

@@ -41,7 +41,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
-#include <unsupported/Eigen/Polynomials>
 
 #include "solve_util.hpp"
 
@@ -300,10 +299,7 @@ TEST(SturmVsCompanion, RandomFamilies)
         EXPECT_EQ(nr, 0);
         continue;
       }
-      Eigen::VectorXd coef(hi - lo + 1);
-      for (int k = lo; k <= hi; ++k) coef[k - lo] = P.c[(size_t)k];
-      Eigen::PolynomialSolver<double, Eigen::Dynamic> ps(coef);
-      std::vector<std::complex<double>> ev(ps.roots().data(), ps.roots().data() + ps.roots().size());
+      const std::vector<std::complex<double>> ev = solvetest::companion_roots(&P.c[(size_t)lo], hi - lo + 1);
       const auto cl = clusters(ev);
       int expected = 0;
       const double u_chain = solvetest::chain_f32() ? 1e-5 : 1e-12;

@@ -20,6 +20,7 @@
 #include <cstdio>
 
 #include "solve_util.hpp"
+#include "testvector.hpp"
 
 using namespace solvetest;
 
