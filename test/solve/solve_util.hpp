@@ -2,9 +2,9 @@
 // Helpers shared by the background-solve tests: the testvector, a float64
 // reference of the regressor (docs/METHOD.md §2) for realistic random sums, an
 // independent long-double evaluation of E_p^2, and Eigen's companion-matrix roots.
-// The testvector's JSON and Eigen's polynomial solver are compiled once, in
-// solve_ref.cpp (testvector.hpp): instantiated in every test file they were most
-// of the solve tests' build time.
+// The testvector's JSON (solve_testvector.cpp, testvector.hpp) and Eigen's
+// polynomial solver (solve_ref.cpp) are compiled once: instantiated in every test
+// file they were most of the solve tests' build time.
 #pragma once
 
 #include <cmath>
