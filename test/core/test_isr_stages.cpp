@@ -395,8 +395,8 @@ TEST(IsrDuty, SmoothErrorMatchesFloat64Formula)
     for (int x = 0; x < 3; ++x) {
       const double i = scale * cur(rng);
       const float ef = isr_duty_error_smooth(&dd.s.duty, &k, df[x], (float)i, rf[x]);
-      worst = std::max(worst, std::fabs((double)ef - dd.error_smooth(d[x], i, dd.ripple(d, x))) /
-                                  dd.ref_scale(i));
+      worst = std::max(worst,
+                       std::fabs((double)ef - dd.error_smooth(d[x], i, dd.ripple(d, x))) / dd.ref_scale(i));
     }
   }
   EXPECT_LT(worst, 2e-6);
@@ -440,9 +440,9 @@ TEST(IsrDuty, SmoothSignAtAZeroCrossingFollowsTheLegsRipple)
   const float kr = isr_duty_constants(&dd.s.duty, (float)dd.vdc, (float)dd.vdc, &k);
   const double per_leg = dd.vdc * dd.td / (3.0 * dd.sl), full = dd.td * dd.fpwm * dd.vdc;
   auto ramp01 = [](double x) { return std::max(0.0, std::min(1.0, x)); };
-  for (double mi : {0.3, 0.6, 0.9}) {                   // modulation index
-    for (double phi : {0.3, 0.6, 1.0}) {                // the current's lag behind the voltage [rad]
-      const double th = 0.5 * 3.14159265358979 + phi;   // leg a's current crosses zero here
+  for (double mi : {0.3, 0.6, 0.9}) {                 // modulation index
+    for (double phi : {0.3, 0.6, 1.0}) {              // the current's lag behind the voltage [rad]
+      const double th = 0.5 * 3.14159265358979 + phi; // leg a's current crosses zero here
       const double d[3] = {0.5 + 0.5 * mi * std::cos(th), 0.5 + 0.5 * mi * std::cos(th - 2.0943951023932),
                            0.5 + 0.5 * mi * std::cos(th + 2.0943951023932)};
       const float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
