@@ -78,8 +78,8 @@ static inline imest_real_t isr_duty_error(const imest_duty_model_t *m, const isr
  * smooth sign s(i) = i / sqrt(i^2 + b^2), b = |r| + b_0: the current at the
  * leg's edges is i + r and i - r (r its ripple there, isr_duty_ripple; 0 with
  * a fixed band i_band_a, which is then k->band2), so near a zero crossing the
- * error fades instead of jumping; b_0 the current's change within the dead
- * time (docs/METHOD.md §17.1). In the constants of the other model:
+ * error fades instead of jumping; b_0 half the current's change within the
+ * dead time, the two edges' mean (docs/METHOD.md §17.1). In the constants of the other model:
  * V_d0 + d_c dV = (V_sw0 + V_d0)/2 + s (dbar - 1/2) dV, the same for the slopes. */
 static inline imest_real_t isr_duty_error_smooth(const imest_duty_model_t *m, const isr_duty_k_t *k,
                                                  imest_real_t dbar, imest_real_t i, imest_real_t r)
