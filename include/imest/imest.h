@@ -215,9 +215,11 @@ typedef enum {
  *      e(i, d) = s(i) * [ t_d f_pwm V_dc + V_d0 + r_d |i| + d_c ((V_sw0 - V_d0) + (r_sw - r_d) |i|) ]
  *
  *  with d_c the share of the period the active switch conducts (d for i > 0, 1 - d
- *  for i < 0) and s(i) = i / sqrt(i^2 + i_band_a^2) the sign of i faded over about
- *  |i| < i_band_a (the current ripple crosses zero inside the period there, so the
- *  error fades rather than jumping). All zero: an ideal (or fully compensated) inverter. The library's
+ *  for i < 0) and s(i) = i / sqrt(i^2 + b^2) the sign of i faded over about |i| < b
+ *  (the current ripple crosses zero inside the period there, so the error fades
+ *  rather than jumping): b = i_band_a if set, else per leg and sample the leg's own
+ *  ripple at its switching instants plus the current's change within the dead time
+ *  (docs/METHOD.md §17.1). All zero: an ideal (or fully compensated) inverter. The library's
  *  standstill commissioning measures these numbers. edge_band_a > 0 selects the
  *  switching-instant model instead (docs/METHOD.md §17.1): the dead time's volt-seconds take
  *  the sign of the current at the leg's two switching instants (the sample plus and minus
@@ -230,8 +232,10 @@ typedef struct {
   float r_switch_ohm; /**< switch slope resistance r_sw [ohm] */
   float v_diode_v;    /**< freewheeling diode threshold voltage V_d0 [V] */
   float r_diode_ohm;  /**< diode slope resistance r_d [ohm] */
-  /** half-width of the zero-crossing transition [A] (0: the current ripple's peak, V_dc / (8 sigma
-   *  L_S f_pwm)) */
+  /** half-width of the zero-crossing transition [A], the same for every leg and sample (0, the
+   *  default: per leg and sample |D_x| + V_dc t_d / (6 sigma L_S), the leg's phase-current ripple at
+   *  its switching instants, closed form from the three duties, V_dc and sigma L_S, plus half the
+   *  current's change within the dead time; docs/METHOD.md §17.1) */
   float i_band_a;
   /** > 0: the switching-instant model (docs/METHOD.md §17.1), with the devices' own smoothing
    *  of the sign at a switching instant b = edge_band_a [A] beyond the ripple it computes (the

@@ -93,15 +93,17 @@ typedef struct {
  *  around a sample are weighted, and the inverter model per leg
  *  (src/estimator/isr/isr_duty.h, docs/METHOD.md §17.1). */
 typedef struct {
-  imest_real_t w_prev;       /**< weight of the previous call's leg voltage (this call's: 1 - w_prev) */
-  imest_real_t td_f_half;    /**< dead time x carrier frequency / 2 */
-  imest_real_t v_sum;        /**< switch plus diode threshold [V] */
-  imest_real_t r_mean;       /**< mean of the switch's and the diode's slope [ohm] */
-  imest_real_t dv, dr;       /**< switch minus diode: threshold [V] and slope [ohm] */
-  imest_real_t ripple_per_v; /**< T / (2 sigma L_S): the phase ripple's scale per bus volt [A/V] */
-  imest_real_t band2;        /**< b^2 of a fixed band (i_band_a, edge_band_a) [A^2] */
-  imest_real_t band_per_kr;  /**< the band per ripple scale (0: a fixed band) */
-  imest_real_t vdc2_w;       /**< 12 / u_absurd_v^2: the bus voltage's weight in the absurdity test */
+  imest_real_t w_prev;    /**< weight of the previous call's leg voltage (this call's: 1 - w_prev) */
+  imest_real_t td_f_half; /**< dead time x carrier frequency / 2 */
+  imest_real_t v_sum;     /**< switch plus diode threshold [V] */
+  imest_real_t r_mean;    /**< mean of the switch's and the diode's slope [ohm] */
+  imest_real_t dv, dr;    /**< switch minus diode: threshold [V] and slope [ohm] */
+  /** T / (2 sigma L_S): the phase ripple's scale per bus volt [A/V] (0: the smooth sign with a
+   *  fixed band, no ripple term) */
+  imest_real_t ripple_per_v;
+  imest_real_t band2;       /**< b^2 of a fixed band (i_band_a, edge_band_a), else 1e-12 [A^2] */
+  imest_real_t floor_per_v; /**< the smooth sign's floor per bus volt, t_d / (6 sigma L_S) (0: none) [A/V] */
+  imest_real_t vdc2_w;      /**< 12 / u_absurd_v^2: the bus voltage's weight in the absurdity test */
   imest_real_t zoh; /**< T / (12 sigma L_S): the staircase's aliased share of a sampled current [A/V] */
 } imest_duty_model_t;
 

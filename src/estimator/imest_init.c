@@ -270,14 +270,22 @@ static void design_duty(imest_duty_model_t *d, const imest_config_t *cfg)
   d->r_mean = 0.5f * (v->r_switch_ohm + v->r_diode_ohm);
   d->dv = v->v_switch_v - v->v_diode_v;
   d->dr = v->r_switch_ohm - v->r_diode_ohm;
-  d->ripple_per_v = 1.0f / (2.0f * cfg->sigma * cfg->ls_h * fpwm);
   /* the sign's band: the switching-instant model's is the devices' own
-   * (edge_band_a); the smooth sign's i_band_a or, at 0, the current ripple's
-   * peak at 50 % duty, a quarter of its scale, where the ripple crosses zero
-   * inside the period. A micro-ampere at least keeps 0 / 0 out of the signs at
-   * zero bus and zero current. */
-  const float band = v->edge_band_a > 0.0f ? v->edge_band_a : v->i_band_a;
-  d->band_per_kr = band > 0.0f ? 0.0f : 0.25f;
+   * (edge_band_a) beyond the ripple at the edges; the smooth sign's i_band_a
+   * alone or, at 0, per leg and sample b = |D_x| + b_0 (docs/METHOD.md §17.1):
+   * s(i) = i / sqrt(i^2 + b^2) falls short of the sign by an area b, as the
+   * dead time's mean over the two edges i +- D_x does by |D_x| + b_0. b_0:
+   * a current that reaches 0 within the dead time loses t_d V_dc in
+   * proportion (a ramp over the current's change in it, short by half of
+   * it); the leg's phase voltage then is n/3 V_dc, n the other legs in the
+   * opposite state, 2 over the two edges: b_0 = V_dc t_d / (6 sigma L_S). A
+   * micro-ampere at least keeps 0 / 0 out of the signs at zero bus and zero
+   * current. */
+  const int edges = v->edge_band_a > 0.0f;
+  const float band = edges ? v->edge_band_a : v->i_band_a;
+  const int leg_band = !edges && !(band > 0.0f);
+  d->ripple_per_v = (edges || leg_band) ? 1.0f / (2.0f * cfg->sigma * cfg->ls_h * fpwm) : 0.0f;
+  d->floor_per_v = leg_band ? v->dead_time_s / (6.0f * cfg->sigma * cfg->ls_h) : 0.0f;
   d->band2 = band > 0.0f ? band * band : 1e-12f;
   d->vdc2_w = 12.0f / (cfg->u_absurd_v * cfg->u_absurd_v);
   /* the staircase's images alias into the samples when the steps' edges are

@@ -259,9 +259,10 @@ struct DutyDrive {
   double vdc = 560.0, fpwm = 8000.0, sl = 0.0645168 * 0.178039;
   double td = 2e-6, vsw = 1.2, rsw = 0.03, vd = 0.9, rd = 0.02;
   double edge_band = 0.075; // the devices' band, about a tenth of the ripple's peak kr / 4
-  explicit DutyDrive(bool edges = true)
+  explicit DutyDrive(bool edges = true, bool drops = true)
   {
     if (!edges) edge_band = 0.0;
+    if (!drops) vsw = rsw = vd = rd = 0.0;
     imest_config_t cfg;
     imest_config_default(&cfg);
     cfg.pole_pairs = 2;
@@ -298,10 +299,14 @@ struct DutyDrive {
     return td * fpwm * vdc * se + 0.5 * (vsw + vd) * m + 0.5 * (rsw + rd) * i +
            (dbar - 0.5) * ((vsw - vd) + (rsw - rd) * std::fabs(i));
   }
-  // the smooth sign's model (edge_band_a 0, the default), as imest.h writes it
-  double error_smooth(double dbar, double i) const
+  // the floor of the smooth sign's band (imest_init.c): the current's change within the dead
+  // time, 1/3 V_dc t_d / (sigma L_S) per other leg in the opposite state, halved, over the edges
+  double floor() const { return vdc * td / (6.0 * sl); }
+  // the smooth sign's model (edge_band_a 0, the default), as imest.h writes it, with the band the
+  // leg's ripple r at its edges plus the floor
+  double error_smooth(double dbar, double i, double r) const
   {
-    const double b = 0.25 * kr(); // the ripple's peak
+    const double b = std::fabs(r) + floor();
     const double sg = i / std::sqrt(i * i + b * b), a = std::fabs(i);
     const double dc = 0.5 + sg * (dbar - 0.5);
     return sg * (td * fpwm * vdc + vd + rd * a + dc * ((vsw - vd) + (rsw - rd) * a));
@@ -340,56 +345,121 @@ TEST(IsrDuty, RippleIsThePhaseCurrentsAtTheEdges)
   EXPECT_LT(worst, 0.002 * dd.kr()); // the integration's step: V_dc / (sigma L_S f n) = kr / 10^4
 }
 
-// isr_duty_ripple and isr_duty_error in float32 against the same formulas in float64,
-// the drops' mean sign in its defining (subtractive) form: within 2e-6 of the error's
-// scale t_d f V_dc + V_sw0 + V_d0 + (r_sw + r_d) |i| (float32 rounding of about ten
-// operations, 6e-8 each, and of the currents near the ripple).
-TEST(IsrDuty, ErrorMatchesFloat64Formula)
+// The largest difference of the ISR's error (float32, the constants as the ISR forms them)
+// from the float64 formula over random duties and currents from deep inside the ripple to ten
+// times it, relative to the error's scale; the ripple checked on the way.
+static double worst_against_float64(const DutyDrive &dd, unsigned seed, bool smooth)
 {
-  DutyDrive dd;
-  std::mt19937 rng(3);
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0.02, 0.98), cur(-1.0, 1.0);
   isr_duty_k_t k{};
-  k.kt = dd.s.duty.td_f_half * (float)dd.vdc;
-  const float kr = dd.s.duty.ripple_per_v * (float)dd.vdc;
-  const float band = dd.s.duty.band_per_kr * kr;
-  k.band2 = band * band + dd.s.duty.band2;
+  const float kr = isr_duty_constants(&dd.s.duty, (float)dd.vdc, (float)dd.vdc, &k);
   double worst = 0;
   for (int trial = 0; trial < 20000; ++trial) {
     const double d[3] = {u(rng), u(rng), u(rng)};
     const float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
     float rf[3];
     isr_duty_ripple(kr, df, rf);
-    // currents from deep inside the ripple to ten times it
     const double scale = (trial % 3 == 0) ? 0.5 : (trial % 3 == 1 ? 3.0 : 30.0);
     for (int x = 0; x < 3; ++x) {
       const double i = scale * cur(rng);
       const double r = dd.ripple(d, x);
-      const double e = dd.error(d[x], i, r);
-      const float ef = isr_duty_error(&dd.s.duty, &k, df[x], (float)i, rf[x]);
+      const double e = smooth ? dd.error_smooth(d[x], i, r) : dd.error(d[x], i, r);
+      const float ef = smooth ? isr_duty_error_smooth(&dd.s.duty, &k, df[x], (float)i, rf[x])
+                              : isr_duty_error(&dd.s.duty, &k, df[x], (float)i, rf[x]);
       worst = std::max(worst, std::fabs((double)ef - e) / dd.ref_scale(i));
-      ASSERT_NEAR(rf[x], r, 1e-5 * dd.kr()) << trial;
+      EXPECT_NEAR(rf[x], r, 1e-5 * dd.kr()) << trial;
     }
   }
-  EXPECT_LT(worst, 2e-6);
+  return worst;
 }
 
-// The default (smooth-sign) form in float32 against imest.h's formula in float64, the same
-// tolerance.
+// isr_duty_ripple and isr_duty_error in float32 against the same formulas in float64,
+// the drops' mean sign in its defining (subtractive) form: within 2e-6 of the error's
+// scale t_d f V_dc + V_sw0 + V_d0 + (r_sw + r_d) |i| (float32 rounding of about ten
+// operations, 6e-8 each, and of the currents near the ripple).
+TEST(IsrDuty, ErrorMatchesFloat64Formula)
+{
+  const DutyDrive dd;
+  EXPECT_LT(worst_against_float64(dd, 3, false), 2e-6);
+}
+
+// The default (smooth-sign) form in float32 against imest.h's formula in float64, each leg's
+// band its own ripple at the edges with the floor, the same tolerance.
 TEST(IsrDuty, SmoothErrorMatchesFloat64Formula)
 {
-  DutyDrive dd(false);
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<double> u(0.02, 0.98), cur(-1.0, 1.0);
+  const DutyDrive dd(false);
+  EXPECT_LT(worst_against_float64(dd, 4, true), 2e-6);
+}
+
+// A user-set i_band_a is the smooth sign's band alone: no ripple term, no floor.
+TEST(IsrDuty, SmoothFixedBandIsIBandA)
+{
+  imest_t s;
+  imest_config_t cfg;
+  imest_config_default(&cfg);
+  cfg.pole_pairs = 2;
+  cfg.ls_h = 0.178039f;
+  cfg.sigma = 0.0645168f;
+  cfg.fs_hz = 8000.0f;
+  cfg.inverter.dead_time_s = 2e-6f;
+  cfg.inverter.i_band_a = 0.4f;
+  ASSERT_EQ(imest_init(&s, &cfg), IMEST_OK);
   isr_duty_k_t k{};
-  k.kt = dd.s.duty.td_f_half * (float)dd.vdc;
-  const float band = dd.s.duty.band_per_kr * (dd.s.duty.ripple_per_v * (float)dd.vdc);
-  k.band2 = band * band + dd.s.duty.band2;
-  double worst = 0;
-  for (int trial = 0; trial < 60000; ++trial) {
-    const double d = u(rng), i = ((trial % 3 == 0) ? 0.5 : (trial % 3 == 1 ? 3.0 : 30.0)) * cur(rng);
-    const float ef = isr_duty_error_smooth(&dd.s.duty, &k, (float)d, (float)i);
-    worst = std::max(worst, std::fabs((double)ef - dd.error_smooth(d, i)) / dd.ref_scale(i));
+  EXPECT_EQ(isr_duty_constants(&s.duty, 560.0f, 560.0f, &k), 0.0f);
+  EXPECT_FLOAT_EQ(k.band2, 0.4f * 0.4f);
+}
+
+// The dead time's error of a leg at its current's zero crossing, the ISR's constants and
+// smooth sign against a float64 reference of the switching instants: the current at the leg's
+// rising edge is i + D, at its falling edge i - D (D its ripple, for duties of a sinusoidal
+// modulation where the leg's current crosses zero); a positive current at the rising edge (a
+// negative one at the falling edge) freewheels through a diode for t_d and, while its leg keeps
+// the state before the edge, changes towards 0 by n/3 V_dc t_d / (sigma L_S), n the other legs
+// in the opposite state (those of larger duty at the rising edge, of smaller at the falling
+// edge): the edge loses t_d V_dc in full if the current stays on its side, in proportion if it
+// reaches 0 first. What the fit reads from the error's shape near the crossing is its area
+// against the full sign (its odd part's; the harmonics' amplitudes are its moments): the smooth
+// sign's is b = |D| + b_0, the reference's |D| + (the two changes' sum) / 4, equal; within 2 % of D
+// (the integration's range and step, the float32 sign). The default band before, the ripple's
+// peak at 50 % duty (kr / 4), was 2.3 to 7 times |D| here.
+TEST(IsrDuty, SmoothSignAtAZeroCrossingFollowsTheLegsRipple)
+{
+  DutyDrive dd(false, false);
+  isr_duty_k_t k{};
+  const float kr = isr_duty_constants(&dd.s.duty, (float)dd.vdc, (float)dd.vdc, &k);
+  const double per_leg = dd.vdc * dd.td / (3.0 * dd.sl), full = dd.td * dd.fpwm * dd.vdc;
+  auto ramp01 = [](double x) { return std::max(0.0, std::min(1.0, x)); };
+  for (double mi : {0.3, 0.6, 0.9}) {                 // modulation index
+    for (double phi : {0.3, 0.6, 1.0}) {              // the current's lag behind the voltage [rad]
+      const double th = 0.5 * 3.14159265358979 + phi; // leg a's current crosses zero here
+      const double d[3] = {0.5 + 0.5 * mi * std::cos(th), 0.5 + 0.5 * mi * std::cos(th - 2.0943951023932),
+                           0.5 + 0.5 * mi * std::cos(th + 2.0943951023932)};
+      const float df[3] = {(float)d[0], (float)d[1], (float)d[2]};
+      float rf[3];
+      isr_duty_ripple(kr, df, rf);
+      const double D = dd.ripple(d, 0);
+      ASSERT_LT(D, 0.0); // the current at its lowest at the rising edge: both ramps off 0
+      const double n_hi = (d[1] > d[0]) + (d[2] > d[0]), n_lo = 2.0 - n_hi;
+      const double dr = n_hi * per_leg, dfall = n_lo * per_leg; // the change within the dead time
+      // the error per t_d f V_dc: the rising edge's loss minus the falling edge's gain
+      auto ref = [&](double i) {
+        const double rise = dr > 0 ? ramp01((i + D) / dr) : (i + D > 0 ? 1.0 : 0.0);
+        const double fall = dfall > 0 ? ramp01(-(i - D) / dfall) : (i - D < 0 ? 1.0 : 0.0);
+        return rise - fall;
+      };
+      // out to where the reference is full and the model's tail b^2 / 2 i is below 1e-3 |D|
+      const int n = 400000;
+      const double top = 500.0 * (std::fabs(D) + per_leg), h = top / n;
+      double area_ref = 0, area_model = 0;
+      for (int q = 0; q < n; ++q) {
+        const double i = (q + 0.5) * h;
+        const double mp = isr_duty_error_smooth(&dd.s.duty, &k, df[0], (float)i, rf[0]) / full;
+        const double mm = isr_duty_error_smooth(&dd.s.duty, &k, df[0], (float)-i, rf[0]) / full;
+        area_ref += 0.5 * ((1.0 - ref(i)) + (1.0 + ref(-i))) * h;
+        area_model += 0.5 * ((1.0 - mp) + (1.0 + mm)) * h;
+      }
+      EXPECT_NEAR(area_model, area_ref, 0.02 * std::fabs(D)) << mi << " " << phi;
+    }
   }
-  EXPECT_LT(worst, 2e-6);
 }

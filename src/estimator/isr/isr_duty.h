@@ -15,8 +15,24 @@
 typedef struct {
   imest_real_t kp, kn; /* w_prev V_dc,prev and w_now V_dc: a leg's voltage is kp dp + kn d */
   imest_real_t kt;     /* t_d f V_dc / 2 at the weighted bus voltage */
-  imest_real_t band2;  /* b^2: the devices' own smoothing, or the smooth sign's band */
+  imest_real_t band2;  /* b^2: the devices' own smoothing, or the smooth sign's fixed band */
+  imest_real_t b0;     /* the smooth sign's floor beyond the leg's ripple [A] (0: none) */
 } isr_duty_k_t;
+
+/* The per-sample constants for the bus voltages V_dc,prev and V_dc; returns
+ * kr = V_dc T / (2 sigma L_S) at the weighted bus voltage (isr_duty_ripple's
+ * scale; 0 for the smooth sign with a fixed band). */
+static inline imest_real_t isr_duty_constants(const imest_duty_model_t *m, imest_real_t vdc_prev,
+                                              imest_real_t vdc, isr_duty_k_t *k)
+{
+  k->kp = m->w_prev * vdc_prev;
+  k->kn = (RL(1) - m->w_prev) * vdc;
+  const imest_real_t vbar = k->kp + k->kn;
+  k->kt = m->td_f_half * vbar;
+  k->b0 = m->floor_per_v * vbar;
+  k->band2 = m->band2;
+  return m->ripple_per_v * vbar;
+}
 
 /* The phase current's ripple at each leg's edges [A] (docs/METHOD.md §17.1):
  * centre-aligned PWM, floating neutral, against the line between the
@@ -59,15 +75,17 @@ static inline imest_real_t isr_duty_error(const imest_duty_model_t *m, const isr
 /* The smooth sign's error of one leg [V] (imest_inverter_t, edge_band_a 0):
  *   e = s(i) [ t_d f V_dc + V_d0 + r_d |i| + d_c ((V_sw0 - V_d0) + (r_sw - r_d) |i|) ]
  * with d_c = 1/2 + s (dbar - 1/2) (dbar for i > 0, 1 - dbar for i < 0) and the
- * smooth sign s(i) = i / sqrt(i^2 + b^2), b the ripple's peak or i_band_a: the
- * current ripple crosses zero inside the period near a zero crossing, so the
- * error fades instead of jumping. In the constants of the other model:
+ * smooth sign s(i) = i / sqrt(i^2 + b^2), b = |r| + b_0: the current at the
+ * leg's edges is i + r and i - r (r its ripple there, isr_duty_ripple; 0 with
+ * a fixed band i_band_a, which is then k->band2), so near a zero crossing the
+ * error fades instead of jumping; b_0 half the current's change within the
+ * dead time, the two edges' mean (docs/METHOD.md §17.1). In the constants of the other model:
  * V_d0 + d_c dV = (V_sw0 + V_d0)/2 + s (dbar - 1/2) dV, the same for the slopes. */
 static inline imest_real_t isr_duty_error_smooth(const imest_duty_model_t *m, const isr_duty_k_t *k,
-                                                 imest_real_t dbar, imest_real_t i)
+                                                 imest_real_t dbar, imest_real_t i, imest_real_t r)
 {
-  const imest_real_t a = imest__abs(i);
-  const imest_real_t sgn = i / imest__sqrt(i * i + k->band2);
+  const imest_real_t a = imest__abs(i), b = imest__abs(r) + k->b0;
+  const imest_real_t sgn = i / imest__sqrt((i * i + b * b) + k->band2);
   const imest_real_t mag = ((k->kt + k->kt) + RL(0.5) * m->v_sum) + m->r_mean * a;
   return sgn * (mag + sgn * ((dbar - RL(0.5)) * (m->dv + m->dr * a)));
 }

@@ -378,15 +378,9 @@ int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float
   s->vdc_prev = vdc;
   const imest_real_t wp = m->w_prev, wn = RL(1) - wp;
   /* per sample, shared by the legs: the weighted bus voltages, the dead
-   * time's volt-seconds, the ripple's scale and the devices' band */
+   * time's volt-seconds, the ripple's scale and the band's fixed part */
   isr_duty_k_t k;
-  k.kp = wp * vdc_prev;
-  k.kn = wn * vdc;
-  const imest_real_t vbar = k.kp + k.kn;
-  k.kt = m->td_f_half * vbar;
-  const imest_real_t kr = m->ripple_per_v * vbar;
-  const imest_real_t band = m->band_per_kr * kr;
-  k.band2 = band * band + m->band2;
+  const imest_real_t kr = isr_duty_constants(m, vdc_prev, vdc, &k);
   const imest_real_t ia = (imest_real_t)i_abc_a[0], ib = (imest_real_t)i_abc_a[1],
                      ic = (imest_real_t)i_abc_a[2];
   const imest_real_t da = (imest_real_t)duty_abc[0], db = (imest_real_t)duty_abc[1],
@@ -397,17 +391,19 @@ int imest_isr_duty(imest_t *s, const float duty_abc[3], float vdc_v, const float
   s->dleg[2] = dc;
   /* written out per leg: a compiler need not unroll a loop over three */
   const imest_real_t dbar[3] = {wp * pa + wn * da, wp * pb + wn * db, wp * pc + wn * dc};
+  /* each leg's ripple at its edges: the edges' currents, or the smooth
+   * sign's band (kr 0 with a fixed band: no ripple term) */
+  imest_real_t r[3];
+  isr_duty_ripple(kr, dbar, r);
   imest_real_t e[3];
   if (s->stages & IMEST_STAGE_DUTY_EDGES) { /* configuration only: the same path every sample */
-    imest_real_t r[3];
-    isr_duty_ripple(kr, dbar, r);
     e[0] = isr_duty_error(m, &k, dbar[0], ia, r[0]);
     e[1] = isr_duty_error(m, &k, dbar[1], ib, r[1]);
     e[2] = isr_duty_error(m, &k, dbar[2], ic, r[2]);
   } else {
-    e[0] = isr_duty_error_smooth(m, &k, dbar[0], ia);
-    e[1] = isr_duty_error_smooth(m, &k, dbar[1], ib);
-    e[2] = isr_duty_error_smooth(m, &k, dbar[2], ic);
+    e[0] = isr_duty_error_smooth(m, &k, dbar[0], ia, r[0]);
+    e[1] = isr_duty_error_smooth(m, &k, dbar[1], ib, r[1]);
+    e[2] = isr_duty_error_smooth(m, &k, dbar[2], ic, r[2]);
   }
   const imest_real_t u[3] = {(k.kp * pa + k.kn * da) - e[0], (k.kp * pb + k.kn * db) - e[1],
                              (k.kp * pc + k.kn * dc) - e[2]};
