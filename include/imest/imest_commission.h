@@ -121,8 +121,8 @@
  *     sum of the threshold voltages (split evenly between switch and diode: their difference
  *     enters only with the active-vector share, ~2 % at standstill, and is not separable); the
  *     upper- and lower-clamped patterns put the switch and the diode in the loop with different
- *     currents, which separates r_sw - r_d. i_band_a is the PWM current ripple's peak,
- *     V_dc / (8 sigma L_S f_pwm), computed, not measured (at standstill the ripple is tiny).
+ *     currents, which separates r_sw - r_d. i_band_a is 0: the estimator then sets the smooth
+ *     sign's band per leg and sample from its own duties (imest_inverter_t).
  *   - current-sensor gains (three sensors): the motor's neutral floats, so the true currents sum
  *     to zero; the measured sum against the axis current gives each sensor's gain relative to
  *     the mean of the three (a common gain error is not observable: it scales R_S and L_S).

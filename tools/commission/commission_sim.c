@@ -195,7 +195,10 @@ static void compare_inverter(const imsim_config_t *sc, const imest_comm_config_t
   const imest_inverter_t *m = &out->r.inverter;
   const double m_true = fmin(sc->r_switch_ohm, sc->r_diode_ohm);
   const double m_fit = (double)out->r.rs_ohm.value - sc->rs_ohm;
-  const double lo = 2.0 * (double)m->i_band_a, hi = (double)cc->i_max_a;
+  /* compared from twice the PWM ripple's peak up, where the leg's sign no longer depends on the band */
+  const double sls = (double)out->r.sigma_ls_h.value;
+  out->ripple_peak_a = sls > 0.0 ? sc->vdc_v / (8.0 * sls * sc->carrier_hz) : 0.0;
+  const double lo = 2.0 * out->ripple_peak_a, hi = (double)cc->i_max_a;
   double w_model = 0.0, w_total = 0.0, sum2 = 0.0;
   int n = 0;
   for (int a = 0; a <= 20; ++a)

@@ -499,9 +499,10 @@ int main(int argc, char **argv)
          (double)r->v_threshold_v.value - 0.5 * (sc->v_switch_v + sc->v_diode_v));
   printf("  %-26s %12.5f %12.5f %+9.5f ohm\n", "r_sw - r_d [ohm]", (double)r->dr_ohm.value,
          sc->r_switch_ohm - sc->r_diode_ohm, (double)r->dr_ohm.value - (sc->r_switch_ohm - sc->r_diode_ohm));
-  printf("  %-26s %12.4f (ripple peak V_dc / (8 sigma L_S f_pwm)), model uncertainty %.3f\n", "i_band [A]",
-         (double)r->inverter.i_band_a, (double)r->inverter.uncertainty);
-  printf("  inverter per-leg voltage error, |i| in [2 i_band, i_max], duty 0.05..0.95: model vs devices "
+  printf("  %-26s %12.4f (0: per leg from the duties; ripple peak V_dc / (8 sigma L_S f_pwm) %.4f A), model "
+         "uncertainty %.3f\n",
+         "i_band [A]", (double)r->inverter.i_band_a, out.ripple_peak_a, (double)r->inverter.uncertainty);
+  printf("  inverter per-leg voltage error, |i| in [2 ripple, i_max], duty 0.05..0.95: model vs devices "
          "(common slope\n"
          "  in R_S) max %.3f V; model + R_S vs devices + winding max %.3f V, rms %.3f V\n",
          out.inv_err_model_v, out.inv_err_total_v, out.inv_err_rms_v);

@@ -209,7 +209,11 @@ static void inverter_model(imest_comm_t *c, const axes_t *a)
   inv->v_diode_v = vthm;
   inv->r_switch_ohm = drm > 0.0f ? drm : 0.0f;
   inv->r_diode_ohm = drm < 0.0f ? -drm : 0.0f;
-  inv->i_band_a = slm > 0.0f ? vdc / (8.0f * slm * fpwm) : 0.0f;
+  /* 0: the estimator sets the smooth sign's band per leg and sample from its own duties (the
+     ripple at the edges plus the dead time's transition), which follows the operating point; a
+     fixed band cannot. Commissioning's own feed-forward uses the ripple's peak. */
+  inv->i_band_a = 0.0f;
+  c->inv_band = slm > 0.0f ? vdc / (8.0f * slm * fpwm) : 1e-3f;
   {
     /* relative uncertainty of the model's error: the fit (3 sigma), the spread between axes,
        and 0.1 V for the switch/diode threshold difference standstill cannot see */
@@ -234,7 +238,6 @@ static void prepare_rotation(imest_comm_t *c, const axes_t *a, float rs)
   c->inv_v = a->vthm;
   c->inv_rsw = inv->r_switch_ohm;
   c->inv_rd = inv->r_diode_ohm;
-  c->inv_band = inv->i_band_a > 0.0f ? inv->i_band_a : 1e-3f;
   c->tau = a->taum;
   c->ls_ss = ls_ss;
   if (!c->cfg.allow_rotation) {
