@@ -111,9 +111,11 @@ typedef struct {
   imest_real_t d;          /**< estimated angle minus encoder angle [rad] */
   imest_real_t dth;        /**< estimated angle step per sample [rad] */
   imest_real_t ddth;       /**< estimated change of the step per sample [rad] */
+  imest_real_t d_max;      /**< one encoder count [rad] (huge: counts unknown) */
   uint32_t engaged;        /**< the observer's estimate in use (0: the encoder as it is): set
                                   by the ISR from the last two windows' mean speeds */
   uint32_t enabled;        /**< configured (angle_observer_hz >= 0) */
+  uint32_t over;           /**< |d| exceeded d_max in this window: the tracker lags a motion */
 } imest_angle_t;
 
 /** Consecutive windows' sums combined by the background (src/estimator/window/bg_combine.c). */
@@ -180,6 +182,7 @@ typedef struct {
   uint32_t w_win_prev_ok;    /* ... and it had used samples */
   imest_real_t obs_rot;      /* the window just ended: rotation and used samples, for */
   uint32_t obs_used;         /* the observer's decision on the next odd sample */
+  uint32_t obs_over;         /* the tracker lagged a motion in the window that ended */
   uint32_t obs_pending;
   uint32_t k;       /* sample index in the current window */
   uint32_t warm;    /* warm-up samples still to discard */

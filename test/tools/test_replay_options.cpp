@@ -61,7 +61,9 @@ TEST(ReplayOptions, DutyInputFlagsSetTheirFields)
                           "--u-delay",
                           "-30e-6",
                           "--angle-observer-hz",
-                          "-1"});
+                          "-1",
+                          "--encoder-counts",
+                          "4096"});
   ASSERT_EQ(p.rc, -1);
   const imest_config_t &c = p.o.cfg;
   EXPECT_EQ(p.o.voltage, REPLAY_VOLTAGE_DUTY);
@@ -79,6 +81,7 @@ TEST(ReplayOptions, DutyInputFlagsSetTheirFields)
   EXPECT_FLOAT_EQ(c.timing_uncertainty_s, 1e-6f);
   EXPECT_FLOAT_EQ(c.u_delay_s, -30e-6f);
   EXPECT_FLOAT_EQ(c.angle_observer_hz, -1.0f);
+  EXPECT_FLOAT_EQ(c.encoder_counts_per_rev, 4096.0f);
 }
 
 TEST(ReplayOptions, InverterUncertaintyDefaults)

@@ -80,7 +80,7 @@ isr_engage_observer(imest_t *s)
   const imest_real_t n_used = s->obs_used > 0u ? (imest_real_t)s->obs_used : RL(1);
   const imest_real_t w_mean = s->obs_rot * s->fs / n_used, w_before = s->w_win_prev;
   const imest_real_t a = imest__abs(w_mean), b = imest__abs(w_before);
-  const int steady = s->obs_used > 0u && s->w_win_prev_ok &&
+  const int steady = s->obs_used > 0u && s->w_win_prev_ok && s->obs_over == 0u &&
                      imest__abs(w_mean - w_before) <=
                          RL(IMEST_STEADY_REL_LIT) * (a > b ? a : b) + RL(IMEST_STEADY_ABS_RAD_S_LIT);
   s->w_win_prev = w_mean;
@@ -122,6 +122,8 @@ static int isr_close_window(imest_t *s)
     isr_engage_observer(s); /* a fault closed the window: the one it decides */
   s->obs_rot = w->rot;      /* for the observer's decision (isr_engage_observer) */
   s->obs_used = w->used;
+  s->obs_over = s->obs.over; /* the tracker lagged a motion: not steady (isr_angle.h) */
+  s->obs.over = 0u;
   s->obs_pending = OBS_WINDOW_ENDED;
   const uint32_t pub = s->published; /* the ISR's own index */
   if (pub == IMEST_LOAD_ACQUIRE(&s->released)) {
