@@ -28,7 +28,7 @@ void imest_config_default(imest_config_t *cfg)
   cfg->aa_hz = 0.0f;
   cfg->u_delay_s = 0.0f;
   cfg->dc_block_hz = 1.0f;
-  cfg->angle_observer_hz = 0.0f; /* auto: filter_hz / 4 */
+  cfg->angle_observer_hz = 0.0f;      /* auto: filter_hz / 4 */
   cfg->encoder_counts_per_rev = 0.0f; /* unknown */
   cfg->warmup_s = 0.0f;
   cfg->start_at_rest = 0;

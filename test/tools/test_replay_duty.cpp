@@ -318,11 +318,11 @@ TEST(ReplayDuty, ModelTwentyPercentOffIsNeverValidAndWrong)
 // off. The 1024-count paper motor keeps the observer (R_S +0.2 %, off +7 %).
 TEST(ReplayDuty, ObserverLeavesAHuntingRotorToTheEncoder)
 {
-  const std::string &csv =
-      sim_csv("11kw_hunting.csv", "--preset 11kw --no-thermal --start steady --vdc 560 --freq 30 --vll 237.419 "
-                                  "--load-nm 18 --duration 4 --seed 5092 --encoder-counts 16384 --no-progress "
-                                  "--dead-time 2e-06 --v-switch 1 --r-switch 0.0172926 --v-diode 1 "
-                                  "--r-diode 0.0172926");
+  const std::string &csv = sim_csv(
+      "11kw_hunting.csv", "--preset 11kw --no-thermal --start steady --vdc 560 --freq 30 --vll 237.419 "
+                          "--load-nm 18 --duration 4 --seed 5092 --encoder-counts 16384 --no-progress "
+                          "--dead-time 2e-06 --v-switch 1 --r-switch 0.0172926 --v-diode 1 "
+                          "--r-diode 0.0172926");
   const std::string est = std::string(REPLAY_BIN) + " --pole-pairs 2 --ls 0.078331 --sigma 0.05515971 "
                                                     "--ls-uncertainty 0 --sigma-uncertainty 0 --from-rest no "
                                                     "--quiet --voltage duty --dead-time 2e-06 --v-switch 1 "
@@ -338,10 +338,12 @@ TEST(ReplayDuty, ObserverLeavesAHuntingRotorToTheEncoder)
 
 TEST(ReplayDuty, ObserverKeepsACoarseEncodersQuantisationOut)
 {
-  const std::string &csv = sim_csv("exp2_1024.csv", "--preset exp2 --duration 4 --encoder-counts 1024 --start "
-                                                    "steady --no-thermal --no-progress --seed 7");
-  const std::string est = std::string(REPLAY_BIN) + " --pole-pairs 2 --ls 0.2908 --sigma 0.096 --ls-uncertainty 0 "
-                                                    "--sigma-uncertainty 0 --from-rest no --quiet ";
+  const std::string &csv =
+      sim_csv("exp2_1024.csv", "--preset exp2 --duration 4 --encoder-counts 1024 --start "
+                               "steady --no-thermal --no-progress --seed 7");
+  const std::string est = std::string(REPLAY_BIN) +
+                          " --pole-pairs 2 --ls 0.2908 --sigma 0.096 --ls-uncertainty 0 "
+                          "--sigma-uncertainty 0 --from-rest no --quiet ";
   const Out on = run(est + "--encoder-counts 1024 " + csv), off = run(est + "--angle-observer-hz -1 " + csv);
   ASSERT_EQ(on.code, 0) << on.err;
   ASSERT_EQ(off.code, 0) << off.err;

@@ -61,9 +61,7 @@ TEST(ReplayOptions, DutyInputFlagsSetTheirFields)
                           "--u-delay",
                           "-30e-6",
                           "--angle-observer-hz",
-                          "-1",
-                          "--encoder-counts",
-                          "4096"});
+                          "-1"});
   ASSERT_EQ(p.rc, -1);
   const imest_config_t &c = p.o.cfg;
   EXPECT_EQ(p.o.voltage, REPLAY_VOLTAGE_DUTY);
@@ -81,7 +79,6 @@ TEST(ReplayOptions, DutyInputFlagsSetTheirFields)
   EXPECT_FLOAT_EQ(c.timing_uncertainty_s, 1e-6f);
   EXPECT_FLOAT_EQ(c.u_delay_s, -30e-6f);
   EXPECT_FLOAT_EQ(c.angle_observer_hz, -1.0f);
-  EXPECT_FLOAT_EQ(c.encoder_counts_per_rev, 4096.0f);
 }
 
 TEST(ReplayOptions, InverterUncertaintyDefaults)
@@ -156,4 +153,12 @@ TEST(ReplayOptions, TemperaturesReferences)
   for (const char *bad :
        {"20,3", "20,3,0.1,4", "20,x,0.1", "20,0,0.1", "20,3,-0.1", "300,3,0.1", "20,3,0.1x"})
     EXPECT_EQ(parse({"--temperatures", bad}).rc, 2) << bad;
+}
+
+TEST(ReplayOptions, EncoderCountsSetTheirField)
+{
+  const Parsed p = parse({"--encoder-counts", "4096"});
+  ASSERT_EQ(p.rc, -1);
+  EXPECT_FLOAT_EQ(p.o.cfg.encoder_counts_per_rev, 4096.0f);
+  EXPECT_FLOAT_EQ(parse({}).o.cfg.encoder_counts_per_rev, 0.0f); // unknown: the observer as before
 }
