@@ -255,8 +255,7 @@ static void design_angle(imest_angle_t *o, float fn, float fs, float counts)
   o->k1 = 1.0f - r * r * r;
   o->k2 = 1.5f * q * q * (1.0f + r);
   o->k3 = q * q * q;
-  o->enabled = fn >= 0.0f;
-  o->engaged = 0u; /* until a window at steady speed */
+  o->state = fn >= 0.0f ? IMEST_ANG_ENABLED : 0u; /* engaged after a window at steady speed */
 }
 
 /* Duty-cycle input: the weights of the two periods around a sample

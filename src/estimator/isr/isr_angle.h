@@ -46,8 +46,8 @@ static inline imest_real_t isr_angle_update(imest_angle_t *o, imest_real_t dth_e
    * ends, and for the next window (isr_engage_observer), the encoder's angle
    * and speed are used: a lag the tracker shows in its angle it has in its
    * speed too. The switch moves the angle by about one count. */
-  o->over |= (uint32_t)(imest__abs(o->d) > o->d_max);
-  const int on = (o->engaged != 0u) & (o->over == 0u);
+  o->state |= (uint32_t)(imest__abs(o->d) > o->d_max); /* IMEST_ANG_OVER */
+  const int on = (o->state & (IMEST_ANG_ENGAGED | IMEST_ANG_OVER)) == IMEST_ANG_ENGAGED;
   *step = on ? o->dth : dth_enc;
   return on ? o->d : RL(0);
 }
