@@ -315,7 +315,8 @@ TEST(ReplayDuty, ModelTwentyPercentOffIsNeverValidAndWrong)
 // 8 % of the swing and its speed by half of it. The observer engaged (from the third window),
 // that lag read as R_S +65 %; with the encoder's counts the tracker's correction beyond one count
 // shows the lag and the encoder is used instead (isr_angle.h): R_S +2.5 %, as with the observer
-// off. The 1024-count paper motor keeps the observer (R_S +0.2 %, off +7 %).
+// off; the swing at a steady mean is not the steady state the bounds assume: `transient`. The
+// 1024-count paper motor keeps the observer (R_S +0.2 %, off +7 %).
 TEST(ReplayDuty, ObserverLeavesAHuntingRotorToTheEncoder)
 {
   const std::string &csv = sim_csv(
@@ -333,7 +334,10 @@ TEST(ReplayDuty, ObserverLeavesAHuntingRotorToTheEncoder)
   const Windows w = parse(o);
   ASSERT_GE(w.rs.size(), 4u) << o.out;
   const std::vector<double> ers = rs_error(csv, w);
-  for (size_t k = 2; k < w.rs.size(); ++k) EXPECT_LT(std::fabs(ers[k]), 0.1) << "window " << k;
+  for (size_t k = 2; k < w.rs.size(); ++k) {
+    EXPECT_LT(std::fabs(ers[k]), 0.1) << "window " << k;
+    EXPECT_FALSE(w.tr_valid[k] || w.rs_valid[k]) << "window " << k;
+  }
 }
 
 TEST(ReplayDuty, ObserverKeepsACoarseEncodersQuantisationOut)
