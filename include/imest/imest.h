@@ -303,6 +303,17 @@ typedef struct {
    *  quantisation steps above this (1024 counts, paper motor at 30 Hz: R_S +6.6 % -> -0.02 %)
    *  (default 0: filter_hz / 4; negative: off, the encoder angle as it is; at most fs_hz / 4) */
   float angle_observer_hz;
+  /** the encoder's counts per mechanical revolution after decoding (e.g. 4096 for a 1024-line
+   *  quadrature encoder; a resolver's or an absolute encoder's 2^bits). The true angle lies within
+   *  one count of the reading, so an angle observer's correction beyond one count is its lag on a
+   *  real motion, not quantisation: the encoder's angle and speed are then used for the rest of
+   *  that window and the next (src/estimator/isr/isr_angle.h). A rotor whose speed swings inside
+   *  the observer's band (a V/f drive's hunting: 11 kW, 2 us dead time, 30 Hz, 25 % load, 5 % of
+   *  the speed at 12 Hz) otherwise reads the observer's lag as R_S: +65 % -> +2.5 % with 16384
+   *  counts given, as with the observer off; such a window (a swing at a steady mean speed) is
+   *  published `transient`. 1024 counts on the paper motor keep the observer's gain (R_S +0.2 %,
+   *  off +7 %). (default 0: unknown, the observer as configured; below 2^24) */
+  float encoder_counts_per_rev;
   /** cut-off [Hz] of a first-order high-pass applied alike to the alpha/beta voltages and currents
    *  before the rotation: it removes sensor offsets (default 1; 0 = off). Applied to both, it
    *  leaves the motor's equations intact at constant speed; see README "Method" (sensor offsets).

@@ -68,6 +68,9 @@ typedef struct {
 /** A flag of imest_window_t.flags above the 16 bits a result carries (internal): the angle
  *  observer was engaged in the window (its angle and speed used, src/estimator/isr/isr_angle.h). */
 #define IMEST_WFLAG_OBSERVER 0x10000u
+/** ... the rotor swung at a steady mean speed: the angle observer's correction exceeded one encoder
+ *  count (a V/f drive's hunting), so the steady-state bounds do not hold: `transient`. */
+#define IMEST_WFLAG_SWING    0x20000u
 
 /** Butterworth-3 as a first-order and a second-order section (transposed DF-II).
  *  Bilinear low-pass sections have binomial numerators, so only their gains
@@ -113,10 +116,20 @@ typedef struct {
   imest_real_t d;          /**< estimated angle minus encoder angle [rad] */
   imest_real_t dth;        /**< estimated angle step per sample [rad] */
   imest_real_t ddth;       /**< estimated change of the step per sample [rad] */
-  uint32_t engaged;        /**< the observer's estimate in use (0: the encoder as it is): set
-                                  by the ISR from the last two windows' mean speeds */
-  uint32_t enabled;        /**< configured (angle_observer_hz >= 0) */
+  imest_real_t d_max;      /**< one encoder count [rad] (huge: counts unknown) */
+  uint32_t state;          /**< IMEST_ANG_* bits */
 } imest_angle_t;
+/** imest_angle_t.state: |d| exceeded d_max in this window (the tracker lags a motion) ... */
+#define IMEST_ANG_OVER      1u
+/** ... and in the window that ended last */
+#define IMEST_ANG_OVER_LAST 2u
+/** this window's decision found the mean speed steady */
+#define IMEST_ANG_STEADY    4u
+/** the observer's estimate in use (else the encoder as it is): set by the ISR from the last two
+ *  windows' mean speeds */
+#define IMEST_ANG_ENGAGED   8u
+/** configured (angle_observer_hz >= 0) */
+#define IMEST_ANG_ENABLED   16u
 
 /** Consecutive windows' sums combined by the background (src/estimator/window/bg_combine.c). */
 typedef struct {

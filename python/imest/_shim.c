@@ -41,6 +41,7 @@ enum { KIND_FLOAT = 0, KIND_INT = 1, KIND_UINT = 2, KIND_PWM_TIMING = 3, KIND_RE
   X(aa_hz, KIND_FLOAT)                                                                                       \
   X(u_delay_s, KIND_FLOAT)                                                                                   \
   X(angle_observer_hz, KIND_FLOAT)                                                                           \
+  X(encoder_counts_per_rev, KIND_FLOAT)                                                                      \
   X(dc_block_hz, KIND_FLOAT)                                                                                 \
   X(warmup_s, KIND_FLOAT)                                                                                    \
   X(start_at_rest, KIND_INT)                                                                                 \

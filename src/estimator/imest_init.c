@@ -28,7 +28,8 @@ void imest_config_default(imest_config_t *cfg)
   cfg->aa_hz = 0.0f;
   cfg->u_delay_s = 0.0f;
   cfg->dc_block_hz = 1.0f;
-  cfg->angle_observer_hz = 0.0f; /* auto: filter_hz / 4 */
+  cfg->angle_observer_hz = 0.0f;      /* auto: filter_hz / 4 */
+  cfg->encoder_counts_per_rev = 0.0f; /* unknown */
   cfg->warmup_s = 0.0f;
   cfg->start_at_rest = 0;
   cfg->tr_nominal_s = 0.1f;
@@ -92,6 +93,7 @@ static const check_t k_checks[] = {
     CHK(u_delay_s, C_ANY, 0.0f, 0.0f),
     CHK(dc_block_hz, C_NONNEG, 0.01f, 0.0f),
     CHK(angle_observer_hz, C_ANY, 0.0f, 0.0f),
+    CHK(encoder_counts_per_rev, C_NONNEG, 0.0f, 16777216.0f),
     CHK(warmup_s, C_NONNEG, 0.0f, 0.0f),
     CHK(tr_nominal_s, C_POS, 0.0f, 0.0f),
     CHK(tr_min_s, C_POS, 0.0f, 0.0f),
@@ -244,14 +246,16 @@ static float exp_neg_small(float x)
 /* Angle observer gains: an alpha-beta-gamma tracker with a triple pole at
  * r = exp(-w_n T): alpha = 1 - r^3, beta = 1.5 (1 - r)^2 (1 + r),
  * gamma = (1 - r)^3 (f_n < 0: never engaged). */
-static void design_angle(imest_angle_t *o, float fn, float fs)
+static void design_angle(imest_angle_t *o, float fn, float fs, float counts)
 {
+  /* one count: the true angle lies within it of the reading whichever way the
+   * encoder rounds; unknown (0), a bound that never acts */
+  o->d_max = counts > 0.0f ? 2.0f * (float)IMEST_PI_D / counts : 1.0e30f;
   const float r = exp_neg_small(2.0f * (float)IMEST_PI_D * (fn > 0.0f ? fn : 0.0f) / fs), q = 1.0f - r;
   o->k1 = 1.0f - r * r * r;
   o->k2 = 1.5f * q * q * (1.0f + r);
   o->k3 = q * q * q;
-  o->enabled = fn >= 0.0f;
-  o->engaged = 0u; /* until a window at steady speed */
+  o->state = fn >= 0.0f ? IMEST_ANG_ENABLED : 0u; /* engaged after a window at steady speed */
 }
 
 /* Duty-cycle input: the weights of the two periods around a sample
@@ -352,7 +356,7 @@ static void init_isr_constants(imest_t *s, const imest_config_t *cfg, double m)
               (cfg->aa_hz > 0.0f ? IMEST_STAGE_AA : 0u) |
               (cfg->inverter.edge_band_a > 0.0f ? IMEST_STAGE_DUTY_EDGES : 0u);
   const float fn = cfg->angle_observer_hz == 0.0f ? 0.25f * cfg->filter_hz : cfg->angle_observer_hz;
-  design_angle(&s->obs, fn, fs);
+  design_angle(&s->obs, fn, fs, cfg->encoder_counts_per_rev);
   s->transient_k = imest__bg_transient_k(fn, (float)s->n, cfg->window_s); /* the judge's (bg_transient.c) */
   design_duty(&s->duty, cfg);
 }

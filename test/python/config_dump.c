@@ -8,7 +8,7 @@
 
 #include "imest/imest.h"
 
-_Static_assert(sizeof(imest_config_t) == 54 * sizeof(float),
+_Static_assert(sizeof(imest_config_t) == 55 * sizeof(float),
                "imest_config_t changed: list the new field below");
 
 #define F(name) printf(#name " %a\n", (double)cfg.name)
@@ -29,6 +29,7 @@ int main(void)
   F(aa_hz);
   F(u_delay_s);
   F(angle_observer_hz);
+  F(encoder_counts_per_rev);
   F(dc_block_hz);
   F(warmup_s);
   I(start_at_rest);

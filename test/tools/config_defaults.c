@@ -33,6 +33,7 @@ static const struct {
     F(aa_hz),
     F(u_delay_s),
     F(angle_observer_hz),
+    F(encoder_counts_per_rev),
     F(dc_block_hz),
     F(warmup_s),
     F(pwm_hz),

@@ -154,3 +154,11 @@ TEST(ReplayOptions, TemperaturesReferences)
        {"20,3", "20,3,0.1,4", "20,x,0.1", "20,0,0.1", "20,3,-0.1", "300,3,0.1", "20,3,0.1x"})
     EXPECT_EQ(parse({"--temperatures", bad}).rc, 2) << bad;
 }
+
+TEST(ReplayOptions, EncoderCountsSetTheirField)
+{
+  const Parsed p = parse({"--encoder-counts", "4096"});
+  ASSERT_EQ(p.rc, -1);
+  EXPECT_FLOAT_EQ(p.o.cfg.encoder_counts_per_rev, 4096.0f);
+  EXPECT_FLOAT_EQ(parse({}).o.cfg.encoder_counts_per_rev, 0.0f); // unknown: the observer as before
+}

@@ -100,6 +100,10 @@ static void usage(FILE *o)
              "  --angle-observer-hz HZ  natural frequency of the angle observer between the\n"
              "                      encoder and the rotation (default 0: filter-hz / 4;\n"
              "                      negative: off)\n"
+             "  --encoder-counts N  the encoder's counts per revolution after decoding (4096\n"
+             "                      for 1024 lines): where the observer's correction exceeds\n"
+             "                      one count (it lags a real motion) the encoder is used\n"
+             "                      (default 0: unknown)\n"
              "  --ls-curve I1:L1,I2:L2,...  the magnetising curve: L_S [H] measured at no load\n"
              "                      at 2 to 4 magnetising currents I [A], given as the alpha/beta\n"
              "                      amplitude (sqrt 3 x the phase rms current, the unit of\n"
@@ -197,6 +201,7 @@ static const struct {
     {"--ls-uncertainty", "ls_uncertainty", offsetof(imest_config_t, ls_uncertainty), FOR_ANY},
     {"--sigma-uncertainty", "sigma_uncertainty", offsetof(imest_config_t, sigma_uncertainty), FOR_ANY},
     {"--angle-observer-hz", "angle_observer_hz", offsetof(imest_config_t, angle_observer_hz), FOR_ANY},
+    {"--encoder-counts", "encoder_counts_per_rev", offsetof(imest_config_t, encoder_counts_per_rev), FOR_ANY},
     {"--rs", "rs_nominal_ohm", offsetof(imest_config_t, rs_nominal_ohm), FOR_ANY},
     {"--rs-tolerance", "rs_tolerance", offsetof(imest_config_t, rs_tolerance), FOR_ANY},
     {"--tr-tolerance", "tr_tolerance", offsetof(imest_config_t, tr_tolerance), FOR_ANY},

@@ -13,7 +13,10 @@
  * start: measured, the run-up window becomes poorly determined), so the
  * observer is engaged only while the rotor turns at a steady speed: the ISR
  * engages it after a window whose mean speed did not change and disengages
- * it after one whose speed did (isr_engage_observer, isr_sample.c). */
+ * it after one whose speed did (isr_engage_observer, isr_sample.c). A rotor
+ * can also swing inside the observer's band at a steady mean speed (a V/f
+ * drive's hunting); with the encoder's counts given, a correction beyond one
+ * count shows that (below), docs/METHOD.md §13.1. */
 #ifndef IMEST_ISR_ANGLE_H
 #define IMEST_ISR_ANGLE_H
 
@@ -37,7 +40,14 @@ static inline imest_real_t isr_angle_update(imest_angle_t *o, imest_real_t dth_e
   o->dth = (o->dth + o->ddth) + o->k2 * e;
   o->ddth += o->k3 * e;
   o->d = (o->k1 - RL(1)) * e;
-  const int on = o->engaged != 0u;
+  /* The true angle lies within one count (d_max) of the encoder's, whichever
+   * way it rounds: a larger correction is the tracker's lag on a real motion
+   * (a V/f drive's hunting), not quantisation. From then on until the window
+   * ends, and for the next window (isr_engage_observer), the encoder's angle
+   * and speed are used: a lag the tracker shows in its angle it has in its
+   * speed too. The switch moves the angle by about one count. */
+  o->state |= (uint32_t)(imest__abs(o->d) > o->d_max); /* IMEST_ANG_OVER */
+  const int on = (o->state & (IMEST_ANG_ENGAGED | IMEST_ANG_OVER)) == IMEST_ANG_ENGAGED;
   *step = on ? o->dth : dth_enc;
   return on ? o->d : RL(0);
 }

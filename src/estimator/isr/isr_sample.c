@@ -80,13 +80,17 @@ isr_engage_observer(imest_t *s)
   const imest_real_t n_used = s->obs_used > 0u ? (imest_real_t)s->obs_used : RL(1);
   const imest_real_t w_mean = s->obs_rot * s->fs / n_used, w_before = s->w_win_prev;
   const imest_real_t a = imest__abs(w_mean), b = imest__abs(w_before);
-  const int steady = s->obs_used > 0u && s->w_win_prev_ok &&
-                     imest__abs(w_mean - w_before) <=
-                         RL(IMEST_STEADY_REL_LIT) * (a > b ? a : b) + RL(IMEST_STEADY_ABS_RAD_S_LIT);
+  const int steady_mean = s->obs_used > 0u && s->w_win_prev_ok &&
+                          imest__abs(w_mean - w_before) <=
+                              RL(IMEST_STEADY_REL_LIT) * (a > b ? a : b) + RL(IMEST_STEADY_ABS_RAD_S_LIT);
+  const uint32_t st = s->obs.state;
+  const int steady = steady_mean && (st & IMEST_ANG_OVER_LAST) == 0u;
+  const int engaged = (st & IMEST_ANG_ENABLED) && steady;
   s->w_win_prev = w_mean;
   s->w_win_prev_ok = s->obs_used > 0u;
-  s->obs.engaged = (s->obs.enabled && steady) ? 1u : 0u;
-  if (s->obs.engaged) s->win[s->published & 1u].flags |= IMEST_WFLAG_OBSERVER; /* the background's judge */
+  s->obs.state = (st & ~(IMEST_ANG_ENGAGED | IMEST_ANG_STEADY)) | (engaged ? IMEST_ANG_ENGAGED : 0u) |
+                 (steady_mean ? IMEST_ANG_STEADY : 0u);
+  if (engaged) s->win[s->published & 1u].flags |= IMEST_WFLAG_OBSERVER; /* the background's judge */
   s->obs_pending = 0u;
 }
 
@@ -117,11 +121,17 @@ static int isr_close_window(imest_t *s)
   w->off_ia = s->off_ia;
   w->off_ib = s->off_ib;
   w->dth_end_rad = s->obs.dth; /* the speed at the window's end (the tracker always runs) */
+  /* a swing at a steady mean (hunting), not a run-up: the background's judge */
+  const uint32_t swing = IMEST_ANG_OVER | IMEST_ANG_STEADY;
+  if ((s->obs.state & swing) == swing) w->flags |= IMEST_WFLAG_SWING;
   s->seq++;
   if (s->obs_pending == OBS_DECIDE)
     isr_engage_observer(s); /* a fault closed the window: the one it decides */
   s->obs_rot = w->rot;      /* for the observer's decision (isr_engage_observer) */
   s->obs_used = w->used;
+  /* the tracker lagged a motion: the next decision finds it not steady (isr_angle.h) */
+  const uint32_t st = s->obs.state;
+  s->obs.state = (st & ~(IMEST_ANG_OVER | IMEST_ANG_OVER_LAST)) | ((st & IMEST_ANG_OVER) << 1);
   s->obs_pending = OBS_WINDOW_ENDED;
   const uint32_t pub = s->published; /* the ISR's own index */
   if (pub == IMEST_LOAD_ACQUIRE(&s->released)) {

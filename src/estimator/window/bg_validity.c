@@ -409,10 +409,13 @@ static inline int tr_constants_uncertain(judge_t *j)
   return j->tr_judged && !(j->c_tr <= j->s->tr_tolerance);
 }
 /* tr_tolerance: a load or speed step inside the window alone (judged where
- * T_R's bound is) */
+ * T_R's bound is); or a rotor that swung at a steady mean (IMEST_WFLAG_SWING):
+ * the steady-state bounds do not cover it (measured, the 4 kW motor hunting
+ * at 30 Hz, 25 % load, 2 us, the inverter model 20 % high: T_R +1.4 % within
+ * its bound) */
 static inline int tr_transient(judge_t *j)
 {
-  return j->tr_judged && !(j->x_tr <= j->s->tr_tolerance);
+  return j->tr_judged && (!(j->x_tr <= j->s->tr_tolerance) || (j->w->flags & IMEST_WFLAG_SWING) != 0u);
 }
 /* tr_tolerance */
 static inline int tr_uncertain(judge_t *j)
@@ -427,7 +430,7 @@ static inline int rs_gain_mismatch(judge_t *j)
 /* rs_tolerance: a load or speed step inside the window alone */
 static inline int rs_transient(judge_t *j)
 {
-  return !(j->x_rs <= j->s->rs_tolerance);
+  return !(j->x_rs <= j->s->rs_tolerance) || (j->w->flags & IMEST_WFLAG_SWING) != 0u;
 }
 /* rs_tolerance, ls_uncertainty, sigma_uncertainty: the constants' share alone */
 static inline int rs_constants_uncertain(judge_t *j)
