@@ -63,7 +63,8 @@ typedef struct {
   double theta_max_standstill_rad; /* rotor travel during the standstill part */
   /* inverter: the fitted model against the simulator's device model, per leg */
   double ripple_peak_a; /* the PWM current ripple's peak, V_dc / (8 sigma L_S f_pwm), from the result */
-  double inv_err_model_v; /* max |e_fit - (e_true - min(r_sw,r_d) i)| over |i| in [2 ripple, i_max], d in [0.05, 0.95] */
+  double
+      inv_err_model_v; /* max |e_fit - (e_true - min(r_sw,r_d) i)| over |i| in [2 ripple, i_max], d in [0.05, 0.95] */
   double
       inv_err_total_v; /* max |e_fit + (R_S,id - R_S) i - e_true| (what the estimator's voltage would miss) */
   double inv_err_rms_v; /* rms of the latter over the same grid */
