@@ -7,6 +7,7 @@
 
 #include "bg_noise_bias.h"
 #include "isr_accumulate.h" /* IMEST_ACC_INDEX: the ISR's packed order of the bias */
+#include "bg_float.h"       /* BG_FMAX...: no libm fmax on a core without VMAXNM */
 
 /* 7-column index (W1 W2 W4 ...) -> 8-entry K index */
 static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
@@ -80,7 +81,7 @@ void imest__bg_noise_subtract(bg_sums_t *sums, bg_noise_t *nz, double m)
   float f = nz->steady ? 1.0f : 0.0f;
   for (unsigned int i = 0; i < 8u; ++i) {
     const float r = (float)((i < 7u) ? sums->rw[k_of_col[i]][k_of_col[i]] : sums->ry), b = bias_f(nz, i, i);
-    if (b > 0.9f * r) f = fminf(f, r > 0.0f ? 0.9f * r / b : 0.0f);
+    if (b > 0.9f * r) f = BG_FMINF(f, r > 0.0f ? 0.9f * r / b : 0.0f);
   }
   nz->scale = (double)f;
   sums->e_slack = 0.0;

@@ -8,6 +8,7 @@
 
 #include "bg_window.h"
 #include "isr_accumulate.h"
+#include "estimator/solve/bg_float.h" /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
 
 /* 7-column index -> 8-column (K) index */
 static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
@@ -65,7 +66,7 @@ void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums
   const float n = w->nreg > 0u ? (float)w->nreg : 1.0f;
   const float n_used = w->used > 0u ? (float)w->used : 1.0f;
   const float r44 = (float)out->rw[3][3];
-  st->i_rms_a = sqrtf(fmaxf(r44, 0.0f) / n);
+  st->i_rms_a = sqrtf(BG_FMAXF(r44, 0.0f) / n);
   st->w_mean = (float)w->rot * (float)fs / n_used;
   const float cross = (float)(w->sum[IMEST_ACC_ROT] + w->blk[IMEST_ACC_ROT]);
   st->slip_rate = (r44 > 0.0f) ? cross / r44 : 0.0f;
