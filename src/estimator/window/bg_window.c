@@ -10,9 +10,6 @@
 #include "isr_accumulate.h"
 #include "estimator/solve/bg_float.h" /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
 
-/* 7-column index -> 8-column (K) index */
-static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
-
 void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out,
                            bg_window_stats_t *st)
 {
@@ -37,8 +34,8 @@ void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums
   }
 
   for (unsigned int i = 0; i < 7u; ++i) {
-    out->rwy[k_of_col[i]] = rwy7[i];
-    for (unsigned int j = 0; j < 7u; ++j) out->rw[k_of_col[i]][k_of_col[j]] = z[i][j];
+    out->rwy[imest__bg_k_of_col[i]] = rwy7[i];
+    for (unsigned int j = 0; j < 7u; ++j) out->rw[imest__bg_k_of_col[i]][imest__bg_k_of_col[j]] = z[i][j];
   }
   for (unsigned int j = 0; j < 8u; ++j) {
     out->rw[2][j] = -m * out->rw[3][j];
@@ -55,8 +52,8 @@ void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums
   out->e_slack = 0.0;
   out->ree = z[7][7];
   for (unsigned int i = 0; i < 7u; ++i) {
-    out->c0[k_of_col[i]] = c0[i];
-    out->rwe[k_of_col[i]] = z[i][7];
+    out->c0[imest__bg_k_of_col[i]] = c0[i];
+    out->rwe[imest__bg_k_of_col[i]] = z[i][7];
   }
   out->c0[2] = 0.0;
   out->rwe[2] = -m * out->rwe[3];
