@@ -6,6 +6,7 @@
 
 #include "commission_internal.h"
 #include "estimator/window/bg_flux.h" /* IMEST_WITH_FLUX */
+#include "estimator/solve/bg_float.h" /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
 
 int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r)
 {
@@ -35,11 +36,10 @@ static float std3_rel(const imest_comm_value_t *v)
  * errors and the axes' spread (either NaN: not known, left out). */
 static float quality_rel(const imest_comm_value_t *v)
 {
-  return fmaxf(std3_rel(v), isfinite(v->spread_rel) ? v->spread_rel : 0.0f);
+  return BG_FMAXF(std3_rel(v), isfinite(v->spread_rel) ? v->spread_rel : 0.0f);
 }
 
-/* min(u, IMEST_COMM_UNCERTAINTY_MAX), the maximum for NaN (as fminf, which nothing else in
-   the library links) */
+/* min(u, IMEST_COMM_UNCERTAINTY_MAX), the maximum for NaN (as fminf, written out) */
 static float at_most_max(float u)
 {
   return u < IMEST_COMM_UNCERTAINTY_MAX ? u : IMEST_COMM_UNCERTAINTY_MAX;
@@ -62,13 +62,13 @@ static void constants_uncertainty(const imest_comm_result_t *r, int curve, imest
 {
   const int standstill = (r->flags & IMEST_COMM_FLAG_LS_STANDSTILL) != 0u;
   const float q_ls = curve ? std3_rel(&r->ls_h) : quality_rel(&r->ls_h);
-  const float u_ls = fmaxf(standstill ? IMEST_COMM_LS_FLOOR_STANDSTILL : IMEST_COMM_LS_FLOOR,
-                           fmaxf(q_ls, standstill ? quality_rel(&r->ls_standstill_h) : 0.0f));
+  const float u_ls = BG_FMAXF(standstill ? IMEST_COMM_LS_FLOOR_STANDSTILL : IMEST_COMM_LS_FLOOR,
+                              BG_FMAXF(q_ls, standstill ? quality_rel(&r->ls_standstill_h) : 0.0f));
   cfg->ls_uncertainty = at_most_max(u_ls);
   if (!sigma_at_slip(r)) return;
   const float q_sg = curve ? std3_rel(&r->sigma) : quality_rel(&r->sigma);
-  const float u_sg = fmaxf(standstill ? IMEST_COMM_SIGMA_FLOOR_STANDSTILL : IMEST_COMM_SIGMA_FLOOR,
-                           fmaxf(q_sg, quality_rel(&r->sigma_ls_h) + u_ls));
+  const float u_sg = BG_FMAXF(standstill ? IMEST_COMM_SIGMA_FLOOR_STANDSTILL : IMEST_COMM_SIGMA_FLOOR,
+                              BG_FMAXF(q_sg, quality_rel(&r->sigma_ls_h) + u_ls));
   cfg->sigma_uncertainty = at_most_max(u_sg);
 }
 

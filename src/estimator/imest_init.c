@@ -67,72 +67,96 @@ void imest_config_default(imest_config_t *cfg)
 
 /* The config's float fields and their ranges, checked in order by one loop
  * (a table costs a fraction of the flash of one comparison chain, and float
- * arithmetic is the FPU's: no soft-double code for a check). */
+ * arithmetic is the FPU's: no soft-double code for a check). A row is the
+ * field's name, its offset and one code: the kind and the indices of its two
+ * bounds in the short tables below (41 rows of two floats each were 328 B). */
 enum { C_ANY = 0, C_NONNEG = 1, C_POS = 2 };
+/* |value| * (1/fs) must stay below this (0: no bound) */
+enum { FS_NONE, FS_FILTER, FS_AA, FS_DC_BLOCK, FS_SPEED };
+static const float k_below_fs[] = {
+    [FS_NONE] = 0.0f,      /* no bound */
+    [FS_FILTER] = 0.4f,    /* filter_hz */
+    [FS_AA] = 0.45f,       /* aa_hz */
+    [FS_DC_BLOCK] = 0.01f, /* dc_block_hz */
+    [FS_SPEED] = 3.0f,     /* speed_limit_rad_s */
+};
+/* |value| must stay below this (0: no bound) */
+enum { LIM_NONE, LIM_ONE, LIM_FS, LIM_COUNTS };
+static const float k_below[] = {
+    [LIM_NONE] = 0.0f,
+    [LIM_ONE] = 1.0f,
+    [LIM_FS] = 1.000001e6f,     /* fs_hz */
+    [LIM_COUNTS] = 16777216.0f, /* encoder_counts_per_rev: exact in float32 */
+};
+#define CODE(kind, fs, lim) ((unsigned short)((kind) | (fs) << 2 | (lim) << 5))
+#define CODE_KIND(c)        ((c)&3u)
+#define CODE_FS(c)          (((c) >> 2) & 7u)
+#define CODE_LIM(c)         ((c) >> 5)
 typedef struct {
-  unsigned short offset;
-  unsigned short kind; /* C_*: finite, and >= 0 or > 0 */
-  float below_fs;      /* |value| * (1/fs) must stay below this (0: no bound) ... */
-  float below;         /* ... and |value| below this (0: no bound) */
   const char *name;
+  unsigned short offset;
+  unsigned short code; /* C_* | FS_* << 2 | LIM_* << 5 */
 } check_t;
 
 #define CHK(f, kind, below_fs, below)                                                                        \
   {                                                                                                          \
-    (unsigned short)offsetof(imest_config_t, f), kind, below_fs, below, #f                                   \
+    .name = #f, .offset = (unsigned short)offsetof(imest_config_t, f), .code = CODE(kind, below_fs, below)   \
   }
 static const check_t k_checks[] = {
-    CHK(ls_h, C_POS, 0.0f, 0.0f),
-    CHK(sigma, C_POS, 0.0f, 1.0f),
-    CHK(ls_uncertainty, C_NONNEG, 0.0f, 1.0f),
-    CHK(sigma_uncertainty, C_NONNEG, 0.0f, 1.0f),
-    CHK(fs_hz, C_POS, 0.0f, 1.000001e6f),
-    CHK(window_s, C_POS, 0.0f, 0.0f),
-    CHK(filter_hz, C_POS, 0.4f, 0.0f),
-    CHK(aa_hz, C_NONNEG, 0.45f, 0.0f),
-    CHK(u_delay_s, C_ANY, 0.0f, 0.0f),
-    CHK(dc_block_hz, C_NONNEG, 0.01f, 0.0f),
-    CHK(angle_observer_hz, C_ANY, 0.0f, 0.0f),
-    CHK(encoder_counts_per_rev, C_NONNEG, 0.0f, 16777216.0f),
-    CHK(warmup_s, C_NONNEG, 0.0f, 0.0f),
-    CHK(tr_nominal_s, C_POS, 0.0f, 0.0f),
-    CHK(tr_min_s, C_POS, 0.0f, 0.0f),
-    CHK(tr_max_s, C_POS, 0.0f, 0.0f),
-    CHK(rs_min_ohm, C_NONNEG, 0.0f, 0.0f),
-    CHK(rs_max_ohm, C_POS, 0.0f, 0.0f),
-    CHK(max_pe_k2_rel, C_POS, 0.0f, 0.0f),
-    CHK(max_ei, C_POS, 0.0f, 0.0f),
-    CHK(min_current_a, C_NONNEG, 0.0f, 0.0f),
-    CHK(min_slip_ratio, C_NONNEG, 0.0f, 0.0f),
-    CHK(i_limit_a, C_NONNEG, 0.0f, 0.0f),
-    CHK(u_limit_v, C_NONNEG, 0.0f, 0.0f),
-    CHK(i_absurd_a, C_POS, 0.0f, 0.0f),
-    CHK(u_absurd_v, C_POS, 0.0f, 0.0f),
-    CHK(speed_limit_rad_s, C_POS, 3.0f, 0.0f),
-    CHK(pwm_hz, C_NONNEG, 0.0f, 0.0f),
-    CHK(inverter.dead_time_s, C_NONNEG, 0.0f, 0.0f),
-    CHK(inverter.v_switch_v, C_NONNEG, 0.0f, 0.0f),
-    CHK(inverter.r_switch_ohm, C_NONNEG, 0.0f, 0.0f),
-    CHK(inverter.v_diode_v, C_NONNEG, 0.0f, 0.0f),
-    CHK(inverter.r_diode_ohm, C_NONNEG, 0.0f, 0.0f),
-    CHK(inverter.i_band_a, C_NONNEG, 0.0f, 0.0f),
-    CHK(inverter.edge_band_a, C_NONNEG, 0.0f, 0.0f),
-    CHK(inverter.uncertainty, C_ANY, 0.0f, 0.0f),
-    CHK(rs_tolerance, C_POS, 0.0f, 0.0f),
-    CHK(tr_tolerance, C_POS, 0.0f, 0.0f),
-    CHK(u_uncertainty_v, C_NONNEG, 0.0f, 0.0f),
-    CHK(timing_uncertainty_s, C_NONNEG, 0.0f, 0.0f),
-    CHK(rs_nominal_ohm, C_NONNEG, 0.0f, 0.0f),
+    CHK(ls_h, C_POS, FS_NONE, LIM_NONE),
+    CHK(sigma, C_POS, FS_NONE, LIM_ONE),
+    CHK(ls_uncertainty, C_NONNEG, FS_NONE, LIM_ONE),
+    CHK(sigma_uncertainty, C_NONNEG, FS_NONE, LIM_ONE),
+    CHK(fs_hz, C_POS, FS_NONE, LIM_FS),
+    CHK(window_s, C_POS, FS_NONE, LIM_NONE),
+    CHK(filter_hz, C_POS, FS_FILTER, LIM_NONE),
+    CHK(aa_hz, C_NONNEG, FS_AA, LIM_NONE),
+    CHK(u_delay_s, C_ANY, FS_NONE, LIM_NONE),
+    CHK(dc_block_hz, C_NONNEG, FS_DC_BLOCK, LIM_NONE),
+    CHK(angle_observer_hz, C_ANY, FS_NONE, LIM_NONE),
+    CHK(encoder_counts_per_rev, C_NONNEG, FS_NONE, LIM_COUNTS),
+    CHK(warmup_s, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(tr_nominal_s, C_POS, FS_NONE, LIM_NONE),
+    CHK(tr_min_s, C_POS, FS_NONE, LIM_NONE),
+    CHK(tr_max_s, C_POS, FS_NONE, LIM_NONE),
+    CHK(rs_min_ohm, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(rs_max_ohm, C_POS, FS_NONE, LIM_NONE),
+    CHK(max_pe_k2_rel, C_POS, FS_NONE, LIM_NONE),
+    CHK(max_ei, C_POS, FS_NONE, LIM_NONE),
+    CHK(min_current_a, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(min_slip_ratio, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(i_limit_a, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(u_limit_v, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(i_absurd_a, C_POS, FS_NONE, LIM_NONE),
+    CHK(u_absurd_v, C_POS, FS_NONE, LIM_NONE),
+    CHK(speed_limit_rad_s, C_POS, FS_SPEED, LIM_NONE),
+    CHK(pwm_hz, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(inverter.dead_time_s, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(inverter.v_switch_v, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(inverter.r_switch_ohm, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(inverter.v_diode_v, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(inverter.r_diode_ohm, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(inverter.i_band_a, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(inverter.edge_band_a, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(inverter.uncertainty, C_ANY, FS_NONE, LIM_NONE),
+    CHK(rs_tolerance, C_POS, FS_NONE, LIM_NONE),
+    CHK(tr_tolerance, C_POS, FS_NONE, LIM_NONE),
+    CHK(u_uncertainty_v, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(timing_uncertainty_s, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(rs_nominal_ohm, C_NONNEG, FS_NONE, LIM_NONE),
 };
 #undef CHK
+#undef CODE
 
 static int check_ok(const check_t *c, float x, float fs)
 {
+  const unsigned int kind = CODE_KIND(c->code);
+  const float below_fs = k_below_fs[CODE_FS(c->code)], below = k_below[CODE_LIM(c->code)];
   if (!isfinite(x)) return 0;
-  if ((c->kind == C_NONNEG && x < 0.0f) || (c->kind == C_POS && !(x > 0.0f))) return 0;
+  if ((kind == C_NONNEG && x < 0.0f) || (kind == C_POS && !(x > 0.0f))) return 0;
   const float ax = fabsf(x);
-  if (c->below_fs > 0.0f && !(ax < c->below_fs * fs)) return 0;
-  return !(c->below > 0.0f && !(ax < c->below));
+  if (below_fs > 0.0f && !(ax < below_fs * fs)) return 0;
+  return !(below > 0.0f && !(ax < below));
 }
 
 /* The magnetising curve: 0 points (none) or 2 .. IMEST_LS_CURVE_POINTS (one

@@ -5,7 +5,8 @@
 // (every exponent, subnormals), numbers next to squares and to the rounding
 // midpoints (y + 1/2 ulp)^2, and the special values; imest__bg_div against the
 // division, on random bit patterns, quotients next to the rounding midpoints
-// and to the ends of the normal range, and the special values.
+// and to the ends of the normal range, and the special values; fmax, fmaxf and fminf
+// against newlib's rule.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -145,5 +146,33 @@ TEST(BgFloat, DivIsCorrectlyRounded)
     }
   }
   EXPECT_EQ(mismatches, 0);
+}
+#endif
+
+#if BG_SOFT_DOUBLE
+// fmax, fmaxf, fminf of bg_float.c: the other operand where one is a NaN (a NaN only
+// where both are), else x > y ? x : y (x < y for the minimum; y where they compare
+// equal, as newlib's): bit for bit, on the special values and random bit patterns.
+TEST(BgFloat, MaxMinAreNewlibs)
+{
+  std::mt19937_64 rng(7003);
+  long mismatches = 0;
+  auto same = [](double a, double b) { return std::isnan(a) ? std::isnan(b) : bits(a) == bits(b); };
+  auto check = [&](double x, double y) {
+    const double want = std::isnan(x) ? y : std::isnan(y) ? x : (x > y ? x : y);
+    const float xf = (float)x, yf = (float)y;
+    const float want_max = std::isnan(xf) ? yf : std::isnan(yf) ? xf : (xf > yf ? xf : yf);
+    const float want_min = std::isnan(xf) ? yf : std::isnan(yf) ? xf : (xf < yf ? xf : yf);
+    if (!same(imest__bg_fmax(x, y), want) || !same(imest__bg_fmaxf(xf, yf), want_max) ||
+        !same(imest__bg_fminf(xf, yf), want_min)) {
+      if (++mismatches <= 5) ADD_FAILURE() << std::hexfloat << "max/min of " << x << ", " << y;
+    }
+  };
+  for (double x : kSpecial)
+    for (double y : kSpecial) check(x, y);
+  for (int i = 0; i < 100000; ++i) check(random_double(rng, i), random_double(rng, i / 3));
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(bits(imest__bg_fmax(0.0, -0.0)), bits(-0.0)); // y where equal, as newlib's
+  EXPECT_TRUE(std::isnan(imest__bg_fmax(NAN, NAN)));
 }
 #endif

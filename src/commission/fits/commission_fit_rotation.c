@@ -169,7 +169,7 @@ static float rated_std(const imest_comm_t *c, uint32_t last, uint32_t ns)
   }
   float ds = -1.0f; /* the larger slope change to a neighbour; none yet */
   if (kd < CM_ROT_LEVELS) ds = imest__abs(level_slope(c, kd, lo) - s_ab);
-  if (ku < CM_ROT_LEVELS) ds = fmaxf(ds, imest__abs(level_slope(c, hi, ku) - s_ab));
+  if (ku < CM_ROT_LEVELS) ds = BG_FMAXF(ds, imest__abs(level_slope(c, hi, ku) - s_ab));
   if (ds < 0.0f) ds = ls / (is < ia ? is : ia);
   const float w2 = interp ? (1.0f - t) * (1.0f - t) + t * t : 1.0f;
   const float rem = (interp ? imest__abs(t * (1.0f - t) * (ib - ia)) : imest__abs(is - ia)) * ds;

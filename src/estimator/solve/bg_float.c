@@ -41,6 +41,33 @@ int imest__bg_finite(double x)
   return ((unsigned int)(b.u >> 52) & 0x7FFu) != 0x7FFu;
 }
 
+#if BG_SOFT_DOUBLE
+double imest__bg_fmax(double x, double y)
+{
+  bits64_t a, b;
+  a.d = x;
+  b.d = y;
+  /* a NaN by the bits: a soft-double comparison costs ~20 instructions */
+  if ((a.u << 1) > 0xFFE0000000000000ull) return y;
+  if ((b.u << 1) > 0xFFE0000000000000ull) return x;
+  return x > y ? x : y;
+}
+
+float imest__bg_fmaxf(float x, float y)
+{
+  if (x != x) return y;
+  if (y != y) return x;
+  return x > y ? x : y;
+}
+
+float imest__bg_fminf(float x, float y)
+{
+  if (x != x) return y;
+  if (y != y) return x;
+  return x < y ? x : y;
+}
+#endif
+
 int imest__bg_round_log2(double x)
 {
   bits64_t b;

@@ -69,6 +69,23 @@ double imest__bg_sqrt(double x);
 BG_CORE_PCS double imest__bg_div(double x, double y);
 #define BG_DIV(x, y) imest__bg_div((x), (y))
 #endif
+/* fmax, fmaxf, fminf as C99 and newlib define them: the other operand where
+ * one is a NaN, else x > y ? x : y (y where equal, as newlib's and glibc's),
+ * bit for bit. Where the FPU has no VMAXNM (Cortex-M4F), libm's call
+ * __fpclassify for each operand: with them 334 B of flash. Where it has
+ * (Cortex-M7 fpv5-d16), GCC's builtins are one instruction. Background only. */
+#if !BG_SOFT_DOUBLE
+#define BG_FMAX(x, y)  fmax((x), (y))
+#define BG_FMAXF(x, y) fmaxf((x), (y))
+#define BG_FMINF(x, y) fminf((x), (y))
+#else
+double imest__bg_fmax(double x, double y);
+float imest__bg_fmaxf(float x, float y);
+float imest__bg_fminf(float x, float y);
+#define BG_FMAX(x, y)  imest__bg_fmax((x), (y))
+#define BG_FMAXF(x, y) imest__bg_fmaxf((x), (y))
+#define BG_FMINF(x, y) imest__bg_fminf((x), (y))
+#endif
 /* round(log2(x)) for finite x > 0, exact (mantissa compared with sqrt 2). */
 int imest__bg_round_log2(double x);
 

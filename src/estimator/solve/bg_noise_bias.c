@@ -7,9 +7,9 @@
 
 #include "bg_noise_bias.h"
 #include "isr_accumulate.h" /* IMEST_ACC_INDEX: the ISR's packed order of the bias */
+#include "bg_float.h"       /* BG_FMAX...: no libm fmax on a core without VMAXNM */
 
-/* 7-column index (W1 W2 W4 ...) -> 8-entry K index */
-static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
+const unsigned int imest__bg_k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
 
 /* The bias entry of ISR columns i, j (0..7, 7 = y). */
 static float bias_f(const bg_noise_t *nz, unsigned int i, unsigned int j)
@@ -41,7 +41,7 @@ static void apply(bg_sums_t *sm, const bg_noise_t *nz, double f, double m)
 {
   const int whole = (f == 1.0);
   double c0[7];
-  for (unsigned int i = 0; i < 7u; ++i) c0[i] = sm->c0[k_of_col[i]];
+  for (unsigned int i = 0; i < 7u; ++i) c0[i] = sm->c0[imest__bg_k_of_col[i]];
   double bwc[7]; /* B_WW c0 */
   for (unsigned int i = 0; i < 7u; ++i) {
     bwc[i] = 0.0;
@@ -49,9 +49,10 @@ static void apply(bg_sums_t *sm, const bg_noise_t *nz, double f, double m)
   }
   double cbc = 0.0, cby = 0.0;
   for (unsigned int i = 0; i < 7u; ++i) {
-    for (unsigned int j = 0; j < 7u; ++j) TAKE(sm->rw[k_of_col[i]][k_of_col[j]], bias_at(nz, i, j));
-    TAKE(sm->rwy[k_of_col[i]], bias_at(nz, i, 7u));
-    TAKE(sm->rwe[k_of_col[i]], bias_at(nz, i, 7u) - bwc[i]);
+    for (unsigned int j = 0; j < 7u; ++j)
+      TAKE(sm->rw[imest__bg_k_of_col[i]][imest__bg_k_of_col[j]], bias_at(nz, i, j));
+    TAKE(sm->rwy[imest__bg_k_of_col[i]], bias_at(nz, i, 7u));
+    TAKE(sm->rwe[imest__bg_k_of_col[i]], bias_at(nz, i, 7u) - bwc[i]);
     cbc += c0[i] * bwc[i];
     cby += c0[i] * bias_at(nz, i, 7u);
   }
@@ -79,8 +80,9 @@ void imest__bg_noise_subtract(bg_sums_t *sums, bg_noise_t *nz, double m)
    * continuous where the test flips (0.9 r / b = 1 there). */
   float f = nz->steady ? 1.0f : 0.0f;
   for (unsigned int i = 0; i < 8u; ++i) {
-    const float r = (float)((i < 7u) ? sums->rw[k_of_col[i]][k_of_col[i]] : sums->ry), b = bias_f(nz, i, i);
-    if (b > 0.9f * r) f = fminf(f, r > 0.0f ? 0.9f * r / b : 0.0f);
+    const float r = (float)((i < 7u) ? sums->rw[imest__bg_k_of_col[i]][imest__bg_k_of_col[i]] : sums->ry),
+                b = bias_f(nz, i, i);
+    if (b > 0.9f * r) f = BG_FMINF(f, r > 0.0f ? 0.9f * r / b : 0.0f);
   }
   nz->scale = (double)f;
   sums->e_slack = 0.0;

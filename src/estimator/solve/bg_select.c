@@ -21,6 +21,7 @@
 #include "bg_noise_bias.h"
 
 #include <math.h>
+#include "bg_float.h" /* BG_FMAX...: no libm fmax on a core without VMAXNM */
 
 static int centred_ok(const bg_sums_t *in)
 {
@@ -82,7 +83,7 @@ int imest__bg_select(const bg_tables_t *t, const double *kappa, int n, const bg_
     double floor_c = floor_e;
     if (c->admissible && c->e < floor_e && in->noise && in->noise_f > 0.0) {
       floor_c = -1e-4 * in->ry -
-                in->noise_f * fmax(0.0, imest__bg_noise_e_at(in->noise, c->k1, c->k2, in->noise_m));
+                in->noise_f * BG_FMAX(0.0, imest__bg_noise_e_at(in->noise, c->k1, c->k2, in->noise_m));
     }
     c->admissible = c->admissible && imest__bg_finite(c->e) && imest__bg_finite(c->ew) && c->e >= floor_c;
     if (c->admissible) {

@@ -20,6 +20,7 @@
 #include "bg_noise_bias.h"
 #include "bg_quality.h"
 #include "bg_resultant.h"
+#include "bg_float.h" /* BG_FMAX...: no libm fmax on a core without VMAXNM */
 
 static int cfg_ok(const bg_solve_cfg_t *cfg)
 {
@@ -100,7 +101,7 @@ int imest__bg_solve_ex(const bg_sums_t *in, const bg_solve_cfg_t *cfg, bg_solve_
    * exact fit: pe 0). */
   if (in->noise) out->noise_e_k = imest__bg_noise_e_at(in->noise, c->k1, c->k2, in->noise_m);
   bg_solve_cfg_t qcfg = *cfg;
-  if (in->noise && in->noise_f > 0.0) qcfg.e_noise = fmax(cfg->e_noise, in->noise_f * out->noise_e_k);
+  if (in->noise && in->noise_f > 0.0) qcfg.e_noise = BG_FMAX(cfg->e_noise, in->noise_f * out->noise_e_k);
   stats->quality_evals = imest__bg_quality(&t, &qcfg, c, out);
   out->work += stats->quality_evals;
 

@@ -42,6 +42,10 @@ typedef struct {
   double ree;
 } bg_sums_t;
 
+/* 7-column index of the ISR's sums (W1 W2 W4 ...) -> 8-entry K index (column 3
+ * rebuilt): 0, 1, 3, 4, 5, 6, 7 (bg_noise_bias.c; the window's stage uses it too). */
+extern const unsigned int imest__bg_k_of_col[7];
+
 typedef struct {
   double sigma;        /* total leakage factor */
   double ls_h;         /* L_S [H] */

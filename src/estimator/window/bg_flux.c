@@ -13,6 +13,7 @@
 #include <math.h>
 
 #include "bg_flux.h"
+#include "estimator/solve/bg_float.h" /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
 
 /* The fixed point L = curve(i_d(T_R(L))) is solved by one secant step: the
  * fit's T_R gives L_1 = curve(i_d), the estimate with L_1 gives L_2; the
@@ -58,7 +59,7 @@ float imest__bg_flux_ls(const imest_t *s, float i_a, float *err_h)
   const float t = (i_a - x[k]) / h;
   float dslope = n == 2u ? fabsf(slope) : 0.0f; /* the slope's change at the segment's ends */
   if (k >= 1u) dslope = fabsf(slope - seg_slope(x, y, k - 1u));
-  if (k + 2u < n) dslope = fmaxf(dslope, fabsf(seg_slope(x, y, k + 1u) - slope));
+  if (k + 2u < n) dslope = BG_FMAXF(dslope, fabsf(seg_slope(x, y, k + 1u) - slope));
   *err_h = t * (1.0f - t) * h * dslope;
   return y[k] + t * (y[k + 1u] - y[k]);
 }

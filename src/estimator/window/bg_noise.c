@@ -19,6 +19,7 @@
 
 #include "bg_noise.h"
 #include "isr_accumulate.h"
+#include "estimator/solve/bg_float.h" /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
 
 /* x_f[n] of the Butterworth-3 (as isr_bw3) for an input x. */
 typedef struct {
@@ -55,7 +56,7 @@ void imest__bg_noise_gains(const imest_bw3_t *bw, float fs, float g[6])
     acc[5] += d2x * d2x;
     y2 = y1;
     y1 = y0;
-    peak = fmaxf(peak, fabsf(y0));
+    peak = BG_FMAXF(peak, fabsf(y0));
     /* the response has decayed far below the sums' resolution */
     if (n > 16u && fabsf(y0) + fabsf(y2) < 1e-7f * peak && fabsf(c.s1) + fabsf(c.s2a) < 1e-7f * peak) break;
   }
@@ -93,7 +94,7 @@ void imest__bg_noise_estimate(const imest_t *s, const imest_window_t *w, const b
   const float we = np * st->w_mean + st->slip_rate;
   /* 2 sin(x/2) by its series (|x| <= pi: error < 1e-3 of it; libm's sin
    * would cost 5 KB of flash on a soft-double core) */
-  const float x = fminf(fabsf(we / fs), IMEST_PI_F), x2 = x * x;
+  const float x = BG_FMINF(fabsf(we / fs), IMEST_PI_F), x2 = x * x;
   const float h =
       x * (1.0f - x2 * (1.0f / 24.0f) * (1.0f - x2 * (1.0f / 80.0f) * (1.0f - x2 * (1.0f / 168.0f))));
   const float h3 = h * h * h, h6 = h3 * h3;
@@ -104,8 +105,8 @@ void imest__bg_noise_estimate(const imest_t *s, const imest_window_t *w, const b
   /* two current sensors (the third computed: the zero sequence is exactly
    * zero) give beta 5/3 of alpha's noise: 4/3 per axis on average */
   const int two = w->sum[IMEST_ACC_I0A] == (imest_real_t)0 && w->sum[IMEST_ACC_I0B] == (imest_real_t)0;
-  nz->var_i = fmaxf(0.0f, ni - h6 * i2) / 20.0f * (two ? 4.0f / 3.0f : 1.0f);
-  nz->var_u = fmaxf(0.0f, nu - h6 * u2) / 20.0f;
+  nz->var_i = BG_FMAXF(0.0f, ni - h6 * i2) / 20.0f * (two ? 4.0f / 3.0f : 1.0f);
+  nz->var_u = BG_FMAXF(0.0f, nu - h6 * u2) / 20.0f;
   nz->scale = 1.0;
   nz->steady = steady;
   /* the columns W1 W2 W4 W5 W6 W7 W8 y in one row (docs/METHOD.md §2, b = n w' = 0) */

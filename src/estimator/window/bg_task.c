@@ -12,6 +12,7 @@
 #include "bg_noise.h"
 #include "bg_transient.h"
 #include "bg_validity.h"
+#include "estimator/solve/bg_float.h" /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
 
 /* Fewer used samples than this: the sums cannot determine the 7 columns. */
 #define MIN_USED_SAMPLES 16u
@@ -59,9 +60,10 @@ static void window_sums(imest_t *s, const imest_window_t *w, double m, bg_step_t
    * speeds of at most speed_limit_rad_s; the mean rounded to float32
    * (relative 6e-8) moves the verdict only at the tolerance's edge */
   const float w_now = x->st.w_mean, w_before = s->w_prev_rad_s;
-  x->steady = w->used > 0u && s->w_prev_valid &&
-              fabsf(w_now - w_before) <= (float)IMEST_STEADY_REL_LIT * fmaxf(fabsf(w_now), fabsf(w_before)) +
-                                             (float)IMEST_STEADY_ABS_RAD_S_LIT;
+  x->steady =
+      w->used > 0u && s->w_prev_valid &&
+      fabsf(w_now - w_before) <= (float)IMEST_STEADY_REL_LIT * BG_FMAXF(fabsf(w_now), fabsf(w_before)) +
+                                     (float)IMEST_STEADY_ABS_RAD_S_LIT;
   x->st.dw_rad_s = imest__bg_transient_dw(s, w, w_now); /* before w_prev_valid moves on */
   s->w_prev_rad_s = w_now;
   s->w_prev_valid = w->used > 0u;
@@ -132,7 +134,7 @@ static void result_from_solve(const bg_step_t *x, const imest_t *s, const bg_sol
     out->rs_ohm = so->rs_ohm;
     out->k1 = so->k1;
     out->k2 = so->k2;
-    const double e_noise = fmax(0.0, so->noise_e_k) * x->noise_share; /* bg_solve's, at this K */
+    const double e_noise = BG_FMAX(0.0, so->noise_e_k) * x->noise_share; /* bg_solve's, at this K */
     out->e = so->e + x->nz.scale * e_noise;
     out->e_i = BG_SQRT(BG_DIV(out->e, ry_all));
     out->e_i_noise = BG_SQRT(BG_DIV(e_noise, ry_all));

@@ -15,6 +15,7 @@
 #include "bg_transient.h"
 #include "bg_validity.h"
 #include "common/imest_math.h"
+#include "estimator/solve/bg_float.h" /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
 
 /* The window's operating point, from its sums: stator frequency, slip,
  * power and impedance (power-invariant alpha/beta: the power is the motor's).
@@ -64,7 +65,7 @@ static void operating_point(const imest_t *s, const bg_window_stats_t *st, const
   op->slip = fabsf(op->we) > 0.0f ? slip_rate / op->we : 0.0f;
   /* W1.W4 - W2.W4 = u.i / (sigma L_S) exactly (i_perp.i = 0) */
   op->p_w = (float)((float)(sm->rw[0][3] - sm->rw[1][3]) / s->inv_s / n);
-  const float i2 = fmaxf((float)sm->rw[3][3] / n, 0.0f), u2 = fmaxf(2.0f * st->u_ms, 0.0f);
+  const float i2 = BG_FMAXF((float)sm->rw[3][3] / n, 0.0f), u2 = BG_FMAXF(2.0f * st->u_ms, 0.0f);
   op->i2 = i2;
   op->s_va = sqrtf(i2 * u2); /* balanced: |u|^2 = 2 u_alpha^2 */
   op->z_ohm = i2 > 0.0f ? sqrtf(u2 / i2) : 0.0f;
@@ -135,10 +136,10 @@ static float voltage_uncertainty(const imest_t *s, const imest_window_t *w, cons
   const float e = fabsf(dead + v->v_diode_v + v->r_diode_ohm * a +
                         0.5f * ((v->v_switch_v - v->v_diode_v) + (v->r_switch_ohm - v->r_diode_ohm) * a));
   const float dv = v->uncertainty * e;
-  h->shape_v = fmaxf(dv, SHAPE_FLOOR * e);
+  h->shape_v = BG_FMAXF(dv, SHAPE_FLOOR * e);
   h->sign_v = fabsf(dead + 0.5f * (v->v_switch_v + v->v_diode_v)) +
               0.5f * (fabsf(v->v_switch_v - v->v_diode_v) + fabsf(v->r_switch_ohm - v->r_diode_ohm) * a);
-  h->u = fmaxf(v->uncertainty, SHAPE_FLOOR);
+  h->u = BG_FMAXF(v->uncertainty, SHAPE_FLOOR);
   return dv;
 }
 
@@ -255,7 +256,7 @@ static void noload_ls_check(imest_t *s, const op_point_t *op, float slip_ratio, 
   if (!(steady && slip_ratio < NOLOAD_SLIP_RATIO && we > IMEST_2PI_F * NOLOAD_MIN_HZ && op->i2 > 0.0f &&
         op->s_va > 0.0f))
     return;
-  const float q = sqrtf(fmaxf(0.0f, op->s_va * op->s_va - op->p_w * op->p_w));
+  const float q = sqrtf(BG_FMAXF(0.0f, op->s_va * op->s_va - op->p_w * op->p_w));
   const float ls_meas = q / op->i2 / we;
   r->ls_noload_h = (double)ls_meas;
   float tol;
@@ -368,7 +369,7 @@ static inline int poorly_determined(judge_t *j)
    * squared stay inside float32's range (pe^2 of an unbounded index is
    * inf: poorly determined, as in float64); a few roundings of 6e-8 */
   const float ei = j->e_i, en = j->e_i_noise, pe = j->pe_k2_rel, lim = j->s->max_pe_k2_rel;
-  const float f = ei > 0.0f ? fminf(1.0f, (en * en) / (ei * ei)) : 1.0f;
+  const float f = ei > 0.0f ? BG_FMINF(1.0f, (en * en) / (ei * ei)) : 1.0f;
   const float pe2 = pe * pe * ((1.0f - f) + f / (float)j->r->windows);
   return !(pe2 <= lim * lim);
 }
@@ -377,7 +378,7 @@ static inline int high_residual(judge_t *j)
 {
   /* float32: E_I and its noise share are O(1e-3..10); the difference of
    * their squares loses only what a 6e-8 rounding of each is worth */
-  const float em = sqrtf(fmaxf(0.0f, j->e_i * j->e_i - j->e_i_noise * j->e_i_noise));
+  const float em = sqrtf(BG_FMAXF(0.0f, j->e_i * j->e_i - j->e_i_noise * j->e_i_noise));
   return !(em <= j->s->max_ei);
 }
 /* rs_min_ohm, rs_max_ohm */

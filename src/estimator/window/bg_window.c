@@ -8,9 +8,7 @@
 
 #include "bg_window.h"
 #include "isr_accumulate.h"
-
-/* 7-column index -> 8-column (K) index */
-static const unsigned int k_of_col[7] = {0u, 1u, 3u, 4u, 5u, 6u, 7u};
+#include "estimator/solve/bg_float.h" /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
 
 void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums_t *out,
                            bg_window_stats_t *st)
@@ -36,8 +34,8 @@ void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums
   }
 
   for (unsigned int i = 0; i < 7u; ++i) {
-    out->rwy[k_of_col[i]] = rwy7[i];
-    for (unsigned int j = 0; j < 7u; ++j) out->rw[k_of_col[i]][k_of_col[j]] = z[i][j];
+    out->rwy[imest__bg_k_of_col[i]] = rwy7[i];
+    for (unsigned int j = 0; j < 7u; ++j) out->rw[imest__bg_k_of_col[i]][imest__bg_k_of_col[j]] = z[i][j];
   }
   for (unsigned int j = 0; j < 8u; ++j) {
     out->rw[2][j] = -m * out->rw[3][j];
@@ -54,8 +52,8 @@ void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums
   out->e_slack = 0.0;
   out->ree = z[7][7];
   for (unsigned int i = 0; i < 7u; ++i) {
-    out->c0[k_of_col[i]] = c0[i];
-    out->rwe[k_of_col[i]] = z[i][7];
+    out->c0[imest__bg_k_of_col[i]] = c0[i];
+    out->rwe[imest__bg_k_of_col[i]] = z[i][7];
   }
   out->c0[2] = 0.0;
   out->rwe[2] = -m * out->rwe[3];
@@ -65,7 +63,7 @@ void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums
   const float n = w->nreg > 0u ? (float)w->nreg : 1.0f;
   const float n_used = w->used > 0u ? (float)w->used : 1.0f;
   const float r44 = (float)out->rw[3][3];
-  st->i_rms_a = sqrtf(fmaxf(r44, 0.0f) / n);
+  st->i_rms_a = sqrtf(BG_FMAXF(r44, 0.0f) / n);
   st->w_mean = (float)w->rot * (float)fs / n_used;
   const float cross = (float)(w->sum[IMEST_ACC_ROT] + w->blk[IMEST_ACC_ROT]);
   st->slip_rate = (r44 > 0.0f) ? cross / r44 : 0.0f;
