@@ -410,13 +410,10 @@ static inline int tr_constants_uncertain(judge_t *j)
   return j->tr_judged && !(j->c_tr <= j->s->tr_tolerance);
 }
 /* tr_tolerance: a load or speed step inside the window alone (judged where
- * T_R's bound is); or a rotor that swung at a steady mean (IMEST_WFLAG_SWING):
- * the steady-state bounds do not cover it (measured, the 4 kW motor hunting
- * at 30 Hz, 25 % load, 2 us, the inverter model 20 % high: T_R +1.4 % within
- * its bound) */
+ * T_R's bound is), or a swing that reaches zero slip (bounds()) */
 static inline int tr_transient(judge_t *j)
 {
-  return j->tr_judged && (!(j->x_tr <= j->s->tr_tolerance) || (j->w->flags & IMEST_WFLAG_SWING) != 0u);
+  return j->tr_judged && !(j->x_tr <= j->s->tr_tolerance);
 }
 /* tr_tolerance */
 static inline int tr_uncertain(judge_t *j)
@@ -428,10 +425,11 @@ static inline int rs_gain_mismatch(judge_t *j)
 {
   return !(j->rs_b + j->g_b <= j->s->rs_tolerance) && j->g_b > j->rs_b;
 }
-/* rs_tolerance: a load or speed step inside the window alone */
+/* rs_tolerance: a load or speed step inside the window alone, or a swing that
+ * reaches zero slip */
 static inline int rs_transient(judge_t *j)
 {
-  return !(j->x_rs <= j->s->rs_tolerance) || (j->w->flags & IMEST_WFLAG_SWING) != 0u;
+  return !(j->x_rs <= j->s->rs_tolerance);
 }
 /* rs_tolerance, ls_uncertainty, sigma_uncertainty: the constants' share alone */
 static inline int rs_constants_uncertain(judge_t *j)
@@ -607,9 +605,16 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
     inv_share_t h;
     float dk1, dk2;
     const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &h);
-    systematic_bounds(j->s, j->w, &j->op, j->st->slip_rate, j->tr, rs, dv_v, h.shape_v, &j->tr_b, &j->rs_b,
-                      &j->c_tr, &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
-    inverter_harmonics(j, &h, j->st->slip_rate, &dk1, &dk2);
+    /* A swing at a steady mean (IMEST_WFLAG_SWING) visits slips down to |w_s| - sqrt(2) x its rms
+     * (a sinusoid's peak): the bounds are taken there, where the fit's leverage of every error on
+     * T_R is largest (|dZ/dT_R| ~ w_s for a < 1). A swing reaching zero slip has none: transient. */
+    const float ws = j->st->slip_rate;
+    const float ws_b = (j->w->flags & IMEST_WFLAG_SWING)
+                           ? copysignf(fmaxf(fabsf(ws) - IMEST_SQRT2_F * j->st->swing_rad_s, 0.0f), ws)
+                           : ws;
+    systematic_bounds(j->s, j->w, &j->op, ws_b, j->tr, rs, dv_v, h.shape_v, &j->tr_b, &j->rs_b, &j->c_tr,
+                      &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
+    inverter_harmonics(j, &h, ws_b, &dk1, &dk2);
     const float h_tr = dk2 * j->tr,
                 h_rs = (j->s->sigma * j->s->ls_h * dk1 + (1.0f - j->s->sigma) * j->s->ls_h * dk2) / rs;
     j->tr_b += h_tr;
@@ -620,6 +625,7 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
       j->tr_b += fx->tr_b;
       j->rs_b += fx->rs_b;
     }
+    if (!(fabsf(ws_b) > 0.0f)) j->x_tr = j->x_rs = j->tr_b = j->rs_b = INFINITY;
     j->g_b = mism * j->op.z_ohm / rs;
     r->tr_bound_rel = (double)j->tr_b;
     r->rs_bound_rel = (double)(j->rs_b + j->g_b);
