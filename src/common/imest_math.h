@@ -37,7 +37,6 @@
 #define IMEST_2PI_F        ((float)IMEST_2PI_LIT)
 #define IMEST_PI_D         IMEST_PI_LIT
 #define IMEST_SQRT2_D      IMEST_SQRT2_LIT
-#define IMEST_SQRT2_F      ((float)IMEST_SQRT2_LIT)
 #define IMEST_SQRT2_3_F    ((float)IMEST_SQRT2_3_LIT)
 #define IMEST_SQRT3_2_F    ((float)IMEST_SQRT3_2_LIT)
 #define IMEST_HALF_SQRT3_F ((float)IMEST_HALF_SQRT3_LIT)

@@ -68,13 +68,6 @@ void imest__bg_window_sums(const imest_window_t *w, double m, double fs, bg_sums
   const float cross = (float)(w->sum[IMEST_ACC_ROT] + w->blk[IMEST_ACC_ROT]);
   st->slip_rate = (r44 > 0.0f) ? cross / r44 : 0.0f;
   st->u_ms = (float)(w->sum[IMEST_ACC_UU] + w->blk[IMEST_ACC_UU]) / n;
-  /* The speed's spread from sums the fit has anyway (docs/METHOD.md §2.2, §13.1): W4.W6 = n^2 w^2
-   * |i|^2 and W6.W6 = (n^2 w'^2 + n^4 w^4) |i|^2, so with c the |i|^2-weighted mean of n^2 w^2,
-   * W6.W6 / W4.W4 - c^2 = n^2 E[w'^2] + n^4 Var(w^2) >= 4 c n^2 Var(w) to first order in the
-   * spread. The w'^2 term (and the encoder's noise in it) only makes the figure larger. */
-  const float c = r44 > 0.0f ? (float)out->rw[3][5] / r44 : 0.0f;
-  const float v = r44 > 0.0f ? (float)out->rw[5][5] / r44 - c * c : 0.0f;
-  st->swing_rad_s = c > 0.0f ? sqrtf(fmaxf(v, 0.0f) / (4.0f * c)) : 0.0f;
 }
 
 /* Centring vector c0 (7-column form) for a given K1, K2 (docs/METHOD.md §2, §10),

@@ -15,15 +15,13 @@
  * the window's sums, rounded once (relative 6e-8), and i_rms_a goes out as
  * that float32 value (the ISR's sums carry no more). */
 typedef struct {
-  float i_rms_a;     /* rms |i| (alpha/beta amplitude) */
-  float w_mean;      /* mean mechanical speed [rad/s] */
-  float slip_rate;   /* mean rotation rate of the rotor-frame current [rad/s]:
+  float i_rms_a;   /* rms |i| (alpha/beta amplitude) */
+  float w_mean;    /* mean mechanical speed [rad/s] */
+  float slip_rate; /* mean rotation rate of the rotor-frame current [rad/s]:
                       the slip frequency in steady state */
-  float u_ms;        /* mean square of u_alpha [V^2] */
-  float dw_rad_s;    /* the speed's change inside the window through the angle observer [rad/s]
+  float u_ms;      /* mean square of u_alpha [V^2] */
+  float dw_rad_s;  /* the speed's change inside the window through the angle observer [rad/s]
                       (bg_transient.c; set by the task) */
-  float swing_rad_s; /* the electrical speed's rms spread in the window [rad/s], an upper bound
-                        (bg_window.c): the slip's swing at a steady stator frequency */
 } bg_window_stats_t;
 
 /* One window's ISR sums -> full 8x8 float64 sums (undoes the centring and
