@@ -618,7 +618,7 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
     if (j->w->flags & IMEST_WFLAG_SWING) {
       const float p = (float)sm->rw[3][5], q = (float)sm->rw[5][5];
       const float peak = sqrtf(fabsf(q * r2 - p * p) / (2.0f * p * r2));
-      ws_b = ws * fmaxf(1.0f - peak / fabsf(ws), 0.0f);
+      ws_b = ws * BG_FMAXF(1.0f - peak / fabsf(ws), 0.0f);
     }
     systematic_bounds(j->s, j->w, &j->op, ws_b, j->tr, rs, dv_v, h.shape_v, &j->tr_b, &j->rs_b, &j->c_tr,
                       &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
