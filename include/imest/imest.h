@@ -154,7 +154,8 @@ typedef enum {
    *  constants are known to */
   IMEST_REASON_CONSTANTS_UNCERTAIN = 28,
   /** a load or speed step inside the window, seen through the angle observer, alone moves T_R (or
-   *  R_S) by more than its tolerance: a transient; the next steady window is estimated again */
+   *  R_S) by more than its tolerance, or the rotor swung at a steady mean through zero slip (a V/f
+   *  drive's hunting): a transient; the next steady window is estimated again */
   IMEST_REASON_TRANSIENT = 29
 } imest_reason_t;
 
@@ -310,8 +311,8 @@ typedef struct {
    *  that window and the next (src/estimator/isr/isr_angle.h). A rotor whose speed swings inside
    *  the observer's band (a V/f drive's hunting: 11 kW, 2 us dead time, 30 Hz, 25 % load, 5 % of
    *  the speed at 12 Hz) otherwise reads the observer's lag as R_S: +65 % -> +2.5 % with 16384
-   *  counts given, as with the observer off; such a window (a swing at a steady mean speed) is
-   *  published `transient`. 1024 counts on the paper motor keep the observer's gain (R_S +0.2 %,
+   *  counts given, as with the observer off; such a window (a swing at a steady mean speed) gets
+   *  its bounds at the least slip the swing visits, `transient` where that reaches zero. 1024 counts on the paper motor keep the observer's gain (R_S +0.2 %,
    *  off +7 %). (default 0: unknown, the observer as configured; below 2^24) */
   float encoder_counts_per_rev;
   /** cut-off [Hz] of a first-order high-pass applied alike to the alpha/beta voltages and currents

@@ -69,7 +69,8 @@ typedef struct {
  *  observer was engaged in the window (its angle and speed used, src/estimator/isr/isr_angle.h). */
 #define IMEST_WFLAG_OBSERVER 0x10000u
 /** ... the rotor swung at a steady mean speed: the angle observer's correction exceeded one encoder
- *  count (a V/f drive's hunting), so the steady-state bounds do not hold: `transient`. */
+ *  count (a V/f drive's hunting), so the steady-state bounds are taken at the least slip the swing
+ *  visits (bg_validity.c, bounds()): `transient` where it reaches zero. */
 #define IMEST_WFLAG_SWING    0x20000u
 
 /** Butterworth-3 as a first-order and a second-order section (transposed DF-II).

@@ -221,9 +221,8 @@ static void systematic_bounds(const imest_t *s, const imest_window_t *w, const o
  * i_a + i_b + i_c is the sensors' error), as the complex pattern E = sum_x
  * eps_x e^(-j 2 pi x / 3) of the per-phase gain errors: |E| (0 with two
  * sensors, where the third is computed and the zero sequence is exactly 0). */
-static float gain_mismatch(const imest_window_t *w, const bg_sums_t *sm)
+static float gain_mismatch(const imest_window_t *w, float s2)
 {
-  const float s2 = (float)sm->rw[3][3];
   if (!(s2 > 0.0f)) return 0.0f;
   const float ca = (float)(w->sum[IMEST_ACC_I0A] + w->blk[IMEST_ACC_I0A]);
   const float cb = (float)(w->sum[IMEST_ACC_I0B] + w->blk[IMEST_ACC_I0B]);
@@ -410,13 +409,10 @@ static inline int tr_constants_uncertain(judge_t *j)
   return j->tr_judged && !(j->c_tr <= j->s->tr_tolerance);
 }
 /* tr_tolerance: a load or speed step inside the window alone (judged where
- * T_R's bound is); or a rotor that swung at a steady mean (IMEST_WFLAG_SWING):
- * the steady-state bounds do not cover it (measured, the 4 kW motor hunting
- * at 30 Hz, 25 % load, 2 us, the inverter model 20 % high: T_R +1.4 % within
- * its bound) */
+ * T_R's bound is), or a swing that reaches zero slip (bounds()) */
 static inline int tr_transient(judge_t *j)
 {
-  return j->tr_judged && (!(j->x_tr <= j->s->tr_tolerance) || (j->w->flags & IMEST_WFLAG_SWING) != 0u);
+  return j->tr_judged && !(j->x_tr <= j->s->tr_tolerance);
 }
 /* tr_tolerance */
 static inline int tr_uncertain(judge_t *j)
@@ -428,10 +424,11 @@ static inline int rs_gain_mismatch(judge_t *j)
 {
   return !(j->rs_b + j->g_b <= j->s->rs_tolerance) && j->g_b > j->rs_b;
 }
-/* rs_tolerance: a load or speed step inside the window alone */
+/* rs_tolerance: a load or speed step inside the window alone, or a swing that
+ * reaches zero slip */
 static inline int rs_transient(judge_t *j)
 {
-  return !(j->x_rs <= j->s->rs_tolerance) || (j->w->flags & IMEST_WFLAG_SWING) != 0u;
+  return !(j->x_rs <= j->s->rs_tolerance);
 }
 /* rs_tolerance, ls_uncertainty, sigma_uncertainty: the constants' share alone */
 static inline int rs_constants_uncertain(judge_t *j)
@@ -593,7 +590,8 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
 static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int have)
 {
   imest_result_t *r = j->r;
-  const float mism = gain_mismatch(j->w, sm);
+  const float r2 = (float)sm->rw[3][3]; /* sum |i|^2 */
+  const float mism = gain_mismatch(j->w, r2);
   if (mism > GAIN_MISMATCH_FLAG) r->flags |= IMEST_FLAG_GAIN_MISMATCH;
   j->tr_b = INFINITY;
   j->rs_b = INFINITY;
@@ -607,9 +605,24 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
     inv_share_t h;
     float dk1, dk2;
     const float dv_v = voltage_uncertainty(j->s, j->w, &j->op, &h);
-    systematic_bounds(j->s, j->w, &j->op, j->st->slip_rate, j->tr, rs, dv_v, h.shape_v, &j->tr_b, &j->rs_b,
-                      &j->c_tr, &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
-    inverter_harmonics(j, &h, j->st->slip_rate, &dk1, &dk2);
+    /* A swing at a steady mean (IMEST_WFLAG_SWING): the steady-state bounds hold at one slip, and
+     * the window visits slips down to |w_s| less the peak of the electrical speed's swing. They are
+     * taken there, where the fit's leverage of every error on T_R is largest (|dZ/dT_R| ~ w_s for
+     * a < 1); a swing that reaches zero slip has no bound (transient, below). The swing from the
+     * sums (docs/METHOD.md §2.2, §13.1): p = W4.W6 = n^2 w^2 |i|^2, q = W6.W6 = (n^2 w'^2 + n^4 w^4)
+     * |i|^2, r = W4.W4 = |i|^2 give q r - p^2 = r^2 (n^2 E[w'^2] + n^4 Var(w^2)), Var(w^2) = 4 E[w]^2
+     * Var(w) to first order, so (q r - p^2) / (2 p r) >= 2 n^2 Var(w), a sinusoid's peak squared
+     * (the w'^2 term and the encoder's noise in it only add; a negative figure is rounding). */
+    const float ws = j->st->slip_rate;
+    float ws_b = ws;
+    if (j->w->flags & IMEST_WFLAG_SWING) {
+      const float p = (float)sm->rw[3][5], q = (float)sm->rw[5][5];
+      const float peak = sqrtf(fabsf(q * r2 - p * p) / (2.0f * p * r2));
+      ws_b = ws * BG_FMAXF(1.0f - peak / fabsf(ws), 0.0f);
+    }
+    systematic_bounds(j->s, j->w, &j->op, ws_b, j->tr, rs, dv_v, h.shape_v, &j->tr_b, &j->rs_b, &j->c_tr,
+                      &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
+    inverter_harmonics(j, &h, ws_b, &dk1, &dk2);
     const float h_tr = dk2 * j->tr,
                 h_rs = (j->s->sigma * j->s->ls_h * dk1 + (1.0f - j->s->sigma) * j->s->ls_h * dk2) / rs;
     j->tr_b += h_tr;
@@ -620,6 +633,7 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
       j->tr_b += fx->tr_b;
       j->rs_b += fx->rs_b;
     }
+    if (ws_b == 0.0f) j->x_tr = j->rs_b = INFINITY; /* the swing reached zero slip */
     j->g_b = mism * j->op.z_ohm / rs;
     r->tr_bound_rel = (double)j->tr_b;
     r->rs_bound_rel = (double)(j->rs_b + j->g_b);
