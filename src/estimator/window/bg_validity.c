@@ -633,7 +633,8 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
       j->tr_b += fx->tr_b;
       j->rs_b += fx->rs_b;
     }
-    if (ws_b == 0.0f) j->x_tr = j->rs_b = INFINITY; /* the swing reached zero slip */
+    if (ws_b == 0.0f) /* the swing reached zero slip: no bound, T_R and R_S transient */
+      j->x_tr = j->tr_b = j->x_rs = j->rs_b = INFINITY;
     j->g_b = mism * j->op.z_ohm / rs;
     r->tr_bound_rel = (double)j->tr_b;
     r->rs_bound_rel = (double)(j->rs_b + j->g_b);
