@@ -312,8 +312,9 @@ typedef struct {
    *  the observer's band (a V/f drive's hunting: 11 kW, 2 us dead time, 30 Hz, 25 % load, 5 % of
    *  the speed at 12 Hz) otherwise reads the observer's lag as R_S: +65 % -> +2.5 % with 16384
    *  counts given, as with the observer off; such a window (a swing at a steady mean speed) gets
-   *  its bounds at the least slip the swing visits, `transient` where that reaches zero. 1024 counts on the paper motor keep the observer's gain (R_S +0.2 %,
-   *  off +7 %). (default 0: unknown, the observer as configured; below 2^24) */
+   *  its bounds at the least slip the swing visits, `transient` where that reaches zero. 1024
+   *  counts on the paper motor keep the observer's gain (R_S +0.2 %, off +7 %). (default 0:
+   *  unknown, the observer as configured; below 2^24) */
   float encoder_counts_per_rev;
   /** cut-off [Hz] of a first-order high-pass applied alike to the alpha/beta voltages and currents
    *  before the rotation: it removes sensor offsets (default 1; 0 = off). Applied to both, it

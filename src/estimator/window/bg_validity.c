@@ -615,10 +615,12 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
      * (the w'^2 term and the encoder's noise in it only add; a negative figure is rounding). */
     const float ws = j->st->slip_rate;
     float ws_b = ws;
+    int through_zero = 0;
     if (j->w->flags & IMEST_WFLAG_SWING) {
       const float p = (float)sm->rw[3][5], q = (float)sm->rw[5][5];
       const float peak = sqrtf(fabsf(q * r2 - p * p) / (2.0f * p * r2));
       ws_b = ws * BG_FMAXF(1.0f - peak / fabsf(ws), 0.0f);
+      through_zero = ws_b == 0.0f;
     }
     systematic_bounds(j->s, j->w, &j->op, ws_b, j->tr, rs, dv_v, h.shape_v, &j->tr_b, &j->rs_b, &j->c_tr,
                       &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
@@ -633,7 +635,7 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
       j->tr_b += fx->tr_b;
       j->rs_b += fx->rs_b;
     }
-    if (ws_b == 0.0f) /* the swing reached zero slip: no bound, T_R and R_S transient */
+    if (through_zero) /* the swing reached zero slip: no bound, T_R and R_S transient */
       j->x_tr = j->tr_b = j->x_rs = j->rs_b = INFINITY;
     j->g_b = mism * j->op.z_ohm / rs;
     r->tr_bound_rel = (double)j->tr_b;
