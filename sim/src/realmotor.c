@@ -31,12 +31,6 @@ static double pow6(double x)
   return x2 * x2 * x2;
 }
 
-/* i_m(x) for the magnitude x = |psi_m| */
-static double im_of(const imsim_real_t *rm, double x)
-{
-  return x / rm->lm0_h * (1.0 + rm->sat_a * pow6(x / rm->psi_n_wb));
-}
-
 double ims_rm_lm_static(const imsim_real_t *rm, double x)
 {
   return rm->lm0_h / (1.0 + rm->sat_a * pow6(x / rm->psi_n_wb));
@@ -169,6 +163,13 @@ int ims_rm_derive(const imsim_config_t *c, imsim_real_t *rm, char *err, size_t e
     g += (1.0 + 7.0 * rm->sat_a * pow6(1.3)) / rm->lm0_h;
     rm->h_max_s = fmin(rm->h_max_s, FE_HMAX / (rm->rfe_ohm * g));
   }
+  rm->inv_lls = 1.0 / rm->lls_h;
+  rm->inv_l1 = 1.0 / rm->l1_h;
+  rm->inv_l2 = rm->dc ? 1.0 / rm->l2_h : 0.0;
+  rm->inv_lm0 = 1.0 / rm->lm0_h;
+  rm->inv_psi_n = 1.0 / rm->psi_n_wb;
+  rm->g_node = rm->inv_lls + rm->inv_l1 + rm->inv_l2 + rm->inv_lm0;
+  rm->sat_k = rm->sat_a * rm->inv_lm0 * pow6(rm->inv_psi_n);
   rm->on = true;
   return 0;
 }
@@ -185,34 +186,31 @@ static void currents(const imsim_real_t *rm, const cpx fl[4], rm_cur_t *o)
   if (rm->fe) {
     psim = fl[3];
   } else {
-    double g = 1.0 / rm->lls_h + 1.0 / rm->l1_h;
-    cpx sum = cadd(cscale(fl[0], 1.0 / rm->lls_h), cscale(fl[1], 1.0 / rm->l1_h));
-    if (rm->dc) {
-      g += 1.0 / rm->l2_h;
-      sum = cadd(sum, cscale(fl[2], 1.0 / rm->l2_h));
-    }
+    cpx sum = cadd(cscale(fl[0], rm->inv_lls), cscale(fl[1], rm->inv_l1));
+    if (rm->dc) sum = cadd(sum, cscale(fl[2], rm->inv_l2));
+    /* g_node x + sat_k x^7 = |sum|: from above the root (the linear solution) Newton descends
+       monotonically, the curve being convex */
     const double sa = sqrt(cabs2(sum));
-    double x = sa / (g + 1.0 / rm->lm0_h); /* above the root: Newton descends monotonically */
+    double x = sa / rm->g_node;
     if (rm->sat_a > 0.0) {
       for (int it = 0; it < 60; ++it) {
-        const double r6 = pow6(x / rm->psi_n_wb);
-        const double f = g * x + x / rm->lm0_h * (1.0 + rm->sat_a * r6) - sa;
-        const double df = g + (1.0 + 7.0 * rm->sat_a * r6) / rm->lm0_h;
-        const double dx = f / df;
+        const double k6 = rm->sat_k * pow6(x);
+        const double dx = (x * (rm->g_node + k6) - sa) / (rm->g_node + 7.0 * k6);
         x -= dx;
-        if (fabs(dx) <= 1e-15 * x) break;
+        if (fabs(dx) <= 1e-9 * x) break;
       }
     }
     psim = sa > 0.0 ? cscale(sum, x / sa) : cx(0.0, 0.0);
   }
   o->psim = psim;
   const cpx mpsim = cscale(psim, -1.0);
-  o->is = cscale(cadd(fl[0], mpsim), 1.0 / rm->lls_h);
-  o->i1 = cscale(cadd(fl[1], mpsim), 1.0 / rm->l1_h);
-  o->i2 = rm->dc ? cscale(cadd(fl[2], mpsim), 1.0 / rm->l2_h) : cx(0.0, 0.0);
+  o->is = cscale(cadd(fl[0], mpsim), rm->inv_lls);
+  o->i1 = cscale(cadd(fl[1], mpsim), rm->inv_l1);
+  o->i2 = rm->dc ? cscale(cadd(fl[2], mpsim), rm->inv_l2) : cx(0.0, 0.0);
   if (rm->fe) {
-    const double x = sqrt(cabs2(psim));
-    const double ks = x > 0.0 ? im_of(rm, x) / x : 1.0 / rm->lm0_h;
+    /* i_m / |psi_m| from |psi_m|^2: no square root */
+    const double u2 = cabs2(psim) * rm->inv_psi_n * rm->inv_psi_n;
+    const double ks = rm->inv_lm0 * (1.0 + rm->sat_a * u2 * u2 * u2);
     o->ife = cadd(cadd(o->is, o->i1), cadd(o->i2, cscale(psim, -ks)));
   } else {
     o->ife = cx(0.0, 0.0);

@@ -252,6 +252,10 @@ typedef struct {
   double rfe_ohm;                    /* iron-loss resistance (fe)                               */
   double r1_ohm, l1_h, r2_ohm, l2_h; /* cold cage branches (single cage: r1 = R_R, l1 = L_lr) */
   double f_n_hz, h_max_s;
+  /* reciprocals for the per-step currents (set once by the derivation; a division costs as
+     much as the rest of a Newton step): 1/L_ls, 1/L_1, 1/L_2, 1/L_m0, the sum of 1/L over the
+     branches and the magnetising node, and the curve's x^7 coefficient a / (L_m0 psi_n^6) */
+  double inv_lls, inv_l1, inv_l2, inv_lm0, inv_psi_n, g_node, sat_k;
   imsim_cpx_t fl[4]; /* psi_S, psi_R1, psi_R2, psi_m (psi_m a state with R_fe only) */
   imsim_cpx_t psi_m_prev;
   double e_fe_j;      /* iron-loss energy integrated with the flux states (fe) */
