@@ -189,7 +189,8 @@ static void currents(const imsim_real_t *rm, const cpx fl[4], rm_cur_t *o)
     cpx sum = cadd(cscale(fl[0], rm->inv_lls), cscale(fl[1], rm->inv_l1));
     if (rm->dc) sum = cadd(sum, cscale(fl[2], rm->inv_l2));
     /* g_node x + sat_k x^7 = |sum|: from above the root (the linear solution) Newton descends
-       monotonically, the curve being convex */
+       monotonically, the curve being convex. Its error after a step dx is below
+       3 dx^2 / x (f''/2f' <= 3/x for this curve), so a step of 1e-9 x leaves < 1e-17 x */
     const double sa = sqrt(cabs2(sum));
     double x = sa / rm->g_node;
     if (rm->sat_a > 0.0) {
