@@ -1,0 +1,3 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+// The translation unit that builds GoogleTest's precompiled header (test/CMakeLists.txt).
+#include <gtest/gtest.h>
