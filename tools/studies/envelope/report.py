@@ -306,6 +306,9 @@ REAL_HEAD = ["| family | windows | T_R valid | T_R valid, within 2 % | T_R valid
 
 # The families the goals are read over (the real-motor effects; the linear ones are controls).
 REAL_CONTROLS = ("real_linear", "real_fw_linear")
+# the input column of the real-motor families' table
+INPUT_LABEL = {"duty_inv": "duty cycle, 2 µs dead time + drops, model given",
+               "phase_inv": "phase voltage measured on that inverter (800 Hz anti-alias filter)"}
 
 
 def real_goals(fam, rows):
@@ -359,7 +362,7 @@ def render_real(fam, rows, table, meta):
         if f in fam:
             eff = (eff + " --supply ifoc").strip() if f in points.IFOC_FAMILIES else eff
             L.append(f"| {f} | `{eff or '(linear motor)'}` | "
-                     f"{'duty cycle, 2 µs dead time + drops, model given' if inp == 'duty_inv' else 'phase voltage'} |")
+                     f"{INPUT_LABEL.get(inp, 'phase voltage')} |")
     goals = real_goals(fam, rows)
     if goals:
         L.append("\n## Goals (over every family but the linear controls " +

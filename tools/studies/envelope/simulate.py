@@ -52,6 +52,8 @@ def sim_args(p, duration_s):
         a += ["--adc-bits", "16"]
     if p["input"] == "duty_inv":
         a += inverter_flags(points.INVERTER)
+    elif p["input"] == "phase_inv":  # the measured voltage carries the dead time (--vmeas aa)
+        a += inverter_flags(points.INVERTER) + ["--vmeas", "aa", "--aa-hz", f"{points.AA_HZ:g}"]
     elif p["input"] == "sine":  # a later --supply overrides the motor's PWM drive
         a += ["--supply", "sine", "--timing", "ideal"]
     if p.get("family") in points.IFOC_FAMILIES:  # the speed loop holds the point's speed
@@ -99,6 +101,10 @@ def replay_args(p, extra=()):
         # the phase voltage of the simulated drive is the volt-seconds of the sample period
         # that just ended: half a sample behind the currents
         a += ["--u-delay", f"{0.5 / FS_HZ:.9g}"]
+    elif p["input"] == "phase_inv":
+        # the instantaneous phase voltages through the anti-alias filter (on the currents too),
+        # which the estimator models on the angle
+        a += ["--aa-hz", f"{points.AA_HZ:g}"]
     elif p["input"] == "sine":
         # the sine supply's voltage is its value at the sample instant: no delay, no staircase
         a += ["--voltage-kind", "smooth"]
