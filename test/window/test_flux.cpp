@@ -339,9 +339,9 @@ TEST(FluxCorrection, CurveIsReadAtTheMagnetisingCurrent)
   EXPECT_NEAR(x.r.ls_window_h / lw - 1.0, 0.0, 1e-4);
   EXPECT_NEAR(x.r.rs_ohm / x.rs_true - 1.0, 0.0, 2e-3)
       << "the fit's R_S was off by " << x.rs_fit / x.rs_true - 1.0;
-  // a motor with its leakage split 0.3 : 0.7 or 0.7 : 0.3 (the split the terminals cannot see):
-  // its L_w and R_S within what the stage states
-  for (double share : {0.3, 0.7}) {
+  // a motor with the rotor's share of the leakage 0.6 or 0.7 (IEEE 112's designs B and C; the
+  // split the terminals cannot see): its T_R and R_S within what the stage states
+  for (double share : {0.6, 0.7}) {
     SCOPED_TRACE(share);
     const double lws = motor_on_curve(c, i_amp, a, share);
     Window y = make_window(c, lws, 0.13, a, i_amp);
