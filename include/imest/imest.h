@@ -376,8 +376,9 @@ typedef struct {
    * test at several voltages (the reactive power over |i|^2 w_e at each, or the no-load windows'
    * ls_noload_h): L_S against the magnetising current. In a window where the steady-state picture
    * holds (slip frequency x T_R x sigma below 1, as for tr_uncertain) the estimate is moved to
-   * L_S at the window's flux-producing current i_d = |i| / sqrt(1 + (slip frequency x T_R)^2),
-   * with sigma L_S held (saturation moves the main flux, not the leakage), and the curve's
+   * L_S at the window's magnetising current |i_m| = i_d |1 + j a L_lr / L_R|, i_d = |i| /
+   * sqrt(1 + a^2), a = slip frequency x T_R, |i| the motor's (the ISR's high-pass and delay
+   * undone), the leakage split equally, with sigma L_S held (saturation moves the main flux, not the leakage), and the curve's
    * uncertainty enters tr_bound_rel and rs_bound_rel. ls_h stays what the solve uses, and what the
    * no-load check compares with when there is no curve. */
   /** the curve's magnetising currents [A], alpha/beta amplitude (sqrt 3 x the phase rms, the unit
