@@ -130,15 +130,18 @@ static float sign_error(const imest_inverter_t *v, float dead, float a)
 
 /* The dead time's harmonics a deep-bar rotor sees (docs/METHOD.md §18.1): the duty input's own
  * model and bus; measured phase voltages: the configured model and bus (inverter_vdc_v), nothing
- * from a smooth source (voltage_kind: no inverter), unknown (INFINITY) without either. */
+ * from a smooth source (voltage_kind: no inverter), unknown (INFINITY) without either. The
+ * harmonics are taken as a square wave's, 1 / |k| of the fundamental, which bound those of any
+ * smoothing of the sign near the zero crossings (a positive kernel only lowers them): the shape
+ * floor is not needed here, only the model's numbers' uncertainty (the truth up to 1 / (1 - u)). */
 static float rotor_hf_share(const imest_t *s, const imest_window_t *w, float a)
 {
   if (!(s->rotor_hf_rr_ratio > 0.0f)) return 0.0f;
   if (!w->duty_input && s->voltage_smooth) return 0.0f;
   const imest_inverter_t *v = &s->inverter;
   const float vdc = w->duty_input ? (float)w->vdc_v : s->inverter_vdc_v;
-  const float u = BG_FMAXF(v->uncertainty, SHAPE_FLOOR);
-  if (v->uncertainty < 0.0f || !(vdc > 0.0f) || !(u < 1.0f)) return INFINITY;
+  const float u = v->uncertainty;
+  if (!(u >= 0.0f && u < 1.0f) || !(vdc > 0.0f)) return INFINITY;
   return sign_error(v, v->dead_time_s * s->pwm_hz * vdc, a) / (1.0f - u);
 }
 
