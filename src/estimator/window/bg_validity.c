@@ -560,24 +560,13 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
   *hk2 = 0.0f;
   const int model = h->sign_v > 0.0f, hf = h->hf_v > 0.0f;
   if (!model && !hf) return;
-  if (model && !(h->u < 1.0f)) {
-    *dk1 = INFINITY;
-    *dk2 = INFINITY;
-  }
-  if (hf && !isfinite(h->hf_v)) {
-    *hk1 = INFINITY;
-    *hk2 = INFINITY;
-  }
-  if (!(isfinite(*dk1) && isfinite(*hk1))) return;
   const float h11 = (float)r->hessian[0][0], h12 = (float)r->hessian[0][1], h22 = (float)r->hessian[1][1];
   const float det = h11 * h22 - h12 * h12;
-  if (!(h11 > 0.0f && det > 0.0f) || !isfinite(det)) {
-    *dk1 = model ? INFINITY : 0.0f;
-    *dk2 = *dk1;
-    *hk1 = hf ? INFINITY : 0.0f;
-    *hk2 = *hk1;
-    return;
-  }
+  /* infinite where H is not positive definite, or the harmonics are not bounded */
+  const int pd = h11 > 0.0f && det > 0.0f && isfinite(det);
+  if (model && !(pd && h->u < 1.0f)) *dk1 = *dk2 = INFINITY;
+  if (hf && !(pd && isfinite(h->hf_v))) *hk1 = *hk2 = INFINITY;
+  if (!(isfinite(*dk1) && isfinite(*hk1))) return;
   const float we = j->op.we, k2 = 1.0f / j->tr, nw = we - slip_rate, m = (float)s->m;
   const float b0 = (float)s->bw.b0, kb = b0 / (1.0f - b0); /* tan(pi f_c / f_s) of the first section */
   const float wq = 2.0f * (float)s->fs * kb;
@@ -601,25 +590,19 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
       bg_impedance_t zk;
       imest__bg_impedance(k * we, wk, s->ls_h, s->sigma, j->tr, j->rs, &zk);
       float zr = zk.zr, zi = zk.zi;
-      float cr = 0.0f, ci = 0.0f; /* the rotor's deviation eps_k = 1 - Z_k / Z_k,double */
       if (hf) {
         /* the rotor branch R_R' rho, rho = 1 + (rr ratio - 1) x^2 / (1 + j x) (1 at slip frequency;
          * rr ratio R_R' and the leakage (1 - sigma ratio) sigma L_S lower at high frequency):
-         * Z = R_S + j w L_S (sigma + (1 - sigma) / (1 + j a / rho)), a = w_k T_R */
-        const float xh = wk * tau, xx = xh * xh, dh = 1.0f + xx;
-        const float rhr = 1.0f + rm1 * xx / dh, rhi = -rm1 * xx * xh / dh, rn = rhr * rhr + rhi * rhi;
-        const float a = wk * j->tr, qr = a * rhr / rn, qi = -a * rhi / rn; /* a / rho */
-        const float br = 1.0f - qi, bi = qr, bb = br * br + bi * bi;       /* 1 + j a / rho */
-        const float wl = k * we * s->ls_h * (1.0f - sg);
-        const float dr = j->rs + wl * bi / bb, di = k * we * s->ls_h * sg + wl * br / bb;
-        const float dd2 = dr * dr + di * di;
-        if (!(dd2 > 0.0f)) continue;
-        /* eps = (Z_d - Z) / Z_d */
-        const float nr = dr - zr, ni = di - zi;
-        cr = (nr * dr + ni * di) / dd2;
-        ci = (ni * dr - nr * di) / dd2;
-        zr = dr; /* the data's current is the double cage's */
-        zi = di;
+         * Z = R_S + j w L_S (sigma + (1 - sigma) / (1 + j a / rho)), a = w_k T_R, with
+         * 1 / (1 + j a / rho) = N / (N + j a (1 + j x)), N = 1 + (rr ratio - 1) x^2 + j x. The data's
+         * current is the double cage's */
+        const float xh = wk * tau, a = wk * j->tr;
+        const float nr = 1.0f + rm1 * xh * xh, dr = nr - a * xh, di = xh + a,
+                    inv = 1.0f / (dr * dr + di * di);
+        const float lr = (nr * dr + xh * di) * inv, li = (xh * dr - nr * di) * inv;
+        const float wl = k * we * s->ls_h;
+        zr = j->rs - wl * (1.0f - sg) * li;
+        zi = wl * (sg + (1.0f - sg) * lr);
       }
       const float zz = zr * zr + zi * zi;
       if (!(zz > 0.0f)) continue;
@@ -641,6 +624,8 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
          * Re(eps y*) |K2 + j w_k|^2 and Re(eps t), each harmonic's move summed in magnitude
          * (their phases are the rotor's, which the one-pole description does not pin) */
         const float wh = ehh / ((1.0f + x3 * x3) * k * k); /* G^2 |E_k|^2 / (sigma L_S) */
+        /* the rotor's deviation eps_k = 1 - Z_k / Z_k,double = 1 - Z_k y */
+        const float cr = 1.0f - (zk.zr * yr - zk.zi * yi), ci = -(zk.zr * yi + zk.zi * yr);
         const float u1 = wh * dd * (cr * yr + ci * yi), u2 = wh * (cr * tr_ - ci * (wk * pr - k2 * pi));
         a1 += fabsf(h22 * u1 - h12 * u2);
         a2 += fabsf(h11 * u2 - h12 * u1);
