@@ -659,7 +659,9 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r);
 
 /**
  * Fill an estimator config from a result: pole_pairs, ls_h, sigma, rs_nominal_ohm, tr_nominal_s
- * and inverter (with i_band_a and uncertainty) - each only if the result holds it (sigma not with
+ * and inverter (with i_band_a and uncertainty, and the bus in inverter_vdc_v), with IMEST_COMM_FLAG_ROTOR_HF
+ * and IMEST_COMM_FLAG_SIGMA_SLIP the rotor at high frequency (rotor_hf_rr_ratio = rr_hf_ohm / rr_slip_ohm,
+ * rotor_hf_sigma_ratio = sigma_ls_hf_h / sigma_ls_slip_h) - each only if the result holds it (sigma not with
  * IMEST_COMM_FLAG_ROTOR_HF unless IMEST_COMM_FLAG_SIGMA_SLIP: the config's stays, with its stated sigma_uncertainty, and
  * imest_config_check() names it if unset) - and, with ls_h and sigma, ls_uncertainty and
  * sigma_uncertainty by the rule above; the magnetising curve (ls_curve_points, ls_curve_i_a,
