@@ -372,6 +372,30 @@ typedef struct {
    *  whose R_S lies outside what heating explains (0.7 .. 1.9 x this) is constants_mismatch */
   float rs_nominal_ohm;
 
+  /* The rotor at high rotor frequency (deep bars, a double cage; docs/METHOD.md §18.1). The
+   * inverter's dead time has the 5th, 7th ... harmonics, which drive the rotor near a slip of 1
+   * (about 6 f_e in the rotor frame); a deep-bar rotor answers them with another impedance than
+   * the single cage the fit assumes, and the fit reads the difference as T_R and R_S. Described
+   * by one pole: the rotor branch's resistance rises from R_R' (at slip frequency) to
+   * rotor_hf_rr_ratio x R_R' and the leakage falls from sigma L_S to rotor_hf_sigma_ratio x
+   * sigma L_S, with the time constant these two give (tau = (1 - sigma ratio) sigma L_S /
+   * ((rr ratio - 1) R_R')). imest_comm_apply() fills both where commissioning found such a rotor
+   * (IMEST_COMM_FLAG_ROTOR_HF: the square wave's R and sigma L_S at fs/8). The harmonics'
+   * first-order move of the fit (twice it) is added to tr_bound_rel and rs_bound_rel. */
+  /** the rotor's resistance at high rotor frequency over R_R' at slip frequency, above 1 (default
+   *  0: a single cage, the term is 0 and every output is as without these fields) */
+  float rotor_hf_rr_ratio;
+  /** sigma L_S at high rotor frequency over sigma L_S at slip frequency, in (0, 1] (read only with
+   *  rotor_hf_rr_ratio; default 0) */
+  float rotor_hf_sigma_ratio;
+  /** phase-voltage input with rotor_hf_rr_ratio: the DC bus [V] of the inverter the measured
+   *  voltages come from; with `inverter` it sizes the dead time's harmonics (t_d f_pwm V_dc plus
+   *  the drops). 0 (default): unknown, and with a PWM source (voltage_kind staircase) and a
+   *  deep-bar rotor T_R's bound is then infinite (tr_uncertain): give the bus and the inverter
+   *  model (commissioning fills both), or say the source is smooth (a line-fed motor: no
+   *  harmonics). The duty-cycle input has its own bus voltage */
+  float inverter_vdc_v;
+
   /* Main-flux saturation: L_S at the window's flux (docs/METHOD.md §18.5). The points of a no-load
    * test at several voltages (the reactive power over |i|^2 w_e at each, or the no-load windows'
    * ls_noload_h): L_S against the magnetising current. In a window where the steady-state picture

@@ -436,7 +436,15 @@ typedef struct {
    *  run spread_rel is at least |L_S - L_S standstill| / L_S: on a saturating motor T_R at rated
    *  flux differs from the standstill one by up to that) */
   imest_comm_value_t tr_s;
-  imest_comm_value_t rr_ohm;          /**< rotor resistance referred to the stator, (1-sigma)L_S/T_R [ohm] */
+  imest_comm_value_t rr_ohm; /**< rotor resistance referred to the stator, (1-sigma)L_S/T_R [ohm] */
+  /** the rotor's resistance at the square wave's fs/8 [ohm]: its R less R_S's axis resistance (with
+   *  IMEST_COMM_FLAG_ROTOR_HF: over 3 x rr_ohm; imest_comm_apply() then describes the rotor at high
+   *  frequency by it and sigma_ls_hf_h, imest_config_t.rotor_hf_rr_ratio) */
+  imest_comm_value_t rr_hf_ohm;
+  /** R_R' at the slip-frequency test's lower tone [ohm] (the inverse-Gamma circuit's, stage 5): the
+   *  rotor resistance the high-frequency one is compared with (the flux tails' rr_ohm is far off
+   *  on a saturating motor: 0.80 against 1.30 on the 4 kW real motor) */
+  imest_comm_value_t rr_slip_ohm;
   imest_comm_value_t ls_standstill_h; /**< L_S from the standstill flux tails [H] */
   imest_inverter_t inverter;          /**< the inverter's voltage error model (incl. i_band_a, uncertainty) */
   imest_comm_value_t dead_time_s;     /**< dead time with its quality (also in inverter) */
@@ -651,15 +659,19 @@ int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r);
 
 /**
  * Fill an estimator config from a result: pole_pairs, ls_h, sigma, rs_nominal_ohm, tr_nominal_s
- * and inverter (with i_band_a and uncertainty) - each only if the result holds it (sigma not with
+ * and inverter (with i_band_a and uncertainty, and the bus in inverter_vdc_v), with IMEST_COMM_FLAG_ROTOR_HF
+ * and IMEST_COMM_FLAG_SIGMA_SLIP the rotor at high frequency (rotor_hf_rr_ratio = rr_hf_ohm / rr_slip_ohm,
+ * rotor_hf_sigma_ratio = sigma_ls_hf_h / sigma_ls_slip_h) - each only if the result holds it (sigma not with
  * IMEST_COMM_FLAG_ROTOR_HF unless IMEST_COMM_FLAG_SIGMA_SLIP: the config's stays, with its stated sigma_uncertainty, and
  * imest_config_check() names it if unset) - and, with ls_h and sigma, ls_uncertainty and
  * sigma_uncertainty by the rule above; the magnetising curve (ls_curve_points, ls_curve_i_a,
  * ls_curve_h) when the result has 2 or more points and the build follows L_S with the flux
  * (not with IMEST_WITH_FLUX=0). The sample rate, window and the other fields stay as they are;
  * set pwm_hz to the carrier.
- * @return the number of fields filled (0..7: the curve counts as one, the uncertainties are not
- *         counted), or
+ * @return the number of fields filled (0..8: the curve counts as one, the uncertainties are not
+ *         counted; the deep-bar rotor's description, rotor_hf_rr_ratio and rotor_hf_sigma_ratio
+ *         with IMEST_COMM_FLAG_ROTOR_HF and IMEST_COMM_FLAG_SIGMA_SLIP, as one; inverter_vdc_v
+ *         goes with the inverter), or
  * @retval IMEST_ERR_NULL  a pointer is NULL
  * @retval IMEST_ERR_ARG   the result is not valid (r->valid == 0): nothing filled
  */

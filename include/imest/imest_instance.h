@@ -154,7 +154,7 @@ typedef struct {
 #define IMEST_STAGE_DUTY_EDGES 8u /**< duty input: the switching-instant inverter model */
 
 /** Estimator instance. All fields are private; sizes are what the ISR needs.
- *  sizeof(imest_t) is 2000 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
+ *  sizeof(imest_t) is 2016 B on a Cortex-M4F and a Cortex-M7 (measured by tools/firmware-budget,
  *  fw/README.md) and on an x86-64 host too (every member is 32-bit: no pointers, no padding that
  *  differs); the test tools_documented_defaults checks this figure against the host's sizeof. */
 typedef struct {
@@ -213,6 +213,10 @@ typedef struct {
   float max_pe_k2_rel, max_ei, min_current_a, min_slip_ratio;
   float rs_tolerance, tr_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
   uint32_t tr_nominal_known;
+  /* the rotor at high rotor frequency (bg_validity.c, rotor_hf): 0 a single cage; the phase-voltage
+     input's bus [V] (0 unknown) and whether its source is smooth (voltage_kind) */
+  float rotor_hf_rr_ratio, rotor_hf_sigma_ratio, inverter_vdc_v;
+  uint32_t voltage_smooth;
   float transient_k; /* a speed step's share of T_R's bound per (rad/s of step / rad/s of slip)
                         through the angle observer's lag (0: no observer; bg_transient.c) */
   float ls_curve_i_a[IMEST_LS_CURVE_POINTS]; /* the magnetising curve as configured (bg_flux.c) */

@@ -71,6 +71,9 @@ enum { KIND_FLOAT = 0, KIND_INT = 1, KIND_UINT = 2, KIND_PWM_TIMING = 3, KIND_RE
   X(u_uncertainty_v, KIND_FLOAT)                                                                             \
   X(timing_uncertainty_s, KIND_FLOAT)                                                                        \
   X(rs_nominal_ohm, KIND_FLOAT)                                                                              \
+  X(rotor_hf_rr_ratio, KIND_FLOAT)                                                                           \
+  X(rotor_hf_sigma_ratio, KIND_FLOAT)                                                                        \
+  X(inverter_vdc_v, KIND_FLOAT)                                                                              \
   X(ls_curve_i_a[0], KIND_FLOAT)                                                                             \
   X(ls_curve_i_a[1], KIND_FLOAT)                                                                             \
   X(ls_curve_i_a[2], KIND_FLOAT)                                                                             \

@@ -152,7 +152,8 @@ int imest_comm_init(imest_comm_t *c, const imest_comm_config_t *cc)
   imest_comm_value_t *vals[] = {&c->res.rs_ohm,        &c->res.sigma_ls_h,      &c->res.tr_s,
                                 &c->res.rr_ohm,        &c->res.ls_standstill_h, &c->res.dead_time_s,
                                 &c->res.v_threshold_v, &c->res.dr_ohm,          &c->res.ls_h,
-                                &c->res.sigma,         &c->res.sigma_ls_hf_h,   &c->res.sigma_ls_slip_h};
+                                &c->res.sigma,         &c->res.sigma_ls_hf_h,   &c->res.sigma_ls_slip_h,
+                                &c->res.rr_hf_ohm,     &c->res.rr_slip_ohm};
   for (size_t v = 0; v < sizeof vals / sizeof vals[0]; ++v) {
     vals[v]->value = nanf_;
     vals[v]->std_rel = nanf_;

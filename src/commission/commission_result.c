@@ -97,6 +97,17 @@ int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)
   }
   if (r->inverter.uncertainty >= 0.0f) {
     cfg->inverter = r->inverter;
+    cfg->inverter_vdc_v = r->vdc_v; /* the bus for measured phase voltages' harmonics */
+    n++;
+  }
+  /* a deep-bar rotor at high frequency: the square wave's resistance and leakage against the
+     slip-frequency ones (one pole, imest_config_t.rotor_hf_rr_ratio) */
+  const float rr_ratio = r->rr_hf_ohm.value / r->rr_slip_ohm.value,
+              sl_ratio = r->sigma_ls_hf_h.value / r->sigma_ls_slip_h.value;
+  if ((r->flags & IMEST_COMM_FLAG_ROTOR_HF) && (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP) && rr_ratio > 1.0f &&
+      sl_ratio > 0.0f) {
+    cfg->rotor_hf_rr_ratio = rr_ratio;
+    cfg->rotor_hf_sigma_ratio = sl_ratio < 1.0f ? sl_ratio : 1.0f;
     n++;
   }
   /* the magnetising curve: the estimator follows L_S with the window's flux (bg_flux.c) */

@@ -62,6 +62,9 @@ void imest_config_default(imest_config_t *cfg)
   cfg->u_uncertainty_v = 0.0f;
   cfg->timing_uncertainty_s = 1.0e-6f;
   cfg->rs_nominal_ohm = 0.0f;
+  cfg->rotor_hf_rr_ratio = 0.0f; /* a single cage */
+  cfg->rotor_hf_sigma_ratio = 0.0f;
+  cfg->inverter_vdc_v = 0.0f;
   cfg->ls_curve_points = 0u; /* no magnetising curve (the points are zero) */
 }
 
@@ -144,6 +147,9 @@ static const check_t k_checks[] = {
     CHK(u_uncertainty_v, C_NONNEG, FS_NONE, LIM_NONE),
     CHK(timing_uncertainty_s, C_NONNEG, FS_NONE, LIM_NONE),
     CHK(rs_nominal_ohm, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(rotor_hf_rr_ratio, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(rotor_hf_sigma_ratio, C_NONNEG, FS_NONE, LIM_NONE),
+    CHK(inverter_vdc_v, C_NONNEG, FS_NONE, LIM_NONE),
 };
 #undef CHK
 #undef CODE
@@ -218,6 +224,11 @@ int imest_config_check(const imest_config_t *cfg, const char **field)
     bad = "inverter.dead_time_s";
   else if (!(cfg->timing_uncertainty_s * fs < 1.0f))
     bad = "timing_uncertainty_s";
+  else if (cfg->rotor_hf_rr_ratio != 0.0f && !(cfg->rotor_hf_rr_ratio > 1.0f))
+    bad = "rotor_hf_rr_ratio";
+  else if (cfg->rotor_hf_rr_ratio != 0.0f &&
+           !(cfg->rotor_hf_sigma_ratio > 0.0f && cfg->rotor_hf_sigma_ratio <= 1.0f))
+    bad = "rotor_hf_sigma_ratio";
   else
     bad = check_ls_curve(cfg);
   if (field) *field = bad;
@@ -437,6 +448,10 @@ static void init_background_constants(imest_t *s, const imest_config_t *cfg)
   s->u_uncertainty_v = cfg->u_uncertainty_v;
   s->timing_uncertainty_s = cfg->timing_uncertainty_s;
   s->rs_nominal_ohm = cfg->rs_nominal_ohm;
+  s->rotor_hf_rr_ratio = cfg->rotor_hf_rr_ratio;
+  s->rotor_hf_sigma_ratio = cfg->rotor_hf_sigma_ratio;
+  s->inverter_vdc_v = cfg->inverter_vdc_v;
+  s->voltage_smooth = cfg->voltage_kind == IMEST_VOLTAGE_SMOOTH;
   s->tr_nominal_known = cfg->tr_nominal_known != 0;
   s->ls_curve_points = cfg->ls_curve_points;
   for (unsigned int k = 0; IMEST_WITH_FLUX && k < IMEST_LS_CURVE_POINTS; ++k) {

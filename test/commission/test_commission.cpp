@@ -75,6 +75,21 @@ void expect_accurate(const comm_sim_out_t &out, double i_max)
 
 class CommissionMotor : public ::testing::TestWithParam<const char *> {};
 
+// A deep-bar rotor's description at high frequency as imest_comm_apply() fills it: the square
+// wave's rotor resistance over the tones' R_R' (the flag's threshold is 3 x the tails' R_R') and
+// its sigma*L_S over the slip-frequency one (the outer cage's leakage, about 44 % low), the bus.
+static void expect_rotor_hf(const imest_comm_result_t &r, const imest_config_t &cfg)
+{
+  EXPECT_FLOAT_EQ(cfg.rotor_hf_rr_ratio, r.rr_hf_ohm.value / r.rr_slip_ohm.value);
+  EXPECT_GT(cfg.rotor_hf_rr_ratio, 3.0f);
+  EXPECT_FLOAT_EQ(cfg.rotor_hf_sigma_ratio, r.sigma_ls_hf_h.value / r.sigma_ls_slip_h.value);
+  EXPECT_LT(cfg.rotor_hf_sigma_ratio, 0.7f);
+  EXPECT_GT(cfg.rotor_hf_sigma_ratio, 0.3f);
+  EXPECT_FLOAT_EQ(cfg.inverter_vdc_v, r.vdc_v);
+  const char *field = nullptr;
+  EXPECT_EQ(imest_config_check(&cfg, &field), IMEST_OK) << (field ? field : "");
+}
+
 TEST_P(CommissionMotor, ClosedLoopWithinTheIssuesAccuracy)
 {
   const comm_sim_opts_t o = opts(GetParam());
@@ -250,8 +265,9 @@ TEST_P(CommissionSaturating, LsAtRatedFluxAndTheCurveWithinTwoPercent)
     EXPECT_GE(r.sigma.spread_rel, std::fabs(rel(r.sigma.value, out.sigma)));
     imest_config_t cfg;
     imest_config_default(&cfg);
-    EXPECT_EQ(imest_comm_apply(&r, &cfg), 7); // sigma too, the curve copied
+    EXPECT_EQ(imest_comm_apply(&r, &cfg), 8); // sigma too, the curve copied, the rotor at fs/8
     EXPECT_FLOAT_EQ(cfg.sigma, r.sigma.value);
+    expect_rotor_hf(r, cfg);
     EXPECT_GT(cfg.sigma_uncertainty, std::fabs(rel(r.sigma.value, out.sigma)));
     EXPECT_LT(cfg.sigma_uncertainty, 0.03f);
     EXPECT_FLOAT_EQ(cfg.ls_h, r.ls_h.value);
@@ -320,8 +336,9 @@ TEST_P(CommissionDeepBar, SigmaAtSlipFrequencyWithinItsStatedUncertainty)
   // the config gets sigma, with an uncertainty that covers its error at 0 and at rated slip
   imest_config_t cfg;
   imest_config_default(&cfg);
-  EXPECT_EQ(imest_comm_apply(&r, &cfg), 7);
+  EXPECT_EQ(imest_comm_apply(&r, &cfg), 8); // with the rotor's description at fs/8
   EXPECT_FLOAT_EQ(cfg.sigma, r.sigma.value);
+  expect_rotor_hf(r, cfg);
   for (const double f : {0.0, f_sl}) {
     const double sigma_true = sigma_ls_at(f) / ls;
     EXPECT_GT(cfg.sigma_uncertainty, std::fabs(rel(cfg.sigma, sigma_true))) << "rotor at " << f << " Hz";

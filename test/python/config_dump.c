@@ -8,7 +8,7 @@
 
 #include "imest/imest.h"
 
-_Static_assert(sizeof(imest_config_t) == 55 * sizeof(float),
+_Static_assert(sizeof(imest_config_t) == 58 * sizeof(float),
                "imest_config_t changed: list the new field below");
 
 #define F(name) printf(#name " %a\n", (double)cfg.name)
@@ -59,6 +59,9 @@ int main(void)
   F(u_uncertainty_v);
   F(timing_uncertainty_s);
   F(rs_nominal_ohm);
+  F(rotor_hf_rr_ratio);
+  F(rotor_hf_sigma_ratio);
+  F(inverter_vdc_v);
   F(ls_curve_i_a[0]);
   F(ls_curve_i_a[1]);
   F(ls_curve_i_a[2]);

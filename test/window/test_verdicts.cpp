@@ -194,13 +194,18 @@ imest_result_t judge(Win &x)
                     std::isfinite(r.rs_ohm) && r.rs_ohm > 0.0;
   // the inverter model within u >= 1 of the truth bounds neither its error nor its harmonics
   const bool harm_known = !x.w.duty_input || x.s.inverter.uncertainty < 1.0f;
+  // a deep-bar rotor sees the inverter's harmonics with either input: unknown without the model
+  // (and, measured voltages from a PWM source, the bus)
+  const bool hf_known = !(x.s.rotor_hf_rr_ratio > 0.0f) || (!x.w.duty_input && x.s.voltage_smooth != 0u) ||
+                        (x.s.inverter.uncertainty >= 0.0f && x.s.inverter.uncertainty < 1.0f &&
+                         (x.w.duty_input ? x.w.vdc_v > 0.0 : x.s.inverter_vdc_v > 0.0f));
   if (have && x.st.slip_rate != 0.0) {
-    if (harm_known)
+    if (harm_known && hf_known)
       EXPECT_TRUE(std::isfinite(r.tr_bound_rel)) << r.tr_bound_rel;
     else
       EXPECT_EQ(r.tr_bound_rel, INFINITY) << r.tr_bound_rel;
     const bool volt_known = !x.w.duty_input || x.s.inverter.uncertainty >= 0.0f;
-    if (volt_known && harm_known)
+    if (volt_known && harm_known && hf_known)
       EXPECT_TRUE(std::isfinite(r.rs_bound_rel)) << r.rs_bound_rel;
     else
       EXPECT_EQ(r.rs_bound_rel, INFINITY) << "an unknown inverter error: no bound";
@@ -778,7 +783,53 @@ struct Bounds {
 // u moves q by G (K2 + j w_k) u E_k / (sigma L_S), the data's current is -E_k
 // / Z_k, and the minimiser moves by -H^-1 2 nreg sum Re(dq conj(dq/dK)). The
 // truth up to 1 / (1 - u) of the model. Relative moves of T_R and R_S.
-Bounds harmonic_share(const Scene &sc, const Win &x, double sign_v, double u)
+// The one-pole rotor of imest_config_t.rotor_hf_*: the impedance at k w_e and the rotor frequency
+// w_k, written as the inverse-Gamma circuit's magnetising branch in parallel with the rotor branch
+// R_R' rho w / w_k, rho = r - (r - 1) / (1 + j x) - j x (r - 1) (the leakage the single cage has in
+// sigma L_S taken out of the rotor's), x = w_k tau, tau = (1 - s) sigma L_S / ((r - 1) R_R').
+cplx double_cage_z(const Scene &sc, const Win &x, double w, double wk)
+{
+  const double ls = (double)sc.cfg.ls_h, sg = (double)sc.cfg.sigma, tr = x.r.tr_s, rs = x.r.rs_ohm;
+  const double r = (double)sc.cfg.rotor_hf_rr_ratio, s = (double)sc.cfg.rotor_hf_sigma_ratio;
+  const double lm = (1.0 - sg) * ls, rr = lm / tr, tau = (1.0 - s) * sg * ls / ((r - 1.0) * rr);
+  const cplx jx(0.0, wk * tau);
+  const cplx rho = r - (r - 1.0) / (1.0 + jx) - jx * (r - 1.0);
+  const cplx zm(0.0, w * lm), zr = rr * rho * (w / wk);
+  return rs + cplx(0.0, w * sg * ls) + zm * zr / (zm + zr);
+}
+
+// The deep-bar rotor's share: the single cage's voltage for the data's current (i_k = -E_k / Z_d)
+// is off by eps_k E_k, eps_k = 1 - Z_k / Z_d; each harmonic's move of (K1, K2) in magnitude, twice.
+Bounds rotor_hf_replica(const Scene &sc, const Win &x, double hf_v)
+{
+  const double ls = (double)sc.cfg.ls_h, sg = (double)sc.cfg.sigma, we = x.we, ws = x.st.slip_rate;
+  const double tr = x.r.tr_s, rs = x.r.rs_ohm, k2 = 1.0 / tr, nw = we - ws, mm = (1.0 - sg) / sg;
+  const double fs = (double)sc.cfg.fs_hz, wq = 2.0 * fs * std::tan(M_PI * (double)sc.cfg.filter_hz / fs);
+  const double e1 = std::sqrt(1.5) * 4.0 / M_PI * hf_v;
+  const double h11 = x.r.hessian[0][0], h12 = x.r.hessian[0][1], h22 = x.r.hessian[1][1];
+  const double det = h11 * h22 - h12 * h12;
+  double m1 = 0.0, m2 = 0.0;
+  for (int p = 1; p <= 16; ++p)
+    for (int k : {-(6 * p - 1), 6 * p + 1}) {
+      const double wk = (k - 1) * we + ws, gain2 = 1.0 / (1.0 + std::pow(wk / wq, 6));
+      const cplx zk = rs + cplx(0.0, k * we * ls) * cplx(1.0, sg * wk * tr) / cplx(1.0, wk * tr);
+      const cplx zd = double_cage_z(sc, x, k * we, wk), eps = 1.0 - zk / zd;
+      const double ek = e1 / std::abs(k);
+      const cplx ik = -ek / zd, dq = cplx(k2, wk) * eps * ek / (sg * ls);
+      const cplx dk1 = cplx(k2, wk) * ik;
+      const cplx zfl = mm * k2 * cplx(k2, -nw) * ik / cplx(k2, wk);
+      const cplx dk2 = zfl - mm * cplx(2.0 * k2, -nw) * ik;
+      const double g1 = 2.0 * x.w.nreg * gain2 * (dq * std::conj(dk1)).real();
+      const double g2 = 2.0 * x.w.nreg * gain2 * (dq * std::conj(dk2)).real();
+      m1 += std::abs(h22 * g1 - h12 * g2) / det;
+      m2 += std::abs(h11 * g2 - h12 * g1) / det;
+    }
+  m1 *= 2.0;
+  m2 *= 2.0;
+  return {m2 * tr, (sg * ls * m1 + (1.0 - sg) * ls * m2) / rs};
+}
+
+Bounds harmonic_share(const Scene &sc, const Win &x, double sign_v, double u, bool deep_bar = false)
 {
   const double ls = (double)sc.cfg.ls_h, sg = (double)sc.cfg.sigma, we = x.we, ws = x.st.slip_rate;
   const double tr = x.r.tr_s, rs = x.r.rs_ohm, k2 = 1.0 / tr, nw = we - ws, mm = (1.0 - sg) / sg;
@@ -788,7 +839,8 @@ Bounds harmonic_share(const Scene &sc, const Win &x, double sign_v, double u)
   for (int p = 1; p <= 16; ++p)
     for (int k : {-(6 * p - 1), 6 * p + 1}) {
       const double wk = (k - 1) * we + ws, gain2 = 1.0 / (1.0 + std::pow(wk / wq, 6));
-      const cplx zk = rs + cplx(0.0, k * we * ls) * cplx(1.0, sg * wk * tr) / cplx(1.0, wk * tr);
+      const cplx zk = deep_bar ? double_cage_z(sc, x, k * we, wk)
+                               : rs + cplx(0.0, k * we * ls) * cplx(1.0, sg * wk * tr) / cplx(1.0, wk * tr);
       const double ek = e1 / std::abs(k);
       const cplx ik = -ek / zk, dq = cplx(k2, wk) * u * ek / (sg * ls);
       const cplx dk1 = cplx(k2, wk) * ik;
@@ -1325,6 +1377,112 @@ TEST(VerdictDuty, TrUncertainFromInverterHarmonics)
   EXPECT_TR_REASON(r, IMEST_REASON_TR_UNCERTAIN);
   Win m = build(sc); // the same window from measured voltages: T_R valid
   EXPECT_EQ(judge(m).tr_reason, IMEST_REASON_NONE);
+}
+
+// ---------------------------------------------------------------------------
+// A deep-bar rotor (rotor_hf_*): the inverter's harmonics through the fit with the rotor's
+// deviation from the single cage (docs/METHOD.md §18.1), with either voltage input
+// ---------------------------------------------------------------------------
+
+// the 4 kW real motor's commissioning: R 5.66 x R_R', sigma L_S 0.557 x at fs/8
+Scene deep_bar_scene(float uncertainty)
+{
+  Scene sc = duty_scene(uncertainty);
+  sc.cfg.rotor_hf_rr_ratio = 5.66f;
+  sc.cfg.rotor_hf_sigma_ratio = 0.557f;
+  sc.cfg.inverter_vdc_v = 300.0f;
+  return sc;
+}
+
+TEST(VerdictRotorHf, MeasuredVoltagesFollowTheReplica)
+{
+  // the amplitude takes the model's own uncertainty, not the shape floor (a square wave's harmonics)
+  for (double a : {0.3, 0.6, 1.5}) {
+    for (float u : {0.0f, 0.05f, 0.4f}) {
+      SCOPED_TRACE(testing::Message() << "a " << a << " u " << u);
+      Scene s0 = duty_scene(u), s1 = deep_bar_scene(u);
+      s0.a = s1.a = a;
+      Win x0 = build(s0), x1 = build(s1); // measured voltages: the model's own term is not there
+      const imest_result_t r0 = judge(x0), r1 = judge(x1);
+      x1.w.vdc_v = 300.0f; // sign_error() reads the bus from the window
+      const Bounds h = rotor_hf_replica(s1, x1, sign_error(s1, x1) / (1.0 - (double)u));
+      EXPECT_GT(h.tr, 1e-4);
+      EXPECT_NEAR(r1.tr_bound_rel - r0.tr_bound_rel, h.tr, 2e-3 * h.tr);
+      EXPECT_NEAR(r1.rs_bound_rel - r0.rs_bound_rel, h.rs, 2e-3 * h.rs);
+    }
+  }
+}
+
+TEST(VerdictRotorHf, DutyInputFollowsTheReplica)
+{
+  // the model's own term now sees the double cage's current, the rotor's term beside it
+  for (float u : {0.0f, 0.05f, 0.4f}) {
+    SCOPED_TRACE(u);
+    const Scene sc = deep_bar_scene(u);
+    Win x = duty_window(sc);
+    const imest_result_t r = judge(x);
+    const double e = inverter_error(sc, x), uh = std::fmax((double)u, 0.2);
+    const Bounds b = expected_bounds(sc, x, true, (double)u * e, uh * e);
+    const Bounds h = harmonic_share(sc, x, sign_error(sc, x), uh, true);
+    const Bounds d = rotor_hf_replica(sc, x, sign_error(sc, x) / (1.0 - (double)u));
+    const double tr = b.tr + h.tr + d.tr, rs = b.rs + h.rs + d.rs;
+    EXPECT_NEAR(r.tr_bound_rel, tr, 2e-3 * tr);
+    EXPECT_NEAR(r.rs_bound_rel, rs, 2e-3 * rs);
+  }
+}
+
+TEST(VerdictRotorHf, SingleCageIsUnchanged)
+{
+  // a ratio of 0 is the single cage: bounds bit-identical to a config without the fields
+  Scene s0 = duty_scene(0.05f), s1 = duty_scene(0.05f);
+  s1.cfg.rotor_hf_sigma_ratio = 0.5f; // read only with a ratio
+  s1.cfg.inverter_vdc_v = 300.0f;
+  Win m0 = build(s0), m1 = build(s1), d0 = duty_window(s0), d1 = duty_window(s1);
+  EXPECT_EQ(judge(m1).tr_bound_rel, judge(m0).tr_bound_rel);
+  EXPECT_EQ(judge(m1).rs_bound_rel, judge(m0).rs_bound_rel);
+  EXPECT_EQ(judge(d1).tr_bound_rel, judge(d0).tr_bound_rel);
+  EXPECT_EQ(judge(d1).rs_bound_rel, judge(d0).rs_bound_rel);
+}
+
+TEST(VerdictRotorHf, UnknownInverterForMeasuredVoltagesIsNoBound)
+{
+  // a deep-bar rotor on a PWM source whose inverter (or bus) is not given: T_R is not bounded
+  Scene sc = deep_bar_scene(-1.0f);
+  EXPECT_TR_REASON(judge(sc), IMEST_REASON_TR_UNCERTAIN);
+  EXPECT_EQ(judge(sc).tr_bound_rel, INFINITY);
+  sc = deep_bar_scene(0.05f);
+  sc.cfg.inverter_vdc_v = 0.0f;
+  EXPECT_EQ(judge(sc).tr_bound_rel, INFINITY);
+  // a smooth source (a line-fed motor) has no inverter harmonics: the term is 0
+  sc.cfg.voltage_kind = IMEST_VOLTAGE_SMOOTH;
+  Scene s0 = paper_scene();
+  s0.cfg.voltage_kind = IMEST_VOLTAGE_SMOOTH;
+  EXPECT_EQ(judge(sc).tr_bound_rel, judge(s0).tr_bound_rel);
+  // an exact ideal inverter (all zero, known): no harmonics either
+  Scene si = paper_scene();
+  si.cfg.rotor_hf_rr_ratio = 5.66f;
+  si.cfg.rotor_hf_sigma_ratio = 0.557f;
+  si.cfg.inverter.uncertainty = 0.0f;
+  si.cfg.inverter_vdc_v = 300.0f;
+  EXPECT_EQ(judge(si).tr_bound_rel, judge(paper_scene()).tr_bound_rel);
+}
+
+TEST(VerdictRotorHf, ConfigRanges)
+{
+  imest_config_t c = paper_scene().cfg;
+  const char *f = nullptr;
+  c.rotor_hf_rr_ratio = 1.0f;
+  c.rotor_hf_sigma_ratio = 0.5f;
+  EXPECT_EQ(imest_config_check(&c, &f), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(f, "rotor_hf_rr_ratio");
+  c.rotor_hf_rr_ratio = 5.0f;
+  c.rotor_hf_sigma_ratio = 0.0f;
+  EXPECT_EQ(imest_config_check(&c, &f), IMEST_ERR_CONFIG);
+  EXPECT_STREQ(f, "rotor_hf_sigma_ratio");
+  c.rotor_hf_sigma_ratio = 1.5f;
+  EXPECT_EQ(imest_config_check(&c, &f), IMEST_ERR_CONFIG);
+  c.rotor_hf_sigma_ratio = 1.0f;
+  EXPECT_EQ(imest_config_check(&c, &f), IMEST_OK);
 }
 
 // A speed step inside the window through the angle observer (bg_transient.c):

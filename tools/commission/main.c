@@ -102,14 +102,20 @@ static int print_apply_args(const imest_comm_result_t *r)
     printf(" --sigma %.9g --sigma-uncertainty %.9g", (double)cfg.sigma, (double)cfg.sigma_uncertainty);
   printf(" --ls-uncertainty %.9g --rs %.9g", (double)cfg.ls_uncertainty, (double)cfg.rs_nominal_ohm);
   if (cfg.tr_nominal_s != tr0) printf(" --tr-nominal %.9g", (double)cfg.tr_nominal_s);
+  if (cfg.rotor_hf_rr_ratio > 0.0f)
+    printf(" --rotor-hf-rr %.9g --rotor-hf-sigma %.9g", (double)cfg.rotor_hf_rr_ratio,
+           (double)cfg.rotor_hf_sigma_ratio);
   for (unsigned int k = 0; k < cfg.ls_curve_points; ++k)
     printf("%s%.9g:%.9g", k == 0u ? " --ls-curve " : ",", (double)cfg.ls_curve_i_a[k],
            (double)cfg.ls_curve_h[k]);
   const imest_inverter_t *v = &cfg.inverter;
   printf("\n--dead-time %.9g --v-switch %.9g --r-switch %.9g --v-diode %.9g --r-diode %.9g --i-band %.9g "
-         "--inverter-uncertainty %.9g\n",
+         "--inverter-uncertainty %.9g",
          (double)v->dead_time_s, (double)v->v_switch_v, (double)v->r_switch_ohm, (double)v->v_diode_v,
          (double)v->r_diode_ohm, (double)v->i_band_a, (double)v->uncertainty);
+  /* the bus only matters to measured phase voltages with a deep-bar rotor (the duty input has its own) */
+  if (cfg.rotor_hf_rr_ratio > 0.0f) printf(" --inverter-vdc %.9g", (double)cfg.inverter_vdc_v);
+  printf("\n");
   return 0;
 }
 
@@ -178,6 +184,8 @@ static void print_result(const imest_comm_result_t *r, const imest_comm_axis_fit
   printf("slip_test_hz %.9g\n", (double)r->slip_test_hz);
   print_value("tr_s", &r->tr_s);
   print_value("rr_ohm", &r->rr_ohm);
+  print_value("rr_hf_ohm", &r->rr_hf_ohm);
+  print_value("rr_slip_ohm", &r->rr_slip_ohm);
   print_value("ls_standstill_h", &r->ls_standstill_h);
   const imest_inverter_t *inv = &r->inverter;
   printf("inverter.dead_time_s %.9g\ninverter.v_switch_v %.9g\ninverter.v_diode_v %.9g\n"

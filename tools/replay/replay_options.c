@@ -123,6 +123,16 @@ static void usage(FILE *o)
              "                      relative (default 0.02)\n"
              "  --timing-uncertainty S  uncertainty of the voltage/current alignment after\n"
              "                      --pwm-timing and --u-delay [s] (default 1e-6)\n"
+             "  --rotor-hf-rr X     a deep-bar (double-cage) rotor: its resistance at high rotor\n"
+             "                      frequency over R_R' (commissioning's square wave at fs/8;\n"
+             "                      default 0: a single cage); the inverter's harmonics' move\n"
+             "                      of the fit then enters the T_R and R_S bounds\n"
+             "  --rotor-hf-sigma X  its sigma L_S at high rotor frequency over sigma L_S, in\n"
+             "                      (0, 1] (default 0; needed with --rotor-hf-rr)\n"
+             "  --inverter-vdc V    measured phase voltages with --rotor-hf-rr: the DC bus of\n"
+             "                      their inverter [V], with --dead-time .. --inverter-\n"
+             "                      uncertainty (allowed then) the harmonics' size (default 0:\n"
+             "                      unknown, T_R not valid unless --voltage-kind smooth)\n"
              "  --speed-limit RAD_S an angle step faster than this is an encoder fault\n"
              "                      (default min(3000, 2 x fs); below 3 x fs, i.e. less than\n"
              "                      pi per sample)\n"
@@ -207,6 +217,9 @@ static const struct {
     {"--tr-tolerance", "tr_tolerance", offsetof(imest_config_t, tr_tolerance), FOR_ANY},
     {"--timing-uncertainty", "timing_uncertainty_s", offsetof(imest_config_t, timing_uncertainty_s), FOR_ANY},
     {"--pwm-hz", "pwm_hz", offsetof(imest_config_t, pwm_hz), FOR_ANY},
+    {"--rotor-hf-rr", "rotor_hf_rr_ratio", offsetof(imest_config_t, rotor_hf_rr_ratio), FOR_ANY},
+    {"--rotor-hf-sigma", "rotor_hf_sigma_ratio", offsetof(imest_config_t, rotor_hf_sigma_ratio), FOR_ANY},
+    {"--inverter-vdc", "inverter_vdc_v", offsetof(imest_config_t, inverter_vdc_v), FOR_ANY},
     {"--inverter-uncertainty", "inverter.uncertainty", offsetof(imest_config_t, inverter.uncertainty),
      FOR_DUTY},
     {"--dead-time", "inverter.dead_time_s", offsetof(imest_config_t, inverter.dead_time_s), FOR_INVERTER},
@@ -286,8 +299,10 @@ static int check_input_options(const replay_opts_t *o, int pwm_timing_given)
     return -1;
   }
   const char *opt = pwm_timing_given ? "--pwm-timing" : NULL;
+  /* a deep-bar rotor: the inverter the measured voltages come from sizes its harmonics */
+  const int hf = o->cfg.rotor_hf_rr_ratio > 0.0f;
   for (size_t k = 0; opt == NULL && k < N_NUMERIC; ++k)
-    if (k_numeric[k].use != FOR_ANY && ((o->given >> k) & 1u)) opt = k_numeric[k].name;
+    if (k_numeric[k].use != FOR_ANY && !hf && ((o->given >> k) & 1u)) opt = k_numeric[k].name;
   if (opt == NULL) return -1;
   fprintf(stderr,
           "%s: %s describes the duty-cycle input: give --voltage duty with the columns "

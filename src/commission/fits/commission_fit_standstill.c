@@ -91,7 +91,8 @@ static float slip_sigma_ls(const float s[IMEST_COMM_NSUM], float w1, float ts, f
 typedef struct {
   float rm, rsp, slm, slsp, taum, tausp, lmm, lmsp, tdm, tdsp, vthm, vthsp, drm, drsp;
   float r_var, sl_var, td_var, vth_var, dr_var, tau_var, rms2;
-  float sfm, sfsp, sf_d, sf_lm; /* slip-frequency sigma*L_S: mean, spread, mean correction; L_M */
+  float sfm, sfsp, sf_d, sf_lm,
+      sf_rr; /* R_R' at the lower tone; slip-frequency sigma*L_S: mean, spread, mean correction; L_M */
 } axes_t;
 
 /* Sensor gains relative to their mean (three sensors only), and the correction factor each
@@ -122,7 +123,7 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
   const imest_comm_axis_fit_t *f = c->fit;
   float rk[3], slk[3], tauk[3], lmk[3], tdk[3], vthk[3], drk[3], sfk[3];
   a->r_var = a->sl_var = a->td_var = a->vth_var = a->dr_var = a->tau_var = a->rms2 = 0.0f;
-  a->sf_d = a->sf_lm = 0.0f;
+  a->sf_d = a->sf_lm = a->sf_rr = 0.0f;
   for (int k = 0; k < 3; ++k) {
     rk[k] = f[k].r_ohm * corr[k];
     slk[k] = f[k].slsig_h * corr[k];
@@ -142,6 +143,7 @@ static void combine_axes(imest_comm_t *c, const float corr[3], axes_t *a)
     const float sk =
         slip_sigma_ls(c->blk[CM_SLIP_BLK + (uint32_t)k].s, c->sl_w, c->ts_s, f[k].r_ohm, rp, &lm);
     a->sf_lm += lm * corr[k] / 3.0f;
+    a->sf_rr += rp[0] * corr[k] / 3.0f;
     const float dl = sk - f[k].slsig_h, dr = f[k].rhf_ohm - f[k].r_ohm - rp[0];
     const float drise = (rp[1] - rp[0]) / (float)(CM_SLIP_M * CM_SLIP_M - 1u);
     const float fall = dl > 0.0f && dr > 0.0f && drise > 0.0f ? dl / dr * drise : 0.0f;
@@ -259,8 +261,10 @@ void imest__cm_fit_standstill(imest_comm_t *c)
   /* the rotor's resistance at the square wave's frequency against R_R' from the flux tails: far
      above it (deep bars, a double cage; single cages stay below 2.2 x, saturated or not), the
      square wave's sigma*L_S is the rotor's high-frequency leakage, below the slip-frequency one */
-  if ((f[0].rhf_ohm + f[1].rhf_ohm + f[2].rhf_ohm) / 3.0f - a.rm > 3.0f * a.lmm / a.taum)
-    r->flags |= IMEST_COMM_FLAG_ROTOR_HF;
+  const float rr_hf = (f[0].rhf_ohm + f[1].rhf_ohm + f[2].rhf_ohm) / 3.0f - a.rm;
+  if (rr_hf > 3.0f * a.lmm / a.taum) r->flags |= IMEST_COMM_FLAG_ROTOR_HF;
+  set_value(&r->rr_hf_ohm, rr_hf, NAN, NAN);
+  set_value(&r->rr_slip_ohm, a.sf_rr > 0.0f ? a.sf_rr : NAN, NAN, NAN);
   const float rs = report_values(c, &a);
   inverter_model(c, &a);
   if (a.rsp > 0.03f || a.slsp > 0.03f) r->flags |= IMEST_COMM_FLAG_AXIS_SPREAD;

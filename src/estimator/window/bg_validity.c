@@ -116,7 +116,34 @@ typedef struct {
                     thresholds' (V_sw0 + V_d0)/2, and the switch-diode differences' half; not the
                     slopes' mean (r_sw + r_d)/2 i, a resistance */
   float u;       /* its relative uncertainty for the harmonics, at least SHAPE_FLOOR */
+  /* a deep-bar rotor (rotor_hf_rr_ratio): the largest sign-type error the inverter's harmonics can
+     have, the model's up to 1 / (1 - u) [V] (either input; INFINITY: not known, 0: no term) */
+  float hf_v;
 } inv_share_t;
+
+/* The sign-type part of an inverter model's error, the part with harmonics [V] (inv_share_t.sign_v). */
+static float sign_error(const imest_inverter_t *v, float dead, float a)
+{
+  return fabsf(dead + 0.5f * (v->v_switch_v + v->v_diode_v)) +
+         0.5f * (fabsf(v->v_switch_v - v->v_diode_v) + fabsf(v->r_switch_ohm - v->r_diode_ohm) * a);
+}
+
+/* The dead time's harmonics a deep-bar rotor sees (docs/METHOD.md §18.1): the duty input's own
+ * model and bus; measured phase voltages: the configured model and bus (inverter_vdc_v), nothing
+ * from a smooth source (voltage_kind: no inverter), unknown (INFINITY) without either. The
+ * harmonics are taken as a square wave's, 1 / |k| of the fundamental, which bound those of any
+ * smoothing of the sign near the zero crossings (a positive kernel only lowers them): the shape
+ * floor is not needed here, only the model's numbers' uncertainty (the truth up to 1 / (1 - u)). */
+static float rotor_hf_share(const imest_t *s, const imest_window_t *w, float a)
+{
+  if (!(s->rotor_hf_rr_ratio > 0.0f)) return 0.0f;
+  if (!w->duty_input && s->voltage_smooth) return 0.0f;
+  const imest_inverter_t *v = &s->inverter;
+  const float vdc = w->duty_input ? (float)w->vdc_v : s->inverter_vdc_v;
+  const float u = v->uncertainty;
+  if (!(u >= 0.0f && u < 1.0f) || !(vdc > 0.0f)) return INFINITY;
+  return sign_error(v, v->dead_time_s * s->pwm_hz * vdc, a) / (1.0f - u);
+}
 
 /* The uncertainty of the voltage's fundamental per phase [V]: the inverter
  * model's error at this current times its relative uncertainty (duty input),
@@ -128,17 +155,17 @@ static float voltage_uncertainty(const imest_t *s, const imest_window_t *w, cons
   h->shape_v = 0.0f;
   h->sign_v = 0.0f;
   h->u = 0.0f;
+  const float a = op->i_pk;
+  h->hf_v = rotor_hf_share(s, w, a);
   if (!w->duty_input) return s->u_uncertainty_v;
   const imest_inverter_t *v = &s->inverter;
   if (v->uncertainty < 0.0f) return -1.0f;
-  const float a = op->i_pk;
   const float dead = v->dead_time_s * s->pwm_hz * (float)w->vdc_v;
   const float e = fabsf(dead + v->v_diode_v + v->r_diode_ohm * a +
                         0.5f * ((v->v_switch_v - v->v_diode_v) + (v->r_switch_ohm - v->r_diode_ohm) * a));
   const float dv = v->uncertainty * e;
   h->shape_v = BG_FMAXF(dv, SHAPE_FLOOR * e);
-  h->sign_v = fabsf(dead + 0.5f * (v->v_switch_v + v->v_diode_v)) +
-              0.5f * (fabsf(v->v_switch_v - v->v_diode_v) + fabsf(v->r_switch_ohm - v->r_diode_ohm) * a);
+  h->sign_v = sign_error(v, dead, a);
   h->u = BG_FMAXF(v->uncertainty, SHAPE_FLOOR);
   return dv;
 }
@@ -495,9 +522,11 @@ static int rs_verdict(judge_t *j)
  * (the 5th and 7th ... the 95th and 97th): the filter and the 1/k of a sign
  * wave leave the rest below 1e-4 of the first pair's share wherever the
  * 5th passes the filter (the share grows as 1/k^2 G^2, G^2 ~ (w_c / w)^6). */
-#define HARMONIC_PAIRS 16
+#define HARMONIC_PAIRS  16
 /* power-invariant alpha/beta: a balanced set of phase amplitude A has |.| = sqrt(3/2) A */
-#define AB_PER_PHASE_F 1.2247449f
+#define AB_PER_PHASE_F  1.2247449f
+/* the deep-bar rotor's share: twice its first-order move (inverter_harmonics) */
+#define ROTOR_HF_MARGIN 2.0f
 
 /* How far the inverter model's uncertain share can move K1 and K2 through
  * its harmonics (docs/METHOD.md §18.1), derived per window from the fit
@@ -521,34 +550,37 @@ static int rs_verdict(judge_t *j)
  * harmonics aliased beyond f_s / 2. *dk1, *dk2: the largest moves [1/s];
  * infinite where H is not positive definite. */
 static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float slip_rate, float *dk1,
-                               float *dk2)
+                               float *dk2, float *hk1, float *hk2)
 {
   const imest_t *s = j->s;
   const imest_result_t *r = j->r;
   *dk1 = 0.0f;
   *dk2 = 0.0f;
-  if (!(h->sign_v > 0.0f)) return;
-  if (!(h->u < 1.0f)) {
-    *dk1 = INFINITY;
-    *dk2 = INFINITY;
-    return;
-  }
+  *hk1 = 0.0f;
+  *hk2 = 0.0f;
+  const int model = h->sign_v > 0.0f, hf = h->hf_v > 0.0f;
+  if (!model && !hf) return;
   const float h11 = (float)r->hessian[0][0], h12 = (float)r->hessian[0][1], h22 = (float)r->hessian[1][1];
   const float det = h11 * h22 - h12 * h12;
-  if (!(h11 > 0.0f && det > 0.0f) || !isfinite(det)) {
-    *dk1 = INFINITY;
-    *dk2 = INFINITY;
-    return;
-  }
+  /* infinite where H is not positive definite, or the harmonics are not bounded */
+  const int pd = h11 > 0.0f && det > 0.0f && isfinite(det);
+  if (model && !(pd && h->u < 1.0f)) *dk1 = *dk2 = INFINITY;
+  if (hf && !(pd && isfinite(h->hf_v))) *hk1 = *hk2 = INFINITY;
+  if (!(isfinite(*dk1) && isfinite(*hk1))) return;
   const float we = j->op.we, k2 = 1.0f / j->tr, nw = we - slip_rate, m = (float)s->m;
   const float b0 = (float)s->bw.b0, kb = b0 / (1.0f - b0); /* tan(pi f_c / f_s) of the first section */
   const float wq = 2.0f * (float)s->fs * kb;
   const float lin = AB_PER_PHASE_F * FOUR_OVER_PI_F;
   /* eps |E_1|^2 / (sigma L_S). The model within u of the truth puts the truth up to 1 / (1 - u) of
    * the model's, and the model's error up to u / (1 - u) of it from the truth */
-  const float e1 = lin * h->sign_v / (1.0f - h->u);
+  const float e1 = model ? lin * h->sign_v / (1.0f - h->u) : 0.0f;
   const float ee = e1 * e1 * h->u * (float)s->inv_s;
-  float g1 = 0.0f, g2 = 0.0f;
+  /* the deep-bar rotor: |E_1|^2 / (sigma L_S) of the largest error (hf_v has the 1 / (1 - u)); its
+   * pole x = w_k tau, tau = (1 - sigma ratio) sigma T_R / ((rr ratio - 1) (1 - sigma)) */
+  const float eh = lin * h->hf_v, ehh = eh * eh * (float)s->inv_s;
+  const float sg = s->sigma, rm1 = s->rotor_hf_rr_ratio - 1.0f;
+  const float tau = hf ? (1.0f - s->rotor_hf_sigma_ratio) * sg * j->tr / (rm1 * (1.0f - sg)) : 0.0f;
+  float g1 = 0.0f, g2 = 0.0f, a1 = 0.0f, a2 = 0.0f;
   for (int p = 1; p <= HARMONIC_PAIRS; ++p) {
     for (int sgn = -1; sgn <= 1; sgn += 2) {
       const float k = (float)(6 * p + sgn) * (float)sgn; /* -5, 7, -11, 13 ... */
@@ -557,10 +589,25 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
       const float w2 = ee / ((1.0f + x3 * x3) * k * k); /* G^2 eps |E_k|^2 / (sigma L_S) */
       bg_impedance_t zk;
       imest__bg_impedance(k * we, wk, s->ls_h, s->sigma, j->tr, j->rs, &zk);
-      const float zz = zk.zr * zk.zr + zk.zi * zk.zi;
+      float zr = zk.zr, zi = zk.zi;
+      if (hf) {
+        /* the rotor branch R_R' rho, rho = 1 + (rr ratio - 1) x^2 / (1 + j x) (1 at slip frequency;
+         * rr ratio R_R' and the leakage (1 - sigma ratio) sigma L_S lower at high frequency):
+         * Z = R_S + j w L_S (sigma + (1 - sigma) / (1 + j a / rho)), a = w_k T_R, with
+         * 1 / (1 + j a / rho) = N / (N + j a (1 + j x)), N = 1 + (rr ratio - 1) x^2 + j x. The data's
+         * current is the double cage's */
+        const float xh = wk * tau, a = wk * j->tr;
+        const float nr = 1.0f + rm1 * xh * xh, dr = nr - a * xh, di = xh + a,
+                    inv = 1.0f / (dr * dr + di * di);
+        const float lr = (nr * dr + xh * di) * inv, li = (xh * dr - nr * di) * inv;
+        const float wl = k * we * s->ls_h;
+        zr = j->rs - wl * (1.0f - sg) * li;
+        zi = wl * (sg + (1.0f - sg) * lr);
+      }
+      const float zz = zr * zr + zi * zi;
       if (!(zz > 0.0f)) continue;
       /* y = 1 / Z_k: i_k = -E_k y */
-      const float yr = zk.zr / zz, yi = -zk.zi / zz;
+      const float yr = zr / zz, yi = -zi / zz;
       const float dd = k2 * k2 + wk * wk; /* |K2 + j w_k|^2 */
       /* dq/dK1 / (-E_k) = (K2 + j w_k) y; Re((K2 + j w_k) conj of it) = |K2 + j w_k|^2 Re y */
       g1 += w2 * dd * yr;
@@ -569,15 +616,33 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
       const float qr = (ar * k2 + ai * wk) / dd, qi = (ai * k2 - ar * wk) / dd; /* / (K2 + j w_k) */
       const float fr = qr - 2.0f * k2, fi = qi + nw;
       const float pr = m * (yr * fr - yi * fi), pi = m * (yr * fi + yi * fr); /* m y F */
-      /* Re((K2 + j w_k) conj(p)) */
-      g2 += w2 * (k2 * pr + wk * pi);
+      /* t = (K2 + j w_k) conj(p); Re t */
+      const float tr_ = k2 * pr + wk * pi;
+      g2 += w2 * tr_;
+      if (hf) {
+        /* the voltage the single cage would need for the data's current is off by eps_k E_k:
+         * Re(eps y*) |K2 + j w_k|^2 and Re(eps t), each harmonic's move summed in magnitude
+         * (their phases are the rotor's, which the one-pole description does not pin) */
+        const float wh = ehh / ((1.0f + x3 * x3) * k * k); /* G^2 |E_k|^2 / (sigma L_S) */
+        /* the rotor's deviation eps_k = 1 - Z_k / Z_k,double = 1 - Z_k y */
+        const float cr = 1.0f - (zk.zr * yr - zk.zi * yi), ci = -(zk.zr * yi + zk.zi * yr);
+        const float u1 = wh * dd * (cr * yr + ci * yi), u2 = wh * (cr * tr_ - ci * (wk * pr - k2 * pi));
+        a1 += fabsf(h22 * u1 - h12 * u2);
+        a2 += fabsf(h11 * u2 - h12 * u1);
+      }
     }
   }
   const float n2 = 2.0f * (float)j->w->nreg * (float)r->windows;
-  g1 *= n2;
-  g2 *= n2;
-  *dk1 = fabsf(h22 * g1 - h12 * g2) / det;
-  *dk2 = fabsf(h11 * g2 - h12 * g1) / det;
+  if (model) {
+    g1 *= n2;
+    g2 *= n2;
+    *dk1 = fabsf(h22 * g1 - h12 * g2) / det;
+    *dk2 = fabsf(h11 * g2 - h12 * g1) / det;
+  }
+  /* twice the first-order move, as the timing's (measured: 0.8 to 1.9 x it at rated load; at half
+   * load its sign is not the data's) */
+  *hk1 = ROTOR_HF_MARGIN * a1 * n2 / det;
+  *hk2 = ROTOR_HF_MARGIN * a2 * n2 / det;
 }
 
 /* The systematic bounds: T_R's (the staircase, the timing, the inverter
@@ -624,7 +689,10 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
     }
     systematic_bounds(j->s, j->w, &j->op, ws_b, j->tr, rs, dv_v, h.shape_v, &j->tr_b, &j->rs_b, &j->c_tr,
                       &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
-    inverter_harmonics(j, &h, ws_b, &dk1, &dk2);
+    float hk1, hk2;
+    inverter_harmonics(j, &h, ws_b, &dk1, &dk2, &hk1, &hk2);
+    dk1 += hk1;
+    dk2 += hk2;
     const float h_tr = dk2 * j->tr,
                 h_rs = (j->s->sigma * j->s->ls_h * dk1 + (1.0f - j->s->sigma) * j->s->ls_h * dk2) / rs;
     j->tr_b += h_tr;

@@ -101,10 +101,18 @@ def replay_args(p, extra=()):
         # the phase voltage of the simulated drive is the volt-seconds of the sample period
         # that just ended: half a sample behind the currents
         a += ["--u-delay", f"{0.5 / FS_HZ:.9g}"]
+        if "--rotor-hf-rr" in a:
+            # a deep-bar rotor: the simulated drive's inverter is ideal (no dead time, no drops),
+            # which the config says (its harmonics are 0); the bus is the motor's
+            a += inverter_flags(dict.fromkeys(points.INVERTER, 0.0)) + \
+                ["--inverter-vdc", f"{motor_of(p)['vdc']:g}"]
     elif p["input"] == "phase_inv":
         # the instantaneous phase voltages through the anti-alias filter (on the currents too),
         # which the estimator models on the angle
         a += ["--aa-hz", f"{points.AA_HZ:g}"]
+        if "--rotor-hf-rr" in a and c.get("inverter"):
+            # a deep-bar rotor: the commissioned inverter (and bus) size the dead time's harmonics
+            a += c["inverter"]
     elif p["input"] == "sine":
         # the sine supply's voltage is its value at the sample instant: no delay, no staircase
         a += ["--voltage-kind", "smooth"]
