@@ -5,8 +5,9 @@
 #include <stddef.h>
 
 #include "commission_internal.h"
-#include "estimator/window/bg_flux.h" /* IMEST_WITH_FLUX */
-#include "estimator/solve/bg_float.h" /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
+#include "estimator/window/bg_flux.h"     /* IMEST_WITH_FLUX */
+#include "estimator/window/bg_validity.h" /* IMEST_WITH_ROTOR_HF */
+#include "estimator/solve/bg_float.h"     /* BG_FMAXF...: no libm fmaxf on a core without VMAXNM */
 
 int imest_comm_result(const imest_comm_t *c, imest_comm_result_t *r)
 {
@@ -104,8 +105,8 @@ int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)
      slip-frequency ones (one pole, imest_config_t.rotor_hf_rr_ratio) */
   const float rr_ratio = r->rr_hf_ohm.value / r->rr_slip_ohm.value,
               sl_ratio = r->sigma_ls_hf_h.value / r->sigma_ls_slip_h.value;
-  if ((r->flags & IMEST_COMM_FLAG_ROTOR_HF) && (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP) && rr_ratio > 1.0f &&
-      sl_ratio > 0.0f) {
+  if (IMEST_WITH_ROTOR_HF && (r->flags & IMEST_COMM_FLAG_ROTOR_HF) &&
+      (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP) && rr_ratio > 1.0f && sl_ratio > 0.0f) {
     cfg->rotor_hf_rr_ratio = rr_ratio;
     cfg->rotor_hf_sigma_ratio = sl_ratio < 1.0f ? sl_ratio : 1.0f;
     n++;

@@ -5,6 +5,7 @@
 #include <stddef.h>
 
 #include "bg_flux.h"
+#include "bg_validity.h" /* IMEST_WITH_ROTOR_HF */
 #include "bg_noise.h"
 #include "bg_transient.h"
 #include "common/imest_handoff.h"
@@ -224,7 +225,7 @@ int imest_config_check(const imest_config_t *cfg, const char **field)
     bad = "inverter.dead_time_s";
   else if (!(cfg->timing_uncertainty_s * fs < 1.0f))
     bad = "timing_uncertainty_s";
-  else if (cfg->rotor_hf_rr_ratio != 0.0f && !(cfg->rotor_hf_rr_ratio > 1.0f))
+  else if (cfg->rotor_hf_rr_ratio != 0.0f && !(IMEST_WITH_ROTOR_HF && cfg->rotor_hf_rr_ratio > 1.0f))
     bad = "rotor_hf_rr_ratio";
   else if (cfg->rotor_hf_rr_ratio != 0.0f &&
            !(cfg->rotor_hf_sigma_ratio > 0.0f && cfg->rotor_hf_sigma_ratio <= 1.0f))

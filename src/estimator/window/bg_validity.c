@@ -136,7 +136,7 @@ static float sign_error(const imest_inverter_t *v, float dead, float a)
  * floor is not needed here, only the model's numbers' uncertainty (the truth up to 1 / (1 - u)). */
 static float rotor_hf_share(const imest_t *s, const imest_window_t *w, float a)
 {
-  if (!(s->rotor_hf_rr_ratio > 0.0f)) return 0.0f;
+  if (!IMEST_WITH_ROTOR_HF || !(s->rotor_hf_rr_ratio > 0.0f)) return 0.0f;
   if (!w->duty_input && s->voltage_smooth) return 0.0f;
   const imest_inverter_t *v = &s->inverter;
   const float vdc = w->duty_input ? (float)w->vdc_v : s->inverter_vdc_v;
@@ -558,7 +558,7 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
   *dk2 = 0.0f;
   *hk1 = 0.0f;
   *hk2 = 0.0f;
-  const int model = h->sign_v > 0.0f, hf = h->hf_v > 0.0f;
+  const int model = h->sign_v > 0.0f, hf = IMEST_WITH_ROTOR_HF && h->hf_v > 0.0f;
   if (!model && !hf) return;
   const float h11 = (float)r->hessian[0][0], h12 = (float)r->hessian[0][1], h22 = (float)r->hessian[1][1];
   const float det = h11 * h22 - h12 * h12;

@@ -7,6 +7,14 @@
 #include "bg_flux.h"
 #include "bg_window.h"
 
+/* The deep-bar rotor's share of the bounds (rotor_hf_rr_ratio, docs/METHOD.md §18.1) is built in
+ * unless the build defines IMEST_WITH_ROTOR_HF=0 (CMake: -DIMEST_ROTOR_HF=OFF); without it a
+ * config with a deep-bar rotor is refused (rotor_hf_rr_ratio) and imest_comm_apply() leaves the
+ * rotor as a single cage. */
+#ifndef IMEST_WITH_ROTOR_HF
+#define IMEST_WITH_ROTOR_HF 1
+#endif
+
 /* Fills valid/status and the per-parameter verdicts of r from the window
  * flags, the window's statistics and the solve; fx: the magnetising curve's
  * share of the bounds (bg_flux.h; NULL: none). */
