@@ -4,28 +4,10 @@
 // naming the field, never estimated as if it were not there; the rest of a config passes.
 #include <gtest/gtest.h>
 
-#include "imest/imest.h"
+#include "config_cases.h"
 
-namespace {
-imest_config_t motor()
-{
-  imest_config_t c;
-  imest_config_default(&c);
-  c.pole_pairs = 2;
-  c.ls_h = 0.1735f;
-  c.sigma = 0.066f;
-  return c;
-}
-
-const char *refused_field(const imest_config_t &c)
-{
-  const char *field = nullptr;
-  const int rc = imest_config_check(&c, &field);
-  static imest_t s;
-  EXPECT_EQ(imest_init(&s, &c), rc) << "imest_init() agrees with imest_config_check()";
-  return rc == IMEST_OK ? "" : field;
-}
-} // namespace
+using config_cases::motor;
+using config_cases::refused_field;
 
 TEST(MinimalBuild, PlainConfigPasses)
 {
