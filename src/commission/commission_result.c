@@ -73,6 +73,21 @@ static void constants_uncertainty(const imest_comm_result_t *r, int curve, imest
   cfg->sigma_uncertainty = at_most_max(u_sg);
 }
 
+/* A deep-bar rotor at high frequency (imest_comm_apply): the square wave's resistance and leakage
+ * against the slip-frequency ones, one pole (imest_config_t.rotor_hf_rr_ratio); 1 if filled. */
+static int apply_rotor_hf(const imest_comm_result_t *r, imest_config_t *cfg)
+{
+  if (!(IMEST_WITH_ROTOR_HF && (r->flags & IMEST_COMM_FLAG_ROTOR_HF) &&
+        (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP)))
+    return 0;
+  const float rr_ratio = r->rr_hf_ohm.value / r->rr_slip_ohm.value,
+              sl_ratio = r->sigma_ls_hf_h.value / r->sigma_ls_slip_h.value;
+  if (!(rr_ratio > 1.0f && sl_ratio > 0.0f)) return 0;
+  cfg->rotor_hf_rr_ratio = rr_ratio;
+  cfg->rotor_hf_sigma_ratio = sl_ratio < 1.0f ? sl_ratio : 1.0f;
+  return 1;
+}
+
 int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)
 {
   if (r == NULL || cfg == NULL) return IMEST_ERR_NULL;
@@ -101,16 +116,7 @@ int imest_comm_apply(const imest_comm_result_t *r, imest_config_t *cfg)
     cfg->inverter_vdc_v = r->vdc_v; /* the bus for measured phase voltages' harmonics */
     n++;
   }
-  /* a deep-bar rotor at high frequency: the square wave's resistance and leakage against the
-     slip-frequency ones (one pole, imest_config_t.rotor_hf_rr_ratio) */
-  const float rr_ratio = r->rr_hf_ohm.value / r->rr_slip_ohm.value,
-              sl_ratio = r->sigma_ls_hf_h.value / r->sigma_ls_slip_h.value;
-  if (IMEST_WITH_ROTOR_HF && (r->flags & IMEST_COMM_FLAG_ROTOR_HF) &&
-      (r->flags & IMEST_COMM_FLAG_SIGMA_SLIP) && rr_ratio > 1.0f && sl_ratio > 0.0f) {
-    cfg->rotor_hf_rr_ratio = rr_ratio;
-    cfg->rotor_hf_sigma_ratio = sl_ratio < 1.0f ? sl_ratio : 1.0f;
-    n++;
-  }
+  n += apply_rotor_hf(r, cfg);
   /* the magnetising curve: the estimator follows L_S with the window's flux (bg_flux.c) */
   if (curve) {
     cfg->ls_curve_points = r->ls_curve_points;

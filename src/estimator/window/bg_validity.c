@@ -528,6 +528,56 @@ static int rs_verdict(judge_t *j)
 /* the deep-bar rotor's share: twice its first-order move (inverter_harmonics) */
 #define ROTOR_HF_MARGIN 2.0f
 
+#if IMEST_WITH_ROTOR_HF
+/* The deep-bar rotor's one pole as inverter_harmonics() needs it */
+typedef struct {
+  float ehh; /* |E_1|^2 / (sigma L_S) of the largest error (hf_v has the 1 / (1 - u)) [V^2/H] */
+  float rm1; /* rr ratio - 1 */
+  float tau; /* the pole x = w_k tau: (1 - sigma ratio) sigma T_R / ((rr ratio - 1) (1 - sigma)) [s] */
+} rotor_hf_t;
+
+static void rotor_hf_setup(const imest_t *s, const inv_share_t *h, float lin, float tr, rotor_hf_t *rh)
+{
+  const float eh = lin * h->hf_v, sg = s->sigma;
+  rh->ehh = eh * eh * (float)s->inv_s;
+  rh->rm1 = s->rotor_hf_rr_ratio - 1.0f;
+  rh->tau = (1.0f - s->rotor_hf_sigma_ratio) * sg * tr / (rh->rm1 * (1.0f - sg));
+}
+
+/* Z_k of the deep-bar rotor's motor at the harmonic k w_e, rotor frequency wk: the rotor branch
+ * R_R' rho, rho = 1 + (rr ratio - 1) x^2 / (1 + j x) (1 at slip frequency; rr ratio R_R' and the
+ * leakage (1 - sigma ratio) sigma L_S lower at high frequency):
+ * Z = R_S + j w L_S (sigma + (1 - sigma) / (1 + j a / rho)), a = w_k T_R, with
+ * 1 / (1 + j a / rho) = N / (N + j a (1 + j x)), N = 1 + (rr ratio - 1) x^2 + j x */
+static void rotor_hf_z(const imest_t *s, const rotor_hf_t *rh, float tr, float rs, float kwe, float wk,
+                       float *zr, float *zi)
+{
+  const float sg = s->sigma, xh = wk * rh->tau, a = wk * tr;
+  const float nr = 1.0f + rh->rm1 * xh * xh, dr = nr - a * xh, di = xh + a, inv = 1.0f / (dr * dr + di * di);
+  const float lr = (nr * dr + xh * di) * inv, li = (xh * dr - nr * di) * inv;
+  const float wl = kwe * s->ls_h;
+  *zr = rs - wl * (1.0f - sg) * li;
+  *zi = wl * (sg + (1.0f - sg) * lr);
+}
+
+/* One harmonic's move of the fit by the rotor's deviation: the voltage the single cage would need
+ * for the data's current is off by eps_k E_k, eps_k = 1 - Z_k / Z_k,double = 1 - Z_k y;
+ * Re(eps y*) |K2 + j w_k|^2 and Re(eps t), t = (K2 + j w_k) conj(m y F), each harmonic's move
+ * summed in magnitude (their phases are the rotor's, which the one-pole description does not
+ * pin). g: G^2 / k^2 of the harmonic; zk: the single cage's Z_k; y = 1 / Z_k,double; q2 = (K2, w_k);
+ * p = m y F; hs = (h11, h12, h22) */
+static void rotor_hf_move(const rotor_hf_t *rh, float g, const bg_impedance_t *zk, float yr, float yi,
+                          float dd, float tr_, const float q2[2], float pr, float pi, const float hs[3],
+                          float *a1, float *a2)
+{
+  const float wh = rh->ehh * g; /* G^2 |E_k|^2 / (sigma L_S) */
+  const float cr = 1.0f - (zk->zr * yr - zk->zi * yi), ci = -(zk->zr * yi + zk->zi * yr);
+  const float u1 = wh * dd * (cr * yr + ci * yi), u2 = wh * (cr * tr_ - ci * (q2[1] * pr - q2[0] * pi));
+  *a1 += fabsf(hs[2] * u1 - hs[1] * u2);
+  *a2 += fabsf(hs[0] * u2 - hs[1] * u1);
+}
+#endif /* IMEST_WITH_ROTOR_HF */
+
 /* How far the inverter model's uncertain share can move K1 and K2 through
  * its harmonics (docs/METHOD.md §18.1), derived per window from the fit
  * itself rather than fitted to a table. A sign-type leg error of amplitude A
@@ -575,12 +625,12 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
    * the model's, and the model's error up to u / (1 - u) of it from the truth */
   const float e1 = model ? lin * h->sign_v / (1.0f - h->u) : 0.0f;
   const float ee = e1 * e1 * h->u * (float)s->inv_s;
-  /* the deep-bar rotor: |E_1|^2 / (sigma L_S) of the largest error (hf_v has the 1 / (1 - u)); its
-   * pole x = w_k tau, tau = (1 - sigma ratio) sigma T_R / ((rr ratio - 1) (1 - sigma)) */
-  const float eh = lin * h->hf_v, ehh = eh * eh * (float)s->inv_s;
-  const float sg = s->sigma, rm1 = s->rotor_hf_rr_ratio - 1.0f;
-  const float tau = hf ? (1.0f - s->rotor_hf_sigma_ratio) * sg * j->tr / (rm1 * (1.0f - sg)) : 0.0f;
   float g1 = 0.0f, g2 = 0.0f, a1 = 0.0f, a2 = 0.0f;
+#if IMEST_WITH_ROTOR_HF
+  rotor_hf_t rh = {0.0f, 0.0f, 0.0f};
+  if (hf) rotor_hf_setup(s, h, lin, j->tr, &rh);
+  const float hs[3] = {h11, h12, h22};
+#endif
   for (int p = 1; p <= HARMONIC_PAIRS; ++p) {
     for (int sgn = -1; sgn <= 1; sgn += 2) {
       const float k = (float)(6 * p + sgn) * (float)sgn; /* -5, 7, -11, 13 ... */
@@ -590,20 +640,10 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
       bg_impedance_t zk;
       imest__bg_impedance(k * we, wk, s->ls_h, s->sigma, j->tr, j->rs, &zk);
       float zr = zk.zr, zi = zk.zi;
-      if (hf) {
-        /* the rotor branch R_R' rho, rho = 1 + (rr ratio - 1) x^2 / (1 + j x) (1 at slip frequency;
-         * rr ratio R_R' and the leakage (1 - sigma ratio) sigma L_S lower at high frequency):
-         * Z = R_S + j w L_S (sigma + (1 - sigma) / (1 + j a / rho)), a = w_k T_R, with
-         * 1 / (1 + j a / rho) = N / (N + j a (1 + j x)), N = 1 + (rr ratio - 1) x^2 + j x. The data's
-         * current is the double cage's */
-        const float xh = wk * tau, a = wk * j->tr;
-        const float nr = 1.0f + rm1 * xh * xh, dr = nr - a * xh, di = xh + a,
-                    inv = 1.0f / (dr * dr + di * di);
-        const float lr = (nr * dr + xh * di) * inv, li = (xh * dr - nr * di) * inv;
-        const float wl = k * we * s->ls_h;
-        zr = j->rs - wl * (1.0f - sg) * li;
-        zi = wl * (sg + (1.0f - sg) * lr);
-      }
+#if IMEST_WITH_ROTOR_HF
+      if (hf)
+        rotor_hf_z(s, &rh, j->tr, j->rs, k * we, wk, &zr, &zi); /* the data's current: the double cage's */
+#endif
       const float zz = zr * zr + zi * zi;
       if (!(zz > 0.0f)) continue;
       /* y = 1 / Z_k: i_k = -E_k y */
@@ -619,17 +659,12 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
       /* t = (K2 + j w_k) conj(p); Re t */
       const float tr_ = k2 * pr + wk * pi;
       g2 += w2 * tr_;
+#if IMEST_WITH_ROTOR_HF
       if (hf) {
-        /* the voltage the single cage would need for the data's current is off by eps_k E_k:
-         * Re(eps y*) |K2 + j w_k|^2 and Re(eps t), each harmonic's move summed in magnitude
-         * (their phases are the rotor's, which the one-pole description does not pin) */
-        const float wh = ehh / ((1.0f + x3 * x3) * k * k); /* G^2 |E_k|^2 / (sigma L_S) */
-        /* the rotor's deviation eps_k = 1 - Z_k / Z_k,double = 1 - Z_k y */
-        const float cr = 1.0f - (zk.zr * yr - zk.zi * yi), ci = -(zk.zr * yi + zk.zi * yr);
-        const float u1 = wh * dd * (cr * yr + ci * yi), u2 = wh * (cr * tr_ - ci * (wk * pr - k2 * pi));
-        a1 += fabsf(h22 * u1 - h12 * u2);
-        a2 += fabsf(h11 * u2 - h12 * u1);
+        const float q2[2] = {k2, wk};
+        rotor_hf_move(&rh, 1.0f / ((1.0f + x3 * x3) * k * k), &zk, yr, yi, dd, tr_, q2, pr, pi, hs, &a1, &a2);
       }
+#endif
     }
   }
   const float n2 = 2.0f * (float)j->w->nreg * (float)r->windows;
