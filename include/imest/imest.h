@@ -383,7 +383,9 @@ typedef struct {
    * (IMEST_COMM_FLAG_ROTOR_HF: the square wave's R and sigma L_S at fs/8). The harmonics'
    * first-order move of the fit (twice it) is added to tr_bound_rel and rs_bound_rel. */
   /** the rotor's resistance at high rotor frequency over R_R' at slip frequency, above 1 (default
-   *  0: a single cage, the term is 0 and every output is as without these fields) */
+   *  0: a single cage, the term is 0 and every output is as without these fields). A core built
+   *  without the term (IMEST_WITH_ROTOR_HF=0, CMake -DIMEST_ROTOR_HF=OFF) refuses any other value:
+   *  imest_config_check() names this field */
   float rotor_hf_rr_ratio;
   /** sigma L_S at high rotor frequency over sigma L_S at slip frequency, in (0, 1] (read only with
    *  rotor_hf_rr_ratio; default 0) */
