@@ -214,9 +214,8 @@ typedef struct {
   float rs_tolerance, tr_tolerance, u_uncertainty_v, timing_uncertainty_s, rs_nominal_ohm;
   uint32_t tr_nominal_known;
   /* the rotor at high rotor frequency (bg_validity.c, rotor_hf): 0 a single cage; the phase-voltage
-     input's bus [V] (0 unknown) and whether its source is smooth (voltage_kind) */
+     input's bus [V] (0 unknown; a smooth source is t_stair_s[0] = 0) */
   float rotor_hf_rr_ratio, rotor_hf_sigma_ratio, inverter_vdc_v;
-  uint32_t voltage_smooth;
   float transient_k; /* a speed step's share of T_R's bound per (rad/s of step / rad/s of slip)
                         through the angle observer's lag (0: no observer; bg_transient.c) */
   float ls_curve_i_a[IMEST_LS_CURVE_POINTS]; /* the magnetising curve as configured (bg_flux.c) */

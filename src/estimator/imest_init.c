@@ -452,7 +452,6 @@ static void init_background_constants(imest_t *s, const imest_config_t *cfg)
   s->rotor_hf_rr_ratio = cfg->rotor_hf_rr_ratio;
   s->rotor_hf_sigma_ratio = cfg->rotor_hf_sigma_ratio;
   s->inverter_vdc_v = cfg->inverter_vdc_v;
-  s->voltage_smooth = cfg->voltage_kind == IMEST_VOLTAGE_SMOOTH;
   s->tr_nominal_known = cfg->tr_nominal_known != 0;
   s->ls_curve_points = cfg->ls_curve_points;
   for (unsigned int k = 0; IMEST_WITH_FLUX && k < IMEST_LS_CURVE_POINTS; ++k) {

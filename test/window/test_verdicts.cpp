@@ -196,7 +196,7 @@ imest_result_t judge(Win &x)
   const bool harm_known = !x.w.duty_input || x.s.inverter.uncertainty < 1.0f;
   // a deep-bar rotor sees the inverter's harmonics with either input: unknown without the model
   // (and, measured voltages from a PWM source, the bus)
-  const bool hf_known = !(x.s.rotor_hf_rr_ratio > 0.0f) || (!x.w.duty_input && x.s.voltage_smooth != 0u) ||
+  const bool hf_known = !(x.s.rotor_hf_rr_ratio > 0.0f) || (!x.w.duty_input && !(x.s.t_stair_s[0] > 0.0f)) ||
                         (x.s.inverter.uncertainty >= 0.0f && x.s.inverter.uncertainty < 1.0f &&
                          (x.w.duty_input ? x.w.vdc_v > 0.0 : x.s.inverter_vdc_v > 0.0f));
   if (have && x.st.slip_rate != 0.0) {

@@ -137,7 +137,7 @@ static float sign_error(const imest_inverter_t *v, float dead, float a)
 static float rotor_hf_share(const imest_t *s, const imest_window_t *w, float a)
 {
   if (!IMEST_WITH_ROTOR_HF || !(s->rotor_hf_rr_ratio > 0.0f)) return 0.0f;
-  if (!w->duty_input && s->voltage_smooth) return 0.0f;
+  if (!w->duty_input && !(s->t_stair_s[0] > 0.0f)) return 0.0f; /* a smooth source */
   const imest_inverter_t *v = &s->inverter;
   const float vdc = w->duty_input ? (float)w->vdc_v : s->inverter_vdc_v;
   const float u = v->uncertainty;
@@ -564,13 +564,13 @@ static void rotor_hf_z(const imest_t *s, const rotor_hf_t *rh, float tr, float r
  * for the data's current is off by eps_k E_k, eps_k = 1 - Z_k / Z_k,double = 1 - Z_k y;
  * Re(eps y*) |K2 + j w_k|^2 and Re(eps t), t = (K2 + j w_k) conj(m y F), each harmonic's move
  * summed in magnitude (their phases are the rotor's, which the one-pole description does not
- * pin). g: G^2 / k^2 of the harmonic; zk: the single cage's Z_k; y = 1 / Z_k,double; q2 = (K2, w_k);
+ * pin). gk: k^2 / G^2 of the harmonic; zk: the single cage's Z_k; y = 1 / Z_k,double; q2 = (K2, w_k);
  * p = m y F; hs = (h11, h12, h22) */
-static void rotor_hf_move(const rotor_hf_t *rh, float g, const bg_impedance_t *zk, float yr, float yi,
+static void rotor_hf_move(const rotor_hf_t *rh, float gk, const bg_impedance_t *zk, float yr, float yi,
                           float dd, float tr_, const float q2[2], float pr, float pi, const float hs[3],
                           float *a1, float *a2)
 {
-  const float wh = rh->ehh * g; /* G^2 |E_k|^2 / (sigma L_S) */
+  const float wh = rh->ehh / gk; /* G^2 |E_k|^2 / (sigma L_S) */
   const float cr = 1.0f - (zk->zr * yr - zk->zi * yi), ci = -(zk->zr * yi + zk->zi * yr);
   const float u1 = wh * dd * (cr * yr + ci * yi), u2 = wh * (cr * tr_ - ci * (q2[1] * pr - q2[0] * pi));
   *a1 += fabsf(hs[2] * u1 - hs[1] * u2);
@@ -597,26 +597,26 @@ static void rotor_hf_move(const rotor_hf_t *rh, float g, const bg_impedance_t *z
  * (|cos| = 1, magnitudes summed); the digital filter's gain is below the
  * analogue one at 2 f_s tan(pi f_c / f_s) (tan x >= x). Not counted: the
  * fundamental (in phase with the current: R_S only, exactly) and the
- * harmonics aliased beyond f_s / 2. *dk1, *dk2: the largest moves [1/s];
- * infinite where H is not positive definite. */
+ * harmonics aliased beyond f_s / 2. *dk1, *dk2: the largest moves [1/s], the
+ * model's and, with a deep-bar rotor, the rotor's (rotor_hf_move()); infinite
+ * where H is not positive definite or the harmonics are not bounded. */
 static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float slip_rate, float *dk1,
-                               float *dk2, float *hk1, float *hk2)
+                               float *dk2)
 {
   const imest_t *s = j->s;
   const imest_result_t *r = j->r;
   *dk1 = 0.0f;
   *dk2 = 0.0f;
-  *hk1 = 0.0f;
-  *hk2 = 0.0f;
   const int model = h->sign_v > 0.0f, hf = IMEST_WITH_ROTOR_HF && h->hf_v > 0.0f;
   if (!model && !hf) return;
   const float h11 = (float)r->hessian[0][0], h12 = (float)r->hessian[0][1], h22 = (float)r->hessian[1][1];
   const float det = h11 * h22 - h12 * h12;
   /* infinite where H is not positive definite, or the harmonics are not bounded */
   const int pd = h11 > 0.0f && det > 0.0f && isfinite(det);
-  if (model && !(pd && h->u < 1.0f)) *dk1 = *dk2 = INFINITY;
-  if (hf && !(pd && isfinite(h->hf_v))) *hk1 = *hk2 = INFINITY;
-  if (!(isfinite(*dk1) && isfinite(*hk1))) return;
+  if ((model && !(pd && h->u < 1.0f)) || (hf && !(pd && isfinite(h->hf_v)))) {
+    *dk1 = *dk2 = INFINITY;
+    return;
+  }
   const float we = j->op.we, k2 = 1.0f / j->tr, nw = we - slip_rate, m = (float)s->m;
   const float b0 = (float)s->bw.b0, kb = b0 / (1.0f - b0); /* tan(pi f_c / f_s) of the first section */
   const float wq = 2.0f * (float)s->fs * kb;
@@ -636,7 +636,8 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
       const float k = (float)(6 * p + sgn) * (float)sgn; /* -5, 7, -11, 13 ... */
       const float wk = (k - 1.0f) * we + slip_rate;
       const float x = wk / wq, x3 = x * x * x;
-      const float w2 = ee / ((1.0f + x3 * x3) * k * k); /* G^2 eps |E_k|^2 / (sigma L_S) */
+      const float gk = (1.0f + x3 * x3) * k * k; /* k^2 / G^2 */
+      const float w2 = ee / gk;                  /* G^2 eps |E_k|^2 / (sigma L_S) */
       bg_impedance_t zk;
       imest__bg_impedance(k * we, wk, s->ls_h, s->sigma, j->tr, j->rs, &zk);
       float zr = zk.zr, zi = zk.zi;
@@ -662,7 +663,7 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
 #if IMEST_WITH_ROTOR_HF
       if (hf) {
         const float q2[2] = {k2, wk};
-        rotor_hf_move(&rh, 1.0f / ((1.0f + x3 * x3) * k * k), &zk, yr, yi, dd, tr_, q2, pr, pi, hs, &a1, &a2);
+        rotor_hf_move(&rh, gk, &zk, yr, yi, dd, tr_, q2, pr, pi, hs, &a1, &a2);
       }
 #endif
     }
@@ -674,10 +675,10 @@ static void inverter_harmonics(const judge_t *j, const inv_share_t *h, float sli
     *dk1 = fabsf(h22 * g1 - h12 * g2) / det;
     *dk2 = fabsf(h11 * g2 - h12 * g1) / det;
   }
-  /* twice the first-order move, as the timing's (measured: 0.8 to 1.9 x it at rated load; at half
-   * load its sign is not the data's) */
-  *hk1 = ROTOR_HF_MARGIN * a1 * n2 / det;
-  *hk2 = ROTOR_HF_MARGIN * a2 * n2 / det;
+  /* the deep-bar rotor's: twice the first-order move, as the timing's (measured: 0.8 to 1.9 x it at
+   * rated load; at half load its sign is not the data's) */
+  *dk1 += ROTOR_HF_MARGIN * a1 * n2 / det;
+  *dk2 += ROTOR_HF_MARGIN * a2 * n2 / det;
 }
 
 /* The systematic bounds: T_R's (the staircase, the timing, the inverter
@@ -724,10 +725,7 @@ static void bounds(judge_t *j, const bg_sums_t *sm, const bg_flux_t *fx, int hav
     }
     systematic_bounds(j->s, j->w, &j->op, ws_b, j->tr, rs, dv_v, h.shape_v, &j->tr_b, &j->rs_b, &j->c_tr,
                       &j->c_rs, j->st->dw_rad_s, &j->x_tr, &j->x_rs);
-    float hk1, hk2;
-    inverter_harmonics(j, &h, ws_b, &dk1, &dk2, &hk1, &hk2);
-    dk1 += hk1;
-    dk2 += hk2;
+    inverter_harmonics(j, &h, ws_b, &dk1, &dk2);
     const float h_tr = dk2 * j->tr,
                 h_rs = (j->s->sigma * j->s->ls_h * dk1 + (1.0f - j->s->sigma) * j->s->ls_h * dk2) / rs;
     j->tr_b += h_tr;
